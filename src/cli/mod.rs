@@ -1,0 +1,61 @@
+//! The `pgt` command line (DESIGN.md §7): one file per subcommand. Every subcommand returns an
+//! [`Outcome`]; `main` maps it and errors to exit codes 0 / 1 / 2.
+
+pub mod render;
+
+use clap::{Parser, Subcommand};
+
+/// What a subcommand ended with, when it did not fail.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Outcome {
+    /// Success, or a gate that passed: exit 0.
+    Success,
+    /// A gate that failed: exit 1.
+    GateFailed,
+}
+
+#[derive(Debug, Parser)]
+#[command(name = "pgt", version, about = "Particle ground truth: exact renderings of sphere particle scenes, GPU approximations, and their difference")]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+pub enum Command {
+    /// Render the exact reference image of a scene (a scene TOML or a bare particle file).
+    Render(render::RenderArgs),
+}
+
+/// Runs the parsed command line.
+pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
+    match cli.command {
+        Command::Render(args) => render::run(args),
+    }
+}
+
+/// Parses `WxH`.
+pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WIDTHxHEIGHT, got '{s}'"))?;
+    let parse = |v: &str| {
+        v.trim()
+            .parse::<u32>()
+            .map_err(|_| format!("expected WIDTHxHEIGHT with positive integers, got '{s}'"))
+    };
+    let (w, h) = (parse(w)?, parse(h)?);
+    if w == 0 || h == 0 || w > crate::scene::MAX_IMAGE_SIDE || h > crate::scene::MAX_IMAGE_SIDE {
+        return Err(format!(
+            "image size must be between 1 and {} on each side, got '{s}'",
+            crate::scene::MAX_IMAGE_SIDE
+        ));
+    }
+    Ok((w, h))
+}
+
+/// Whether stderr is a terminal (progress bars only then).
+pub fn stderr_is_terminal() -> bool {
+    use std::io::IsTerminal;
+    std::io::stderr().is_terminal()
+}

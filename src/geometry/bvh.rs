@@ -1,0 +1,518 @@
+//! A bounding volume hierarchy over spheres, built with binned SAH (DESIGN.md §3).
+//!
+//! Nodes live in one flat `Vec` (the GPU side flattens the same array into a storage buffer);
+//! memory is O(n): at most 2n − 1 nodes of 56 bytes and one u32 index per sphere.
+//! Two queries: every sphere a ray crosses, sorted by entry (the volume renderer cuts rays into
+//! intervals with them) and whether any sphere blocks a segment (shadow rays).
+
+use super::{intersect_sphere, Chord, Ray};
+use glam::DVec3;
+
+/// Spheres per leaf at most (fewer when the SAH says a split does not pay).
+const MAX_LEAF: usize = 4;
+/// Centroid bins per axis for the SAH sweep.
+const BINS: usize = 16;
+/// Relative cost of one ray–box test against one ray–sphere test.
+const TRAVERSAL_COST: f64 = 1.0;
+
+/// One node. `count > 0`: a leaf holding `indices[first .. first + count]`; `count == 0`: an
+/// inner node whose children are `first` and `first + 1`.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct BvhNode {
+    pub min: DVec3,
+    pub max: DVec3,
+    pub first: u32,
+    pub count: u32,
+}
+
+/// A sphere crossed by a ray: its index in the input order and the chord's ends.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Hit {
+    pub index: u32,
+    pub chord: Chord,
+}
+
+/// The hierarchy over a fixed set of spheres (centres, radii, in the caller's order).
+#[derive(Debug, Clone)]
+pub struct Bvh {
+    pub nodes: Vec<BvhNode>,
+    /// Sphere indices in leaf order.
+    pub indices: Vec<u32>,
+    centers: Vec<DVec3>,
+    radii: Vec<f64>,
+}
+
+#[derive(Clone, Copy)]
+struct Aabb {
+    min: DVec3,
+    max: DVec3,
+}
+
+impl Aabb {
+    const EMPTY: Aabb = Aabb {
+        min: DVec3::splat(f64::INFINITY),
+        max: DVec3::splat(f64::NEG_INFINITY),
+    };
+    fn grow(&mut self, other: &Aabb) {
+        self.min = self.min.min(other.min);
+        self.max = self.max.max(other.max);
+    }
+    fn grow_point(&mut self, p: DVec3) {
+        self.min = self.min.min(p);
+        self.max = self.max.max(p);
+    }
+    fn half_area(&self) -> f64 {
+        let e = self.max - self.min;
+        if e.x < 0.0 {
+            return 0.0;
+        }
+        e.x * e.y + e.y * e.z + e.z * e.x
+    }
+}
+
+/// The box of a sphere, padded by a relative margin so that round-off in the slab test can never
+/// cull a ray that grazes the sphere (the box only has to be conservative).
+fn sphere_box(c: DVec3, r: f64) -> Aabb {
+    let pad = r * (1.0 + 1e-9) + 1e-12 * c.abs().max_element();
+    Aabb {
+        min: c - DVec3::splat(pad),
+        max: c + DVec3::splat(pad),
+    }
+}
+
+impl Bvh {
+    /// Builds the hierarchy. Centres and radii must be finite (the scene validates them).
+    pub fn build(centers: Vec<DVec3>, radii: Vec<f64>) -> Bvh {
+        assert_eq!(centers.len(), radii.len());
+        let n = centers.len();
+        let boxes: Vec<Aabb> = centers.iter().zip(&radii).map(|(&c, &r)| sphere_box(c, r)).collect();
+        let mut indices: Vec<u32> = (0..n as u32).collect();
+        let mut nodes = Vec::with_capacity(2 * n.max(1));
+        nodes.push(BvhNode {
+            min: DVec3::ZERO,
+            max: DVec3::ZERO,
+            first: 0,
+            count: 0,
+        });
+        if n == 0 {
+            // An empty box that no ray enters.
+            nodes[0].min = DVec3::splat(f64::INFINITY);
+            nodes[0].max = DVec3::splat(f64::NEG_INFINITY);
+            return Bvh { nodes, indices, centers, radii };
+        }
+        // Explicit work stack: (node, range start, range end); depth is bounded by the
+        // fall-back median split, so no recursion limit is hit for millions of spheres.
+        let mut stack = vec![(0usize, 0usize, n)];
+        while let Some((node, start, end)) = stack.pop() {
+            let mut bounds = Aabb::EMPTY;
+            let mut cbounds = Aabb::EMPTY;
+            for &i in &indices[start..end] {
+                bounds.grow(&boxes[i as usize]);
+                cbounds.grow_point(centers[i as usize]);
+            }
+            nodes[node].min = bounds.min;
+            nodes[node].max = bounds.max;
+            let count = end - start;
+            let split = if count <= MAX_LEAF {
+                None
+            } else {
+                choose_split(&indices[start..end], &boxes, &centers, &bounds, &cbounds)
+            };
+            let mid = match split {
+                Some((axis, pos)) => {
+                    let slice = &mut indices[start..end];
+                    let mut left = 0;
+                    for k in 0..slice.len() {
+                        if centers[slice[k] as usize][axis] < pos {
+                            slice.swap(k, left);
+                            left += 1;
+                        }
+                    }
+                    if left == 0 || left == slice.len() {
+                        // Round-off put every centroid on one side: split by count instead.
+                        median_split(slice, &centers, &cbounds);
+                        start + slice.len() / 2
+                    } else {
+                        start + left
+                    }
+                }
+                None if count > 4 * MAX_LEAF * BINS => {
+                    // SAH sees no gain (e.g. all centroids equal) but the node is huge: split
+                    // by count so depth stays logarithmic.
+                    let slice = &mut indices[start..end];
+                    median_split(slice, &centers, &cbounds);
+                    start + slice.len() / 2
+                }
+                None => start,
+            };
+            if mid == start || mid == end {
+                nodes[node].first = start as u32;
+                nodes[node].count = count as u32;
+                continue;
+            }
+            let left = nodes.len();
+            for _ in 0..2 {
+                nodes.push(BvhNode {
+                    min: DVec3::ZERO,
+                    max: DVec3::ZERO,
+                    first: 0,
+                    count: 0,
+                });
+            }
+            nodes[node].first = left as u32;
+            nodes[node].count = 0;
+            stack.push((left + 1, mid, end));
+            stack.push((left, start, mid));
+        }
+        nodes.shrink_to_fit();
+        Bvh { nodes, indices, centers, radii }
+    }
+
+    /// Number of spheres.
+    pub fn len(&self) -> usize {
+        self.centers.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.centers.is_empty()
+    }
+
+    /// Every sphere whose chord overlaps (t_min, t_max), sorted by entry then index (a total
+    /// order, so the result does not depend on the tree's shape). `out` is cleared first.
+    pub fn all_hits(&self, ray: &Ray, t_min: f64, t_max: f64, out: &mut Vec<Hit>) {
+        out.clear();
+        self.traverse(ray, t_min, t_max, |index, chord, _| {
+            out.push(Hit { index, chord });
+            false
+        });
+        out.sort_unstable_by(|a, b| {
+            a.chord
+                .t_enter
+                .total_cmp(&b.chord.t_enter)
+                .then(a.index.cmp(&b.index))
+        });
+    }
+
+    /// Whether any sphere's chord overlaps (t_min, t_max), ignoring spheres for which `skip`
+    /// returns true.
+    pub fn any_hit(&self, ray: &Ray, t_min: f64, t_max: f64, skip: impl Fn(u32) -> bool) -> bool {
+        let mut found = false;
+        self.traverse(ray, t_min, t_max, |index, _, _| {
+            if skip(index) {
+                false
+            } else {
+                found = true;
+                true
+            }
+        });
+        found
+    }
+
+    /// The nearest surface crossing with t in (t_min, t_max): the sphere, t, and whether the ray
+    /// enters the sphere there (false: it leaves it, the origin being inside). Ties go to the
+    /// lower index, so the answer does not depend on the tree's shape.
+    pub fn first_hit(&self, ray: &Ray, t_min: f64, t_max: f64) -> Option<(u32, f64, bool)> {
+        let mut best: Option<(u32, f64, bool)> = None;
+        self.traverse(ray, t_min, t_max, |index, chord, limit| {
+            let (t, entering) = if chord.t_enter > t_min {
+                (chord.t_enter, true)
+            } else {
+                (chord.t_exit, false)
+            };
+            if t < *limit || (t == *limit && best.is_some_and(|b| index < b.0)) {
+                best = Some((index, t, entering));
+                *limit = t;
+            }
+            false
+        });
+        best
+    }
+
+    /// Visits every sphere whose chord overlaps (t_min, limit), nearer boxes first; `visit` may
+    /// lower `limit` (nearest-hit search) and returns true to stop.
+    fn traverse(&self, ray: &Ray, t_min: f64, t_max: f64, mut visit: impl FnMut(u32, Chord, &mut f64) -> bool) {
+        if self.centers.is_empty() {
+            return;
+        }
+        let inv = ray.direction.recip();
+        let mut limit = t_max;
+        let root = &self.nodes[0];
+        if slab_test(ray.origin, inv, root.min, root.max, t_min, limit).is_none() {
+            return;
+        }
+        let mut stack = NodeStack::new();
+        stack.push(0);
+        while let Some(n) = stack.pop() {
+            let node = &self.nodes[n as usize];
+            if node.count > 0 {
+                let first = node.first as usize;
+                for &i in &self.indices[first..first + node.count as usize] {
+                    if let Some(chord) = intersect_sphere(ray, self.centers[i as usize], self.radii[i as usize]) {
+                        if chord.t_exit > t_min && chord.t_enter < limit && visit(i, chord, &mut limit) {
+                            return;
+                        }
+                    }
+                }
+                continue;
+            }
+            let (a, b) = (node.first, node.first + 1);
+            let na = &self.nodes[a as usize];
+            let nb = &self.nodes[b as usize];
+            let ta = slab_test(ray.origin, inv, na.min, na.max, t_min, limit);
+            let tb = slab_test(ray.origin, inv, nb.min, nb.max, t_min, limit);
+            match (ta, tb) {
+                (Some(ta), Some(tb)) => {
+                    // Far child first on the stack, so the near one is visited first.
+                    if ta <= tb {
+                        stack.push(b);
+                        stack.push(a);
+                    } else {
+                        stack.push(a);
+                        stack.push(b);
+                    }
+                }
+                (Some(_), None) => stack.push(a),
+                (None, Some(_)) => stack.push(b),
+                (None, None) => {}
+            }
+        }
+    }
+}
+
+/// A traversal stack that lives on the machine stack for the usual depths and spills to the
+/// heap only for pathological trees.
+struct NodeStack {
+    fixed: [u32; 64],
+    len: usize,
+    spill: Vec<u32>,
+}
+
+impl NodeStack {
+    fn new() -> Self {
+        NodeStack {
+            fixed: [0; 64],
+            len: 0,
+            spill: Vec::new(),
+        }
+    }
+    #[inline]
+    fn push(&mut self, n: u32) {
+        if self.len < self.fixed.len() {
+            self.fixed[self.len] = n;
+            self.len += 1;
+        } else {
+            self.spill.push(n);
+        }
+    }
+    #[inline]
+    fn pop(&mut self) -> Option<u32> {
+        if let Some(n) = self.spill.pop() {
+            return Some(n);
+        }
+        if self.len == 0 {
+            return None;
+        }
+        self.len -= 1;
+        Some(self.fixed[self.len])
+    }
+}
+
+/// Reorders `slice` so that its first half holds the centroids below the median along the widest
+/// centroid axis.
+fn median_split(slice: &mut [u32], centers: &[DVec3], cbounds: &Aabb) {
+    let axis = (cbounds.max - cbounds.min).max_position();
+    let half = slice.len() / 2;
+    slice.select_nth_unstable_by(half, |&a, &b| centers[a as usize][axis].total_cmp(&centers[b as usize][axis]));
+}
+
+/// Slab test of the segment (t_min, t_max) against a box. `f64::min`/`max` drop the NaN that
+/// 0·∞ gives when the origin lies on a slab plane of an axis the ray is parallel to.
+/// Returns the entry distance when the segment meets the box.
+#[inline]
+fn slab_test(o: DVec3, inv: DVec3, min: DVec3, max: DVec3, t_min: f64, t_max: f64) -> Option<f64> {
+    let t0 = (min - o) * inv;
+    let t1 = (max - o) * inv;
+    let near = t0.x.min(t1.x).max(t0.y.min(t1.y)).max(t0.z.min(t1.z)).max(t_min);
+    let far = t0.x.max(t1.x).min(t0.y.max(t1.y)).min(t0.z.max(t1.z)).min(t_max);
+    (near <= far).then_some(near)
+}
+
+/// Binned SAH over centroids: the (axis, position) with the lowest cost, or `None` when no split
+/// beats a leaf.
+fn choose_split(indices: &[u32], boxes: &[Aabb], centers: &[DVec3], bounds: &Aabb, cbounds: &Aabb) -> Option<(usize, f64)> {
+    let mut best: Option<(f64, usize, f64)> = None;
+    for axis in 0..3 {
+        let lo = cbounds.min[axis];
+        let hi = cbounds.max[axis];
+        if !(hi > lo) {
+            continue;
+        }
+        let scale = BINS as f64 / (hi - lo);
+        let mut bin_box = [Aabb::EMPTY; BINS];
+        let mut bin_count = [0usize; BINS];
+        for &i in indices {
+            let b = (((centers[i as usize][axis] - lo) * scale) as usize).min(BINS - 1);
+            bin_count[b] += 1;
+            bin_box[b].grow(&boxes[i as usize]);
+        }
+        // Sweep from the right to get the right-hand areas, then from the left.
+        let mut right_area = [0.0; BINS];
+        let mut right_count = [0usize; BINS];
+        let mut acc = Aabb::EMPTY;
+        let mut cnt = 0;
+        for b in (1..BINS).rev() {
+            acc.grow(&bin_box[b]);
+            cnt += bin_count[b];
+            right_area[b] = acc.half_area();
+            right_count[b] = cnt;
+        }
+        let mut acc = Aabb::EMPTY;
+        let mut cnt = 0;
+        for b in 0..BINS - 1 {
+            acc.grow(&bin_box[b]);
+            cnt += bin_count[b];
+            if cnt == 0 || right_count[b + 1] == 0 {
+                continue;
+            }
+            let cost = acc.half_area() * cnt as f64 + right_area[b + 1] * right_count[b + 1] as f64;
+            if best.is_none_or(|(c, _, _)| cost < c) {
+                best = Some((cost, axis, lo + (b + 1) as f64 / scale));
+            }
+        }
+    }
+    let (cost, axis, pos) = best?;
+    let leaf_cost = indices.len() as f64;
+    let split_cost = TRAVERSAL_COST + cost / bounds.half_area().max(f64::MIN_POSITIVE);
+    if split_cost < leaf_cost || indices.len() > 4 * MAX_LEAF * BINS {
+        Some((axis, pos))
+    } else {
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn brute_all(centers: &[DVec3], radii: &[f64], ray: &Ray, t_min: f64, t_max: f64) -> Vec<Hit> {
+        let mut v: Vec<Hit> = centers
+            .iter()
+            .zip(radii)
+            .enumerate()
+            .filter_map(|(i, (&c, &r))| intersect_sphere(ray, c, r).map(|chord| Hit { index: i as u32, chord }))
+            .filter(|h| h.chord.t_exit > t_min && h.chord.t_enter < t_max)
+            .collect();
+        v.sort_unstable_by(|a, b| a.chord.t_enter.total_cmp(&b.chord.t_enter).then(a.index.cmp(&b.index)));
+        v
+    }
+
+    fn spheres() -> impl Strategy<Value = Vec<([f64; 3], f64)>> {
+        prop::collection::vec((prop::array::uniform3(-10.0f64..10.0), 0.05f64..2.0), 0..200)
+    }
+
+    #[derive(Debug, Clone)]
+    enum RayKind {
+        Random([f64; 3], [f64; 3]),
+        /// Grazes sphere `k` at (1 − 1e-12·s)·r from its centre, s ∈ [-1, 1].
+        Graze(usize, [f64; 3], f64),
+        /// Starts inside sphere `k`.
+        Inside(usize, [f64; 3], [f64; 3]),
+    }
+
+    fn ray_kind() -> impl Strategy<Value = RayKind> {
+        prop_oneof![
+            (prop::array::uniform3(-15.0f64..15.0), prop::array::uniform3(-1.0f64..1.0)).prop_map(|(o, d)| RayKind::Random(o, d)),
+            (0usize..1000, prop::array::uniform3(-1.0f64..1.0), -1.0f64..1.0).prop_map(|(k, d, s)| RayKind::Graze(k, d, s)),
+            (0usize..1000, prop::array::uniform3(-0.5f64..0.5), prop::array::uniform3(-1.0f64..1.0)).prop_map(|(k, o, d)| RayKind::Inside(k, o, d)),
+        ]
+    }
+
+    fn make_ray(kind: &RayKind, centers: &[DVec3], radii: &[f64]) -> Option<Ray> {
+        match *kind {
+            RayKind::Random(o, d) => {
+                let d = DVec3::from(d);
+                (d.length() > 1e-3).then(|| Ray::new(DVec3::from(o), d))
+            }
+            RayKind::Graze(k, d, s) => {
+                let d = DVec3::from(d);
+                if centers.is_empty() || d.length() < 1e-3 {
+                    return None;
+                }
+                let k = k % centers.len();
+                let d = d.normalize();
+                let b = radii[k] * (1.0 - 1e-12 * s);
+                let origin = centers[k] + d.any_orthonormal_vector() * b - 20.0 * d;
+                Some(Ray { origin, direction: d })
+            }
+            RayKind::Inside(k, o, d) => {
+                let d = DVec3::from(d);
+                if centers.is_empty() || d.length() < 1e-3 {
+                    return None;
+                }
+                let k = k % centers.len();
+                Some(Ray::new(centers[k] + DVec3::from(o) * radii[k], d))
+            }
+        }
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(256))]
+        #[test]
+        fn bvh_queries_agree_with_brute_force(sph in spheres(), kind in ray_kind(), t_min in prop_oneof![Just(0.0), Just(f64::NEG_INFINITY)], t_max in prop_oneof![Just(f64::INFINITY), 0.1f64..30.0]) {
+            let centers: Vec<DVec3> = sph.iter().map(|s| DVec3::from(s.0)).collect();
+            let radii: Vec<f64> = sph.iter().map(|s| s.1).collect();
+            let Some(ray) = make_ray(&kind, &centers, &radii) else { return Ok(()); };
+            let bvh = Bvh::build(centers.clone(), radii.clone());
+            let mut got = Vec::new();
+            bvh.all_hits(&ray, t_min, t_max, &mut got);
+            let expected = brute_all(&centers, &radii, &ray, t_min, t_max);
+            prop_assert_eq!(&got, &expected);
+            prop_assert_eq!(bvh.any_hit(&ray, t_min, t_max, |_| false), !expected.is_empty());
+            let brute_first = expected
+                .iter()
+                .map(|h| if h.chord.t_enter > t_min { (h.index, h.chord.t_enter, true) } else { (h.index, h.chord.t_exit, false) })
+                .filter(|h| h.1 < t_max)
+                .min_by(|a, b| a.1.total_cmp(&b.1).then(a.0.cmp(&b.0)));
+            prop_assert_eq!(bvh.first_hit(&ray, t_min, t_max), brute_first);
+            if let Some(first) = expected.first() {
+                let skip = first.index;
+                let others = expected.iter().any(|h| h.index != skip);
+                prop_assert_eq!(bvh.any_hit(&ray, t_min, t_max, |i| i == skip), others);
+            }
+        }
+    }
+
+    #[test]
+    fn leaves_cover_every_sphere_once_and_memory_is_linear() {
+        let n = 20_000;
+        let mut centers = Vec::with_capacity(n);
+        let mut state = 12345u64;
+        let mut next = || {
+            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..n {
+            centers.push(DVec3::new(next(), next(), next()) * 100.0);
+        }
+        let bvh = Bvh::build(centers, vec![0.5; n]);
+        assert!(bvh.nodes.len() < 2 * n);
+        let mut seen = vec![0u8; n];
+        for node in bvh.nodes.iter().filter(|nd| nd.count > 0) {
+            for &i in &bvh.indices[node.first as usize..(node.first + node.count) as usize] {
+                seen[i as usize] += 1;
+            }
+        }
+        assert!(seen.iter().all(|&s| s == 1));
+    }
+
+    #[test]
+    fn identical_centres_still_build_a_shallow_tree() {
+        let n = 5000;
+        let bvh = Bvh::build(vec![DVec3::ONE; n], vec![1.0; n]);
+        let ray = Ray::new(DVec3::new(1.0, 1.0, -5.0), DVec3::Z);
+        let mut hits = Vec::new();
+        bvh.all_hits(&ray, 0.0, f64::INFINITY, &mut hits);
+        assert_eq!(hits.len(), n);
+    }
+}

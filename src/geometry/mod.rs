@@ -1,0 +1,11 @@
+//! Rays, the stable ray–sphere intersection, the pinhole camera and the BVH (DESIGN.md §1, §3).
+
+pub mod bvh;
+pub mod camera;
+pub mod ray;
+pub mod sphere;
+
+pub use bvh::{Bvh, BvhNode, Hit};
+pub use camera::Camera;
+pub use ray::Ray;
+pub use sphere::{intersect_sphere, Chord};

@@ -1,0 +1,39 @@
+//! Images in memory and on disk (DESIGN.md §7): EXR (linear float32 `R`, `G`, `B`, plus extra
+//! layers such as the reference's `err.R/G/B`) and PNG (8-bit sRGB of the linear image).
+//! Every write is atomic: a temporary file in the target folder, renamed at the end.
+
+mod read;
+mod write;
+
+pub use read::{read_image, read_exr_layer};
+pub use write::{linear_to_srgb8, write_image, ImageFormat};
+
+/// A linear RGB image, row-major, row 0 at the top.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RgbImage {
+    pub width: u32,
+    pub height: u32,
+    pub pixels: Vec<[f32; 3]>,
+}
+
+impl RgbImage {
+    /// A black image.
+    pub fn new(width: u32, height: u32) -> Self {
+        RgbImage {
+            width,
+            height,
+            pixels: vec![[0.0; 3]; width as usize * height as usize],
+        }
+    }
+
+    /// The pixel at (x, y).
+    #[inline]
+    pub fn get(&self, x: u32, y: u32) -> [f32; 3] {
+        self.pixels[y as usize * self.width as usize + x as usize]
+    }
+
+    /// Whether every value is finite.
+    pub fn all_finite(&self) -> bool {
+        self.pixels.iter().all(|p| p.iter().all(|v| v.is_finite()))
+    }
+}

@@ -1,0 +1,17 @@
+//! pgt — particle ground truth.
+//!
+//! Data flows one way (DESIGN.md, STYLE.md): scene → geometry → optics → reference | approx →
+//! metrics → report, with the command line on top. This file holds only module lines and
+//! re-exports.
+
+pub mod cli;
+pub mod error;
+pub mod formats;
+pub mod geometry;
+pub mod image_io;
+pub mod optics;
+pub mod reference;
+pub mod scene;
+
+pub use error::{PgtError, Result};
+pub use scene::{Scene, SceneLoadOptions};

@@ -1,0 +1,147 @@
+//! The TOML scene file of DESIGN.md §1, as serde types. Every table denies unknown fields so a
+//! misspelt key is an error, not a silently ignored setting. Tables are `Spanned` so validation
+//! can name the line.
+
+use super::{Falloff, LightWeight, OpticalModel, RenderMode};
+use serde::Deserialize;
+use toml::Spanned;
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct SceneFile {
+    pub camera: Option<Spanned<CameraTable>>,
+    pub render: Option<Spanned<RenderTable>>,
+    #[serde(default)]
+    pub lights: Vec<Spanned<LightTable>>,
+    pub defaults: Option<Spanned<ParticleDefaults>>,
+    #[serde(default)]
+    pub particles: Vec<Spanned<ParticleTable>>,
+    #[serde(default)]
+    pub include: Vec<Spanned<IncludeSpec>>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct CameraTable {
+    pub position: Option<[f64; 3]>,
+    pub look_at: Option<[f64; 3]>,
+    pub up: Option<[f64; 3]>,
+    pub fov_y: Option<f64>,
+    pub focal_length: Option<f64>,
+    pub width: Option<i64>,
+    pub height: Option<i64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct RenderTable {
+    pub mode: Option<RenderMode>,
+    pub model: Option<OpticalModel>,
+    pub background: Option<[f64; 3]>,
+    pub lambda: Option<f64>,
+    pub light_weight: Option<LightWeight>,
+    pub emission_weight: Option<f64>,
+    pub ambient: Option<f64>,
+    pub tol: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(tag = "type", rename_all = "kebab-case")]
+pub(super) enum LightTable {
+    Directional(DirectionalTable),
+    Point(PointTable),
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct DirectionalTable {
+    pub direction: [f64; 3],
+    pub irradiance: [f64; 3],
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct PointTable {
+    pub position: [f64; 3],
+    pub intensity: [f64; 3],
+    pub falloff: Option<Falloff>,
+}
+
+/// `[defaults]`: values for every particle that does not set its own.
+#[derive(Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct ParticleDefaults {
+    pub color: Option<[f64; 3]>,
+    pub opacity: Option<f64>,
+    pub kappa: Option<f64>,
+    pub albedo: Option<[f64; 3]>,
+    pub ks: Option<f64>,
+    pub shininess: Option<f64>,
+}
+
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct ParticleTable {
+    pub center: [f64; 3],
+    pub radius: f64,
+    pub color: Option<[f64; 3]>,
+    pub opacity: Option<f64>,
+    pub kappa: Option<f64>,
+    pub albedo: Option<[f64; 3]>,
+    pub ks: Option<f64>,
+    pub shininess: Option<f64>,
+}
+
+/// How particles read from a file are coloured (PDB/mmCIF).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ColorBy {
+    #[default]
+    Element,
+    Chain,
+    Uniform,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// `[[include]]`: particles from a file (DESIGN.md §1, §6). The path is relative to the scene
+/// file. Format-specific selections are ignored by formats they do not apply to.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IncludeSpec {
+    pub path: std::path::PathBuf,
+    #[serde(default)]
+    pub color_by: ColorBy,
+    #[serde(default = "one")]
+    pub radius_scale: f64,
+    /// PDB/mmCIF: keep only these chains.
+    pub chains: Option<Vec<String>>,
+    /// PDB/mmCIF: which model (1-based); the first by default.
+    pub model: Option<usize>,
+    /// PDB/mmCIF: drop waters.
+    #[serde(default)]
+    pub skip_water: bool,
+    /// PDB/mmCIF: drop hydrogens.
+    #[serde(default)]
+    pub skip_hydrogen: bool,
+    /// MMPLD: which frame (0-based); the first by default.
+    pub frame: Option<usize>,
+}
+
+impl IncludeSpec {
+    /// The include of a bare particle file, with every option at its default.
+    pub fn bare(path: &std::path::Path) -> IncludeSpec {
+        IncludeSpec {
+            path: path.to_path_buf(),
+            color_by: ColorBy::default(),
+            radius_scale: 1.0,
+            chains: None,
+            model: None,
+            skip_water: false,
+            skip_hydrogen: false,
+            frame: None,
+        }
+    }
+}

@@ -1,0 +1,234 @@
+//! The scene model of DESIGN.md §1: particles, lights, camera and render settings, already
+//! validated and resolved (σ computed, defaults applied). `file` holds the TOML format and
+//! `validate` turns it into a [`Scene`], with errors that name the file, line and field.
+
+mod file;
+mod framing;
+mod validate;
+
+pub use file::{ColorBy, IncludeSpec};
+pub use framing::{default_camera, thesis_lights};
+
+use crate::error::{PgtError, Result};
+use crate::geometry::Camera;
+use glam::DVec3;
+use std::path::{Path, PathBuf};
+
+/// `mode` (DESIGN.md §1): opaque spheres or spheres of gas.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum RenderMode {
+    Opaque,
+    Volume,
+}
+
+/// `model` (DESIGN.md §2): the source term Q of the volume renderer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum OpticalModel {
+    Emission,
+    Lit,
+    SingleScatter,
+}
+
+/// `light_weight` of the lit model: w = 1/m (`mean`) or w = 1 (`sum`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum LightWeight {
+    Mean,
+    Sum,
+}
+
+/// How a point light's irradiance falls off with distance d.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Falloff {
+    /// E = I/d².
+    InverseSquare,
+    /// E = I.
+    None,
+}
+
+/// A light source (DESIGN.md §1).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Light {
+    /// `direction` is unit length and is the way the light travels.
+    Directional { direction: DVec3, irradiance: DVec3 },
+    /// `intensity` in W/sr.
+    Point {
+        position: DVec3,
+        intensity: DVec3,
+        falloff: Falloff,
+    },
+}
+
+/// What arrives at a point from one light, before any occlusion.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Incident {
+    /// Unit vector from the point towards the light.
+    pub toward: DVec3,
+    /// Distance to the light (∞ for a directional light).
+    pub distance: f64,
+    /// Irradiance on a surface facing the light, unoccluded: E, or I/d² (I with `falloff = none`).
+    pub irradiance: DVec3,
+}
+
+impl Light {
+    /// The unoccluded light arriving at `x` (DESIGN.md §1: E for directional lights, I/d² for
+    /// point lights). A point exactly at a point light's position gets `None`.
+    #[inline]
+    pub fn incident_at(&self, x: DVec3) -> Option<Incident> {
+        match *self {
+            Light::Directional { direction, irradiance } => Some(Incident {
+                toward: -direction,
+                distance: f64::INFINITY,
+                irradiance,
+            }),
+            Light::Point {
+                position,
+                intensity,
+                falloff,
+            } => {
+                let v = position - x;
+                let d = v.length();
+                if d <= 0.0 || !d.is_finite() {
+                    return None;
+                }
+                let irradiance = match falloff {
+                    Falloff::InverseSquare => intensity / (d * d),
+                    Falloff::None => intensity,
+                };
+                Some(Incident {
+                    toward: v / d,
+                    distance: d,
+                    irradiance,
+                })
+            }
+        }
+    }
+}
+
+/// One sphere, resolved: σ computed from Θmax or κ, defaults applied.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Particle {
+    pub center: DVec3,
+    /// Radius in metres, > 0.
+    pub radius: f64,
+    /// Linear RGB colour C ≥ 0 (emission colour in volume mode, albedo-diffuse in opaque mode).
+    pub color: DVec3,
+    /// Extinction σ = λκ = −ln(1−Θmax)/(2r) in 1/m (DESIGN.md §1, thesis eq. 5.1); may be +∞
+    /// (Θmax = 1) or 0 (Θmax = 0).
+    pub sigma: f64,
+    /// Single-scatter albedo (defaults to `color`).
+    pub albedo: DVec3,
+    /// Blinn–Phong specular weight (opaque mode).
+    pub ks: f64,
+    /// Blinn–Phong exponent (opaque mode).
+    pub shininess: f64,
+}
+
+/// Global render settings, `[render]` of the scene file with the command-line overrides applied.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RenderSettings {
+    pub mode: RenderMode,
+    pub model: OpticalModel,
+    /// L_bg, linear RGB.
+    pub background: DVec3,
+    /// λ ∈ (0, 1].
+    pub lambda: f64,
+    pub light_weight: LightWeight,
+    /// Single-scatter emission weight a.
+    pub emission_weight: f64,
+    /// Opaque-mode ambient term (ambient·C).
+    pub ambient: f64,
+    /// Absolute radiance tolerance of the reference quadrature, per pixel and channel.
+    pub tol: f64,
+}
+
+impl Default for RenderSettings {
+    fn default() -> Self {
+        RenderSettings {
+            mode: RenderMode::Volume,
+            model: OpticalModel::Lit,
+            background: DVec3::ZERO,
+            lambda: 1.0,
+            light_weight: LightWeight::Mean,
+            emission_weight: 1.0,
+            ambient: 0.0,
+            tol: 1e-5,
+        }
+    }
+}
+
+/// A loaded, validated scene.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    /// The file it came from (for messages).
+    pub source: PathBuf,
+    pub camera: Camera,
+    pub render: RenderSettings,
+    pub lights: Vec<Light>,
+    pub particles: Vec<Particle>,
+    /// Non-fatal remarks for the user (an empty scene, skipped shapes, …).
+    pub warnings: Vec<String>,
+}
+
+/// Command-line overrides of the scene (DESIGN.md §1: flags override the scene).
+#[derive(Debug, Clone, Default)]
+pub struct SceneLoadOptions {
+    pub size: Option<(u32, u32)>,
+    pub mode: Option<RenderMode>,
+    pub model: Option<OpticalModel>,
+    pub tol: Option<f64>,
+}
+
+/// A particle as a file format delivers it, before defaults and validation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParticleRecord {
+    pub center: DVec3,
+    pub radius: f64,
+    pub color: Option<DVec3>,
+    /// Θmax, if the format carries one (e.g. VRML transparency).
+    pub opacity: Option<f64>,
+    /// Where in its file the particle was defined (line, or byte offset for binary formats).
+    pub location: crate::error::Location,
+}
+
+/// Largest image side pgt accepts; beyond it a typo (`--size 5120000x512`) would allocate
+/// gigabytes before anything useful happens.
+pub const MAX_IMAGE_SIDE: u32 = 32768;
+
+impl Scene {
+    /// Loads a scene: a TOML scene file (`.toml`), or a bare particle file that gets the default
+    /// scene of DESIGN.md §1.
+    pub fn load(path: &Path, options: &SceneLoadOptions) -> Result<Scene> {
+        let is_toml = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+        if is_toml {
+            let text = std::fs::read_to_string(path).map_err(|e| PgtError::io(path, e))?;
+            Scene::from_toml_str(&text, path, options)
+        } else {
+            validate::bare_particle_file(path, options)
+        }
+    }
+
+    /// Parses and validates scene TOML text; `path` names it in messages and anchors includes.
+    pub fn from_toml_str(text: &str, path: &Path, options: &SceneLoadOptions) -> Result<Scene> {
+        validate::scene_from_toml(text, path, options)
+    }
+
+    /// σ of every particle, in input order.
+    pub fn sigmas(&self) -> Vec<f64> {
+        self.particles.iter().map(|p| p.sigma).collect()
+    }
+
+    /// A BVH over the scene's particles (indices are positions in `particles`).
+    pub fn build_bvh(&self) -> crate::geometry::Bvh {
+        crate::geometry::Bvh::build(
+            self.particles.iter().map(|p| p.center).collect(),
+            self.particles.iter().map(|p| p.radius).collect(),
+        )
+    }
+}

@@ -1,0 +1,551 @@
+//! Scene validation: the raw TOML tables become a [`Scene`], or an error that names the file,
+//! the line and the field (DESIGN.md §6 "Bad input").
+
+use super::file::{CameraTable, LightTable, ParticleDefaults, ParticleTable, RenderTable, SceneFile};
+use super::framing::{default_camera, thesis_lights, DEFAULT_FOV_Y, DEFAULT_SIZE};
+use super::{
+    Falloff, IncludeSpec, Light, Particle, ParticleRecord, RenderSettings, Scene, SceneLoadOptions,
+    MAX_IMAGE_SIDE,
+};
+use crate::error::{Location, PgtError, Result};
+use crate::geometry::Camera;
+use crate::optics::extinction::sigma_from_opacity;
+use glam::DVec3;
+use std::path::Path;
+use toml::Spanned;
+
+/// 1-based line of a byte offset.
+fn line_of(text: &str, offset: usize) -> usize {
+    text.as_bytes()[..offset.min(text.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
+}
+
+/// Names a place for messages: the file and a location.
+struct At<'a> {
+    path: &'a Path,
+    location: Location,
+}
+
+impl At<'_> {
+    fn err(&self, message: impl Into<String>) -> PgtError {
+        PgtError::Input {
+            path: self.path.to_path_buf(),
+            location: self.location.clone(),
+            message: message.into(),
+        }
+    }
+
+    fn finite(&self, field: &str, v: f64) -> Result<f64> {
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(self.err(format!("{field} must be a finite number, got {v}")))
+        }
+    }
+
+    fn vec3(&self, field: &str, v: [f64; 3]) -> Result<DVec3> {
+        if v.iter().all(|x| x.is_finite()) {
+            Ok(DVec3::from(v))
+        } else {
+            Err(self.err(format!("{field} must hold three finite numbers, got {v:?}")))
+        }
+    }
+
+    fn non_negative3(&self, field: &str, v: [f64; 3]) -> Result<DVec3> {
+        let d = self.vec3(field, v)?;
+        if d.min_element() < 0.0 {
+            return Err(self.err(format!("{field} must be ≥ 0 in every channel, got {v:?}")));
+        }
+        Ok(d)
+    }
+
+    fn direction(&self, field: &str, v: [f64; 3]) -> Result<DVec3> {
+        let d = self.vec3(field, v)?;
+        let len = d.length();
+        if len == 0.0 || !len.is_finite() {
+            return Err(self.err(format!("{field} must be a non-zero vector, got {v:?}")));
+        }
+        Ok(d / len)
+    }
+
+    fn in_range(&self, field: &str, v: f64, lo: f64, hi: f64, what: &str) -> Result<f64> {
+        let v = self.finite(field, v)?;
+        if v < lo || v > hi {
+            return Err(self.err(format!("{field} must be {what}, got {v}")));
+        }
+        Ok(v)
+    }
+}
+
+/// Turns a TOML syntax or type error into one naming the file and line.
+fn toml_error(path: &Path, text: &str, e: toml::de::Error) -> PgtError {
+    let line = e.span().map(|s| line_of(text, s.start)).unwrap_or(1);
+    PgtError::at_line(path, line, e.message().trim().to_string())
+}
+
+pub(super) fn scene_from_toml(text: &str, path: &Path, options: &SceneLoadOptions) -> Result<Scene> {
+    let file: SceneFile = toml::from_str(text).map_err(|e| toml_error(path, text, e))?;
+    let at = |span: std::ops::Range<usize>| At {
+        path,
+        location: Location::Line(line_of(text, span.start)),
+    };
+    let whole = At {
+        path,
+        location: Location::File,
+    };
+
+    let render = match &file.render {
+        Some(r) => render_settings(&at(r.span()), r.get_ref())?,
+        None => RenderSettings::default(),
+    };
+    let render = apply_overrides(render, options, &whole)?;
+
+    let defaults_at = file.defaults.as_ref().map_or(whole.location.clone(), |d| {
+        Location::Line(line_of(text, d.span().start))
+    });
+    let empty = ParticleDefaults::default();
+    let defaults = file.defaults.as_ref().map_or(&empty, |d| d.get_ref());
+    let resolved_defaults = ResolvedDefaults::new(
+        &At {
+            path,
+            location: defaults_at,
+        },
+        defaults,
+        render.lambda,
+    )?;
+
+    let mut particles = Vec::with_capacity(file.particles.len());
+    for (i, p) in file.particles.iter().enumerate() {
+        particles.push(inline_particle(&at(p.span()), i, p.get_ref(), &resolved_defaults, render.lambda)?);
+    }
+    let mut warnings = Vec::new();
+    let base = path.parent().unwrap_or(Path::new("."));
+    for inc in &file.include {
+        let spec_at = at(inc.span());
+        let mut spec = inc.get_ref().clone();
+        spec_at.in_range("include.radius_scale", spec.radius_scale, f64::MIN_POSITIVE, f64::MAX, "> 0")?;
+        spec.path = base.join(&spec.path);
+        let loaded = crate::formats::load_particles(&spec)?;
+        warnings.extend(loaded.warnings);
+        for rec in &loaded.records {
+            particles.push(record_particle(&spec.path, rec, &resolved_defaults, render.lambda)?);
+        }
+    }
+
+    let lights = file
+        .lights
+        .iter()
+        .enumerate()
+        .map(|(i, l)| light(&at(l.span()), i, l.get_ref()))
+        .collect::<Result<Vec<_>>>()?;
+
+    let camera = camera(&file.camera, &at, &whole, options, &particles)?;
+    if particles.is_empty() {
+        warnings.push(format!("{}: the scene has no particles; it renders the background", path.display()));
+    }
+    Ok(Scene {
+        source: path.to_path_buf(),
+        camera,
+        render,
+        lights,
+        particles,
+        warnings,
+    })
+}
+
+/// A bare particle file with the default scene of DESIGN.md §1.
+pub(super) fn bare_particle_file(path: &Path, options: &SceneLoadOptions) -> Result<Scene> {
+    let whole = At {
+        path,
+        location: Location::File,
+    };
+    let render = apply_overrides(RenderSettings::default(), options, &whole)?;
+    let defaults = ResolvedDefaults::new(&whole, &ParticleDefaults::default(), render.lambda)?;
+    let loaded = crate::formats::load_particles(&IncludeSpec::bare(path))?;
+    let particles = loaded
+        .records
+        .iter()
+        .map(|rec| record_particle(path, rec, &defaults, render.lambda))
+        .collect::<Result<Vec<_>>>()?;
+    let mut warnings = loaded.warnings;
+    if particles.is_empty() {
+        warnings.push(format!("{}: the file has no particles; it renders the background", path.display()));
+    }
+    let (w, h) = options.size.unwrap_or(DEFAULT_SIZE);
+    check_size(&whole, w as i64, h as i64)?;
+    Ok(Scene {
+        source: path.to_path_buf(),
+        camera: default_camera(&particles, w, h),
+        render,
+        lights: thesis_lights(),
+        particles,
+        warnings,
+    })
+}
+
+fn render_settings(at: &At, t: &RenderTable) -> Result<RenderSettings> {
+    let d = RenderSettings::default();
+    Ok(RenderSettings {
+        mode: t.mode.unwrap_or(d.mode),
+        model: t.model.unwrap_or(d.model),
+        background: t.background.map_or(Ok(d.background), |v| at.non_negative3("render.background", v))?,
+        lambda: t.lambda.map_or(Ok(d.lambda), |v| {
+            let v = at.finite("render.lambda", v)?;
+            if v > 0.0 && v <= 1.0 {
+                Ok(v)
+            } else {
+                Err(at.err(format!("render.lambda must be in (0, 1], got {v}")))
+            }
+        })?,
+        light_weight: t.light_weight.unwrap_or(d.light_weight),
+        emission_weight: t.emission_weight.map_or(Ok(d.emission_weight), |v| {
+            at.in_range("render.emission_weight", v, 0.0, 1.0, "in [0, 1]")
+        })?,
+        ambient: t.ambient.map_or(Ok(d.ambient), |v| {
+            at.in_range("render.ambient", v, 0.0, f64::MAX, "≥ 0")
+        })?,
+        tol: t.tol.map_or(Ok(d.tol), |v| check_tol(at, v))?,
+    })
+}
+
+fn check_tol(at: &At, v: f64) -> Result<f64> {
+    let v = at.finite("render.tol", v)?;
+    if v > 0.0 {
+        Ok(v)
+    } else {
+        Err(at.err(format!("render.tol must be > 0, got {v}")))
+    }
+}
+
+fn apply_overrides(mut r: RenderSettings, o: &SceneLoadOptions, whole: &At) -> Result<RenderSettings> {
+    if let Some(m) = o.mode {
+        r.mode = m;
+    }
+    if let Some(m) = o.model {
+        r.model = m;
+    }
+    if let Some(t) = o.tol {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(PgtError::Usage(format!("--tol must be a finite number > 0, got {t}")));
+        }
+        r.tol = t;
+    }
+    let _ = whole;
+    Ok(r)
+}
+
+/// `[defaults]` with each field checked once.
+struct ResolvedDefaults {
+    color: DVec3,
+    /// σ source for particles that set neither opacity nor kappa.
+    opacity: Option<f64>,
+    kappa: Option<f64>,
+    albedo: Option<DVec3>,
+    ks: f64,
+    shininess: f64,
+}
+
+/// Θmax used when neither the particle nor `[defaults]` sets opacity or kappa.
+const DEFAULT_OPACITY: f64 = 0.5;
+const DEFAULT_SHININESS: f64 = 32.0;
+
+impl ResolvedDefaults {
+    fn new(at: &At, d: &ParticleDefaults, _lambda: f64) -> Result<Self> {
+        if d.opacity.is_some() && d.kappa.is_some() {
+            return Err(at.err("defaults: set opacity or kappa, not both"));
+        }
+        Ok(ResolvedDefaults {
+            color: d.color.map_or(Ok(DVec3::ONE), |c| at.non_negative3("defaults.color", c))?,
+            opacity: d
+                .opacity
+                .map(|o| at.in_range("defaults.opacity", o, 0.0, 1.0, "in [0, 1]"))
+                .transpose()?,
+            kappa: d
+                .kappa
+                .map(|k| at.in_range("defaults.kappa", k, 0.0, f64::MAX, "≥ 0"))
+                .transpose()?,
+            albedo: d.albedo.map(|a| at.non_negative3("defaults.albedo", a)).transpose()?,
+            ks: d.ks.map_or(Ok(0.0), |v| at.in_range("defaults.ks", v, 0.0, f64::MAX, "≥ 0"))?,
+            shininess: d.shininess.map_or(Ok(DEFAULT_SHININESS), |v| {
+                at.in_range("defaults.shininess", v, 0.0, f64::MAX, "≥ 0")
+            })?,
+        })
+    }
+
+    /// σ from the particle's own opacity/kappa or the defaults (DESIGN.md §1, thesis eq. 5.1).
+    fn sigma(&self, opacity: Option<f64>, kappa: Option<f64>, radius: f64, lambda: f64) -> f64 {
+        match (opacity, kappa) {
+            (Some(o), _) => sigma_from_opacity(o, radius),
+            (None, Some(k)) => lambda * k,
+            (None, None) => match (self.opacity, self.kappa) {
+                (_, Some(k)) => lambda * k,
+                (Some(o), None) => sigma_from_opacity(o, radius),
+                (None, None) => sigma_from_opacity(DEFAULT_OPACITY, radius),
+            },
+        }
+    }
+}
+
+fn inline_particle(at: &At, i: usize, p: &ParticleTable, d: &ResolvedDefaults, lambda: f64) -> Result<Particle> {
+    let name = |f: &str| format!("particles[{i}].{f}");
+    let center = at.vec3(&name("center"), p.center)?;
+    let radius = at.finite(&name("radius"), p.radius)?;
+    if radius <= 0.0 {
+        return Err(at.err(format!("{} must be > 0, got {radius}", name("radius"))));
+    }
+    if p.opacity.is_some() && p.kappa.is_some() {
+        return Err(at.err(format!("particles[{i}]: set opacity or kappa, not both")));
+    }
+    let opacity = p
+        .opacity
+        .map(|o| at.in_range(&name("opacity"), o, 0.0, 1.0, "in [0, 1]"))
+        .transpose()?;
+    let kappa = p
+        .kappa
+        .map(|k| at.in_range(&name("kappa"), k, 0.0, f64::MAX, "≥ 0"))
+        .transpose()?;
+    let color = p.color.map_or(Ok(d.color), |c| at.non_negative3(&name("color"), c))?;
+    Ok(Particle {
+        center,
+        radius,
+        color,
+        sigma: d.sigma(opacity, kappa, radius, lambda),
+        albedo: p
+            .albedo
+            .map_or(Ok(d.albedo.unwrap_or(color)), |a| at.non_negative3(&name("albedo"), a))?,
+        ks: p.ks.map_or(Ok(d.ks), |v| at.in_range(&name("ks"), v, 0.0, f64::MAX, "≥ 0"))?,
+        shininess: p
+            .shininess
+            .map_or(Ok(d.shininess), |v| at.in_range(&name("shininess"), v, 0.0, f64::MAX, "≥ 0"))?,
+    })
+}
+
+/// A particle from a file format, checked with the location the format recorded.
+fn record_particle(path: &Path, rec: &ParticleRecord, d: &ResolvedDefaults, lambda: f64) -> Result<Particle> {
+    let at = At {
+        path,
+        location: rec.location.clone(),
+    };
+    let center = DVec3::from(at.vec3("particle position", rec.center.to_array())?);
+    let radius = at.finite("particle radius", rec.radius)?;
+    if radius <= 0.0 {
+        return Err(at.err(format!("particle radius must be > 0, got {radius}")));
+    }
+    let color = rec
+        .color
+        .map_or(Ok(d.color), |c| at.non_negative3("particle colour", c.to_array()))?;
+    let opacity = rec
+        .opacity
+        .map(|o| at.in_range("particle opacity", o, 0.0, 1.0, "in [0, 1]"))
+        .transpose()?;
+    Ok(Particle {
+        center,
+        radius,
+        color,
+        sigma: d.sigma(opacity, None, radius, lambda),
+        albedo: d.albedo.unwrap_or(color),
+        ks: d.ks,
+        shininess: d.shininess,
+    })
+}
+
+fn light(at: &At, i: usize, l: &LightTable) -> Result<Light> {
+    match l {
+        LightTable::Directional(t) => Ok(Light::Directional {
+            direction: at.direction(&format!("lights[{i}].direction"), t.direction)?,
+            irradiance: at.non_negative3(&format!("lights[{i}].irradiance"), t.irradiance)?,
+        }),
+        LightTable::Point(t) => Ok(Light::Point {
+            position: at.vec3(&format!("lights[{i}].position"), t.position)?,
+            intensity: at.non_negative3(&format!("lights[{i}].intensity"), t.intensity)?,
+            falloff: t.falloff.unwrap_or(Falloff::InverseSquare),
+        }),
+    }
+}
+
+fn check_size(at: &At, w: i64, h: i64) -> Result<(u32, u32)> {
+    let max = MAX_IMAGE_SIDE as i64;
+    if w < 1 || h < 1 || w > max || h > max {
+        return Err(at.err(format!(
+            "image size must be between 1 and {MAX_IMAGE_SIDE} pixels on each side, got {w}x{h}"
+        )));
+    }
+    Ok((w as u32, h as u32))
+}
+
+fn camera<'a>(
+    table: &Option<Spanned<CameraTable>>,
+    at: &dyn Fn(std::ops::Range<usize>) -> At<'a>,
+    whole: &At<'a>,
+    options: &SceneLoadOptions,
+    particles: &[Particle],
+) -> Result<Camera> {
+    let Some(table) = table else {
+        let (w, h) = options.size.unwrap_or(DEFAULT_SIZE);
+        check_size(whole, w as i64, h as i64)?;
+        return Ok(default_camera(particles, w, h));
+    };
+    let at = at(table.span());
+    let t = table.get_ref();
+    let (w, h) = match options.size {
+        Some((w, h)) => check_size(whole, w as i64, h as i64)?,
+        None => check_size(
+            &at,
+            t.width.unwrap_or(DEFAULT_SIZE.0 as i64),
+            t.height.unwrap_or(DEFAULT_SIZE.1 as i64),
+        )?,
+    };
+    let fov_y = match (t.fov_y, t.focal_length) {
+        (Some(_), Some(_)) => return Err(at.err("camera: set fov_y or focal_length, not both")),
+        (Some(f), None) => {
+            let f = at.finite("camera.fov_y", f)?;
+            if !(f > 0.0 && f < 180.0) {
+                return Err(at.err(format!("camera.fov_y must be in (0, 180) degrees, got {f}")));
+            }
+            f
+        }
+        (None, Some(f)) => {
+            let f = at.finite("camera.focal_length", f)?;
+            if f <= 0.0 {
+                return Err(at.err(format!("camera.focal_length must be > 0, got {f}")));
+            }
+            Camera::fov_y_from_focal_length(f)
+        }
+        (None, None) => DEFAULT_FOV_Y,
+    };
+    let (position, look_at) = match (t.position, t.look_at) {
+        (Some(p), Some(l)) => (at.vec3("camera.position", p)?, at.vec3("camera.look_at", l)?),
+        (None, None) => {
+            let framed = default_camera(particles, w, h);
+            (framed.position, framed.position + framed.forward)
+        }
+        _ => return Err(at.err("camera: set both position and look_at, or neither (to frame the particles)")),
+    };
+    let up = at.direction("camera.up", t.up.unwrap_or([0.0, 1.0, 0.0]))?;
+    let forward = look_at - position;
+    if forward.length() == 0.0 {
+        return Err(at.err("camera.look_at must differ from camera.position"));
+    }
+    if forward.normalize().cross(up).length() < 1e-9 {
+        return Err(at.err("camera.up must not be parallel to the viewing direction"));
+    }
+    Ok(Camera::new(position, look_at, up, fov_y, w, h))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn load(text: &str) -> Result<Scene> {
+        Scene::from_toml_str(text, Path::new("s.toml"), &SceneLoadOptions::default())
+    }
+
+    fn err_text(text: &str) -> String {
+        load(text).unwrap_err().to_string()
+    }
+
+    #[test]
+    fn full_design_example_parses() {
+        let text = r#"
+[camera]
+position = [0.0, 0.0, -10.0]
+look_at  = [0.0, 0.0, 0.0]
+up       = [0.0, 1.0, 0.0]
+fov_y    = 40.0
+width    = 64
+height   = 32
+
+[render]
+mode  = "volume"
+model = "lit"
+background = [0.0, 0.0, 0.0]
+lambda = 1.0
+light_weight = "mean"
+emission_weight = 0.0
+ambient = 0.0
+tol = 1e-5
+
+[[lights]]
+type = "directional"
+direction  = [0.0, -1.0, 0.0]
+irradiance = [0.0, 1.0, 0.0]
+
+[[lights]]
+type = "point"
+position  = [0.0, 5.0, 0.0]
+intensity = [10.0, 10.0, 10.0]
+falloff   = "inverse-square"
+
+[defaults]
+color = [1.0, 1.0, 1.0]
+opacity = 0.5
+ks = 0.0
+shininess = 32.0
+
+[[particles]]
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+color  = [1.0, 0.2, 0.2]
+opacity = 0.8
+"#;
+        let s = load(text).unwrap();
+        assert_eq!((s.camera.width, s.camera.height), (64, 32));
+        assert_eq!(s.lights.len(), 2);
+        let p = s.particles[0];
+        assert!((p.sigma - (-(0.2f64).ln() / 2.0)).abs() < 1e-15);
+        assert_eq!(p.albedo, p.color);
+    }
+
+    #[test]
+    fn kappa_is_scaled_by_lambda_but_opacity_is_not() {
+        let s = load(
+            "[render]\nlambda = 0.5\n[[particles]]\ncenter=[0,0,0]\nradius=2.0\nkappa=3.0\n[[particles]]\ncenter=[5,0,0]\nradius=2.0\nopacity=0.5\n",
+        )
+        .unwrap();
+        assert_eq!(s.particles[0].sigma, 1.5);
+        assert!((s.particles[1].sigma - 2f64.ln() / 4.0).abs() < 1e-15);
+    }
+
+    #[test]
+    fn errors_name_the_line_and_field() {
+        let e = err_text("[[particles]]\ncenter=[0,0,0]\nradius=1.0\n\n[[particles]]\ncenter=[0,0,0]\nradius=-1.0\n");
+        assert!(e.starts_with("s.toml:5:"), "{e}");
+        assert!(e.contains("particles[1].radius must be > 0"), "{e}");
+        let e = err_text("[render]\nmodle = \"lit\"\n");
+        assert!(e.starts_with("s.toml:2:") && e.contains("modle"), "{e}");
+        let e = err_text("[render]\nmodel = \"glow\"\n");
+        assert!(e.starts_with("s.toml:2:") && e.contains("glow"), "{e}");
+        let e = err_text("[[lights]]\ntype=\"directional\"\ndirection=[0,0,0]\nirradiance=[1,1,1]\n");
+        assert!(e.contains("lights[0].direction must be a non-zero vector"), "{e}");
+        let e = err_text("[camera]\nwidth = 0\n");
+        assert!(e.contains("image size"), "{e}");
+        let e = err_text("[[particles]]\ncenter=[0,0,0]\nradius=1.0\nopacity=1.5\n");
+        assert!(e.contains("opacity must be in [0, 1]"), "{e}");
+        let e = err_text("[[particles]]\ncenter=[0,nan,0]\nradius=1.0\n");
+        assert!(e.contains("finite"), "{e}");
+    }
+
+    #[test]
+    fn empty_scene_is_valid_with_a_warning() {
+        let s = load("").unwrap();
+        assert!(s.particles.is_empty());
+        assert_eq!(s.warnings.len(), 1);
+    }
+
+    #[test]
+    fn overrides_win() {
+        let o = SceneLoadOptions {
+            size: Some((7, 3)),
+            mode: Some(super::super::RenderMode::Opaque),
+            model: None,
+            tol: Some(1e-3),
+        };
+        let s = Scene::from_toml_str("[camera]\nwidth=100\nheight=100\n", Path::new("s.toml"), &o).unwrap();
+        assert_eq!((s.camera.width, s.camera.height), (7, 3));
+        assert_eq!(s.render.mode, super::super::RenderMode::Opaque);
+        assert_eq!(s.render.tol, 1e-3);
+    }
+}
