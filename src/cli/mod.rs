@@ -1,7 +1,9 @@
 //! The `pgt` command line (DESIGN.md §7): one file per subcommand. Every subcommand returns an
 //! [`Outcome`]; `main` maps it and errors to exit codes 0 / 1 / 2.
 
+pub mod compare;
 pub mod render;
+pub mod sweep;
 
 use clap::{Parser, Subcommand};
 
@@ -15,7 +17,11 @@ pub enum Outcome {
 }
 
 #[derive(Debug, Parser)]
-#[command(name = "pgt", version, about = "Particle ground truth: exact renderings of sphere particle scenes, GPU approximations, and their difference")]
+#[command(
+    name = "pgt",
+    version,
+    about = "Particle ground truth: exact renderings of sphere particle scenes, GPU approximations, and their difference"
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
@@ -25,12 +31,18 @@ pub struct Cli {
 pub enum Command {
     /// Render the exact reference image of a scene (a scene TOML or a bare particle file).
     Render(render::RenderArgs),
+    /// Compare an approximation with the reference: metrics, maps, report, gates.
+    Compare(compare::CompareArgs),
+    /// Render the reference once and an approximation per parameter set; report with plots.
+    Sweep(sweep::SweepArgs),
 }
 
 /// Runs the parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
     match cli.command {
         Command::Render(args) => render::run(args),
+        Command::Compare(args) => compare::run(args),
+        Command::Sweep(args) => sweep::run(args),
     }
 }
 
