@@ -382,10 +382,11 @@ fn choose_split(
     cbounds: &Aabb,
 ) -> Option<(usize, f64)> {
     let mut best: Option<(f64, usize, f64)> = None;
+    #[allow(clippy::needless_range_loop)] // `axis` indexes DVec3 components, not a slice
     for axis in 0..3 {
         let lo = cbounds.min[axis];
         let hi = cbounds.max[axis];
-        if !(hi > lo) {
+        if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
             continue;
         }
         let scale = BINS as f64 / (hi - lo);

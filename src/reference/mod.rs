@@ -87,8 +87,11 @@ pub struct RenderOutput {
 
 /// Renders the scene with the renderer its mode and model call for.
 pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
-    if options.spp == 0 {
-        return Err(PgtError::Usage("--spp must be at least 1".into()));
+    if !(1..=MAX_SPP).contains(&options.spp) {
+        return Err(PgtError::Usage(format!(
+            "--spp must be between 1 and {MAX_SPP}, got {}",
+            options.spp
+        )));
     }
     match scene.render.mode {
         RenderMode::Opaque => {
@@ -100,6 +103,9 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
         )),
     }
 }
+
+/// Largest k of k×k samples per pixel.
+pub const MAX_SPP: u32 = 64;
 
 /// Side of a square tile of pixels, the unit of parallel work.
 const TILE: u32 = 16;

@@ -253,14 +253,20 @@ mod tests {
 
     #[test]
     fn blinn_phong_peaks_at_the_mirror_direction() {
-        // Eye on −z looking at the sphere's pole (0,0,−1) with normal −z. A light whose direction
-        // mirrors the view about the normal gives the largest highlight.
+        // An eye ray hitting the unit sphere off-centre: the highlight lobe (radiance over the
+        // cosine factor) is largest when the light sits in the mirror direction of the eye about
+        // the normal, where it is ks·(s+8)/(8π).
         let mut p = particle(DVec3::ZERO, 1.0);
         p.ks = 1.0;
         p.shininess = 64.0;
         p.color = DVec3::ZERO;
-        let spec_at = |angle: f64| {
-            let toward = DVec3::new(angle.sin(), 0.0, -angle.cos());
+        let eye = Ray::new(DVec3::new(0.5, 0.2, -10.0), DVec3::Z);
+        let x = eye.at(intersect_t(&eye));
+        let n = x.normalize();
+        let v = -eye.direction;
+        let mirror = 2.0 * n.dot(v) * n - v;
+        let axis = n.cross(v).normalize();
+        let spec_for = |toward: DVec3| {
             let s = scene(
                 vec![p],
                 vec![Light::Directional {
@@ -268,14 +274,21 @@ mod tests {
                     irradiance: DVec3::ONE,
                 }],
             );
-            centre_radiance(&s).x
+            OpaqueRenderer::new(&s).radiance(&eye).radiance.x / n.dot(toward)
         };
-        // View along +z at the pole: the mirror direction is the normal itself (angle 0).
-        let peak = spec_at(0.0);
-        assert_relative_eq!(peak, (64.0 + 8.0) / (8.0 * PI), max_relative = 1e-12);
-        for a in [0.05, 0.1, 0.3, -0.2] {
-            assert!(spec_at(a) < peak);
+        let peak = spec_for(mirror);
+        assert_relative_eq!(peak, (64.0 + 8.0) / (8.0 * PI), max_relative = 1e-9);
+        for angle in [-0.2, -0.05, -0.01, 0.01, 0.05, 0.2] {
+            let rotated = glam::DQuat::from_axis_angle(axis, angle) * mirror;
+            let off = spec_for(rotated);
+            assert!(off < peak, "angle {angle}: {off} ≥ {peak}");
         }
+    }
+
+    fn intersect_t(ray: &Ray) -> f64 {
+        crate::geometry::intersect_sphere(ray, DVec3::ZERO, 1.0)
+            .unwrap()
+            .t_enter
     }
 
     #[test]

@@ -204,6 +204,25 @@ pub struct ParticleRecord {
 /// Largest image side pgt accepts; beyond it a typo (`--size 5120000x512`) would allocate
 /// gigabytes before anything useful happens.
 pub const MAX_IMAGE_SIDE: u32 = 32768;
+/// Largest pixel count (8192²): the reference keeps the image, its error layer and the tile
+/// results in memory, about 40 bytes a pixel.
+pub const MAX_PIXELS: u64 = 1 << 26;
+
+/// Checks an image size against [`MAX_IMAGE_SIDE`] and [`MAX_PIXELS`]; the error text says why.
+pub fn check_image_size(width: i64, height: i64) -> std::result::Result<(u32, u32), String> {
+    let max = MAX_IMAGE_SIDE as i64;
+    if width < 1
+        || height < 1
+        || width > max
+        || height > max
+        || (width * height) as u64 > MAX_PIXELS
+    {
+        return Err(format!(
+            "image size must be between 1 and {MAX_IMAGE_SIDE} pixels on each side and at most {MAX_PIXELS} pixels, got {width}x{height}"
+        ));
+    }
+    Ok((width as u32, height as u32))
+}
 
 impl Scene {
     /// Loads a scene: a TOML scene file (`.toml`), or a bare particle file that gets the default

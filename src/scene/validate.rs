@@ -2,12 +2,11 @@
 //! the line and the field (DESIGN.md §6 "Bad input").
 
 use super::file::{
-    CameraTable, LightTable, ParticleDefaults, ParticleTable, RenderTable, SceneFile,
+    CameraTable, LightKind, LightTable, ParticleDefaults, ParticleTable, RenderTable, SceneFile,
 };
 use super::framing::{default_camera, thesis_lights, DEFAULT_FOV_Y, DEFAULT_SIZE};
 use super::{
     Falloff, IncludeSpec, Light, Particle, ParticleRecord, RenderSettings, Scene, SceneLoadOptions,
-    MAX_IMAGE_SIDE,
 };
 use crate::error::{Location, PgtError, Result};
 use crate::geometry::Camera;
@@ -83,9 +82,21 @@ impl At<'_> {
 }
 
 /// Turns a TOML syntax or type error into one naming the file and line.
+/// The offending line's text is quoted, since serde's message alone ("invalid length 2") does
+/// not name the field.
 fn toml_error(path: &Path, text: &str, e: toml::de::Error) -> PgtError {
     let line = e.span().map(|s| line_of(text, s.start)).unwrap_or(1);
-    PgtError::at_line(path, line, e.message().trim().to_string())
+    let mut message = e.message().trim().to_string();
+    if let Some(source_line) = text
+        .lines()
+        .nth(line - 1)
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+    {
+        let quoted: String = source_line.chars().take(100).collect();
+        message = format!("{message} (in `{quoted}`)");
+    }
+    PgtError::at_line(path, line, message)
 }
 
 pub(super) fn scene_from_toml(
@@ -388,7 +399,7 @@ fn record_particle(
         path,
         location: rec.location.clone(),
     };
-    let center = DVec3::from(at.vec3("particle position", rec.center.to_array())?);
+    let center = at.vec3("particle position", rec.center.to_array())?;
     let radius = at.finite("particle radius", rec.radius)?;
     if radius <= 0.0 {
         return Err(at.err(format!("particle radius must be > 0, got {radius}")));
@@ -412,27 +423,47 @@ fn record_particle(
 }
 
 fn light(at: &At, i: usize, l: &LightTable) -> Result<Light> {
-    match l {
-        LightTable::Directional(t) => Ok(Light::Directional {
-            direction: at.direction(&format!("lights[{i}].direction"), t.direction)?,
-            irradiance: at.non_negative3(&format!("lights[{i}].irradiance"), t.irradiance)?,
-        }),
-        LightTable::Point(t) => Ok(Light::Point {
-            position: at.vec3(&format!("lights[{i}].position"), t.position)?,
-            intensity: at.non_negative3(&format!("lights[{i}].intensity"), t.intensity)?,
-            falloff: t.falloff.unwrap_or(Falloff::InverseSquare),
-        }),
+    let field = |f: &str| format!("lights[{i}].{f}");
+    let required = |f: &str, v: Option<[f64; 3]>| {
+        v.ok_or_else(|| {
+            at.err(format!("{} is required for a {:?} light", field(f), l.kind).to_lowercase())
+        })
+    };
+    let forbidden = |f: &str, present: bool| {
+        if present {
+            Err(at
+                .err(format!("{} does not apply to a {:?} light", field(f), l.kind).to_lowercase()))
+        } else {
+            Ok(())
+        }
+    };
+    match l.kind {
+        LightKind::Directional => {
+            forbidden("position", l.position.is_some())?;
+            forbidden("intensity", l.intensity.is_some())?;
+            forbidden("falloff", l.falloff.is_some())?;
+            Ok(Light::Directional {
+                direction: at
+                    .direction(&field("direction"), required("direction", l.direction)?)?,
+                irradiance: at
+                    .non_negative3(&field("irradiance"), required("irradiance", l.irradiance)?)?,
+            })
+        }
+        LightKind::Point => {
+            forbidden("direction", l.direction.is_some())?;
+            forbidden("irradiance", l.irradiance.is_some())?;
+            Ok(Light::Point {
+                position: at.vec3(&field("position"), required("position", l.position)?)?,
+                intensity: at
+                    .non_negative3(&field("intensity"), required("intensity", l.intensity)?)?,
+                falloff: l.falloff.unwrap_or(Falloff::InverseSquare),
+            })
+        }
     }
 }
 
 fn check_size(at: &At, w: i64, h: i64) -> Result<(u32, u32)> {
-    let max = MAX_IMAGE_SIDE as i64;
-    if w < 1 || h < 1 || w > max || h > max {
-        return Err(at.err(format!(
-            "image size must be between 1 and {MAX_IMAGE_SIDE} pixels on each side, got {w}x{h}"
-        )));
-    }
-    Ok((w as u32, h as u32))
+    super::check_image_size(w, h).map_err(|e| at.err(e))
 }
 
 fn camera<'a>(
