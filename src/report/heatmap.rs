@@ -63,6 +63,7 @@ impl Srgb8Image {
             w.flush().map_err(|e| PgtError::io(path, e))?;
         }
         tmp.persist(path).map_err(|e| PgtError::io(path, e.error))?;
+        super::html::make_readable(path);
         Ok(())
     }
 }
