@@ -36,7 +36,7 @@ use crate::error::PgtError;
 use crate::image_io::{read_exr_layer, write_image, RgbImage};
 use crate::metrics::{compare, CompareOptions, Comparison};
 use crate::reference::{self, Integrator, RenderOptions};
-use crate::report::html::{escape, page, write_text};
+use crate::report::html::{escape, make_readable, page, write_text};
 use crate::report::plot::{line_plot_svg, PlotSpec, Series};
 use crate::report::summary::short;
 use crate::scene::{Scene, SceneLoadOptions};
@@ -304,6 +304,7 @@ pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
     };
     let exposure = 0.0;
     write_image(&dir.join("reference.png"), &reference_image, &[], exposure)?;
+    make_readable(&dir.join("reference.png"));
 
     let mut results = Vec::new();
     for run in runs {
@@ -314,6 +315,7 @@ pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
         let cmp = compare(&reference_image, &image, &options).with_context(|| run.label())?;
         let image_file = format!("{}.png", run.file_stem());
         write_image(&dir.join(&image_file), &image, &[], exposure)?;
+        make_readable(&dir.join(&image_file));
         let ssim = cmp
             .ssim_values()
             .map(|s| format!("{:.6}", s.mean))
@@ -355,17 +357,46 @@ pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
     Ok(Outcome::Success)
 }
 
-/// Series for a plot: x = the run's first parameter, one series per combination of the others.
-fn series_of(results: &[RunResult], y: impl Fn(&RunResult) -> Option<f64>) -> Vec<Series> {
+/// The plots' x axis: the parameter with the most distinct values over all runs (ties: the one
+/// named first), e.g. `samples` for the thesis's Figures 6.2/6.3.
+fn x_parameter(results: &[RunResult]) -> &'static str {
+    let mut names: Vec<&'static str> = Vec::new();
+    let mut values: BTreeMap<&'static str, std::collections::BTreeSet<u32>> = BTreeMap::new();
+    for r in results {
+        for (k, v) in &r.run.params {
+            if !names.contains(k) {
+                names.push(k);
+            }
+            values.entry(k).or_default().insert(*v);
+        }
+    }
+    let mut best = names.first().copied().unwrap_or("parameter");
+    for n in &names {
+        if values[n].len() > values[best].len() {
+            best = n;
+        }
+    }
+    best
+}
+
+/// Series for a plot: x = the run's value of `x_name`, one series per method and combination of
+/// the other parameters.
+fn series_of(
+    results: &[RunResult],
+    x_name: &str,
+    y: impl Fn(&RunResult) -> Option<f64>,
+) -> Vec<Series> {
     let mut groups: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
     for r in results {
         let Some(v) = y(r) else { continue };
-        let x = r.run.params.first().map(|(_, v)| *v as f64).unwrap_or(0.0);
+        let Some(x) = r.run.params.iter().find(|(k, _)| *k == x_name) else {
+            continue;
+        };
         let mut label = r.run.method.to_string();
-        for (k, v) in r.run.params.iter().skip(1) {
+        for (k, v) in r.run.params.iter().filter(|(k, _)| *k != x_name) {
             let _ = write!(label, " {k}={v}");
         }
-        groups.entry(label).or_default().push((x, v));
+        groups.entry(label).or_default().push((x.1 as f64, v));
     }
     groups
         .into_iter()
@@ -374,16 +405,14 @@ fn series_of(results: &[RunResult], y: impl Fn(&RunResult) -> Option<f64>) -> Ve
 }
 
 fn write_plots(dir: &Path, results: &[RunResult]) -> anyhow::Result<()> {
-    let x_label = results
-        .first()
-        .and_then(|r| r.run.params.first())
-        .map(|(k, _)| *k)
-        .unwrap_or("parameter");
-    let dssim = series_of(results, |r| r.cmp.ssim_values().map(|s| 1.0 - s.mean));
+    let x_label = x_parameter(results);
+    let dssim = series_of(results, x_label, |r| {
+        r.cmp.ssim_values().map(|s| 1.0 - s.mean)
+    });
     line_plot_svg(
         &dir.join("dssim.svg"),
         &PlotSpec {
-            title: "1 − SSIM (mean over R, G, B) against the parameter",
+            title: &format!("1 − SSIM (mean over R, G, B) against {x_label}"),
             x_label,
             y_label: "1 − SSIM",
             log_x: true,
@@ -391,11 +420,13 @@ fn write_plots(dir: &Path, results: &[RunResult]) -> anyhow::Result<()> {
         },
         &dssim,
     )?;
-    let rmse = series_of(results, |r| Some(r.cmp.error_values(|e| e.rmse).mean));
+    let rmse = series_of(results, x_label, |r| {
+        Some(r.cmp.error_values(|e| e.rmse).mean)
+    });
     line_plot_svg(
         &dir.join("rmse.svg"),
         &PlotSpec {
-            title: "RMSE (mean over R, G, B) against the parameter",
+            title: &format!("RMSE (mean over R, G, B) against {x_label}"),
             x_label,
             y_label: "RMSE",
             log_x: true,
@@ -403,11 +434,11 @@ fn write_plots(dir: &Path, results: &[RunResult]) -> anyhow::Result<()> {
         },
         &rmse,
     )?;
-    let time = series_of(results, |r| Some(r.seconds));
+    let time = series_of(results, x_label, |r| Some(r.seconds));
     line_plot_svg(
         &dir.join("time.svg"),
         &PlotSpec {
-            title: "Render time against the parameter",
+            title: &format!("Render time against {x_label}"),
             x_label,
             y_label: "seconds",
             log_x: true,

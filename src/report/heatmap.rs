@@ -83,7 +83,7 @@ pub fn heatmap(
     cmap: ColorMap,
 ) -> Srgb8Image {
     // Font and bar grow with the image so that the labels stay readable.
-    let s = (height / 200).clamp(1, 6);
+    let s = (height / 96).clamp(1, 8);
     let labels = [scale.hi, 0.5 * (scale.lo + scale.hi), scale.lo].map(format_label);
     let label_chars = labels
         .iter()

@@ -358,7 +358,7 @@ fn write_maps_exr(path: &Path, abs: &RgbImage, layers: &[(&str, &RgbImage)]) -> 
 
 /// Report files are for reading by anyone (a web server, a CI artefact store): 0644 instead of
 /// the temporary file's 0600. Best effort.
-pub(crate) fn make_readable(path: &Path) {
+pub fn make_readable(path: &Path) {
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
@@ -382,5 +382,6 @@ pub fn write_text(path: &Path, text: &str) -> Result<()> {
     tmp.write_all(text.as_bytes())
         .map_err(|e| PgtError::io(path, e))?;
     tmp.persist(path).map_err(|e| PgtError::io(path, e.error))?;
+    make_readable(path);
     Ok(())
 }

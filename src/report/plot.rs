@@ -102,6 +102,7 @@ pub fn line_plot_svg(path: &Path, spec: &PlotSpec, series: &[Series]) -> Result<
                 .configure_mesh()
                 .x_desc(spec.x_label)
                 .y_desc(spec.y_label)
+                .x_label_formatter(&|v| crate::report::heatmap::format_label(*v))
                 .y_label_formatter(&|v| crate::report::heatmap::format_label(*v))
                 .draw()
                 .map_err(|e| err(&e))?;
