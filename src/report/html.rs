@@ -213,9 +213,8 @@ pub fn metrics_table(s: &Summary) -> String {
             fmt(v.mean)
         );
     };
-    match &s.ssim {
-        Some(v) => row("SSIM", v, &|x| format!("{x:.6}")),
-        None => {}
+    if let Some(v) = &s.ssim {
+        row("SSIM", v, &|x| format!("{x:.6}"));
     }
     row("RMSE", &s.rmse, &|x| format!("{x:.4e}"));
     row("PSNR", &s.psnr, &format_db);
