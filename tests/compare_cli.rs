@@ -322,3 +322,51 @@ fn report_folder_has_page_maps_and_summary() {
     let heat = image::open(rep.join("abs_error.png")).unwrap();
     assert!(heat.width() > 48 && heat.height() >= 32);
 }
+
+#[test]
+fn scene_reference_is_rendered_on_the_fly() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/shadows.toml");
+    let rendered = dir.path().join("r.exr");
+    let o = pgt(&[
+        "render",
+        &scene.to_string_lossy(),
+        "-o",
+        &rendered.to_string_lossy(),
+    ]);
+    assert_eq!(code(&o), 0, "{}", text(&o.stderr));
+    // The scene rendered on the fly equals the same scene rendered to a file.
+    let o = pgt(&[
+        "compare",
+        &scene.to_string_lossy(),
+        &rendered.to_string_lossy(),
+        "--json",
+        "-",
+    ]);
+    assert_eq!(code(&o), 0, "{}", text(&o.stderr));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["rmse"]["mean"], 0.0);
+    assert_eq!(v["ssim"]["mean"], 1.0);
+    // A different size is refused, naming both.
+    let small = dir.path().join("small.exr");
+    let o = pgt(&[
+        "render",
+        &scene.to_string_lossy(),
+        "-o",
+        &small.to_string_lossy(),
+        "--size",
+        "64x48",
+    ]);
+    assert_eq!(code(&o), 0);
+    let o = pgt(&[
+        "compare",
+        &scene.to_string_lossy(),
+        &small.to_string_lossy(),
+    ]);
+    assert_eq!(code(&o), 2);
+    let err = text(&o.stderr);
+    assert!(
+        err.contains("shadows.toml") && err.contains("small.exr"),
+        "{err}"
+    );
+}

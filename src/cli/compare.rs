@@ -16,7 +16,7 @@ use std::time::Instant;
 
 #[derive(Debug, Args)]
 pub struct CompareArgs {
-    /// The reference image (.exr or .png).
+    /// The reference image (.exr or .png), or a scene (.toml) rendered on the fly.
     pub reference: PathBuf,
     /// The approximation (.exr or .png).
     pub approximation: PathBuf,
@@ -140,15 +140,51 @@ pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
     })
 }
 
-/// Reads both images and checks they can be compared: same size and channel count (an error
+/// An image file, or a scene file (`.toml`) rendered on the fly by the exact reference with its
+/// default options (DESIGN.md §5 "Inputs: … or scenes rendered on the fly").
+fn read_or_render(path: &Path, layer: Option<&str>) -> anyhow::Result<ReadImage> {
+    let is_scene = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    if !is_scene {
+        return Ok(read_image_layer(path, layer)?);
+    }
+    if layer.is_some_and(|l| !l.is_empty()) {
+        anyhow::bail!(
+            "{}: --layer applies to EXR files, not to a scene",
+            path.display()
+        );
+    }
+    let scene = crate::scene::Scene::load(path, &crate::scene::SceneLoadOptions::default())?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    let options = crate::reference::RenderOptions {
+        progress: super::stderr_is_terminal(),
+        ..Default::default()
+    };
+    let out = crate::reference::render(&scene, &options)?;
+    eprintln!(
+        "rendered the reference of {} in {:.2} s",
+        path.display(),
+        out.stats.seconds
+    );
+    Ok(ReadImage {
+        image: out.image,
+        channels: 3,
+    })
+}
+
+/// Reads both images (or renders scenes) and checks they can be compared: same size and channel count (an error
 /// naming both files otherwise).
 pub fn load_pair(
     reference: &Path,
     approximation: &Path,
     layer: Option<&str>,
 ) -> anyhow::Result<(RgbImage, RgbImage)> {
-    let r: ReadImage = read_image_layer(reference, layer)?;
-    let a: ReadImage = read_image_layer(approximation, layer)?;
+    let r = read_or_render(reference, layer)?;
+    let a = read_or_render(approximation, layer)?;
     if (r.image.width, r.image.height) != (a.image.width, a.image.height) {
         anyhow::bail!(
             "images differ in size: {} is {}x{}, {} is {}x{}",

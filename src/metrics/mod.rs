@@ -54,7 +54,7 @@ impl PerChannel {
 pub enum DataRangeSource {
     /// `--data-range` (or the experiment file).
     Given,
-    /// LDR inputs (every value in [0, 1]): 1 (DESIGN.md §5).
+    /// LDR inputs (no value above 1): 1 (DESIGN.md §5).
     Default,
     /// HDR inputs without a given range: max(reference) − min(0, min(reference)).
     Derived,
@@ -180,6 +180,9 @@ pub fn compare(
             "images differ in size: reference {}x{}, approximation {}x{}",
             reference.width, reference.height, approximation.width, approximation.height
         )));
+    }
+    if reference.pixels.is_empty() {
+        return Err(PgtError::Usage("images have no pixels".into()));
     }
     for (name, img) in [("reference", reference), ("approximation", approximation)] {
         if let Some((x, y, c)) = first_non_finite(img) {
