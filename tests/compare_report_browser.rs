@@ -141,3 +141,45 @@ fn report_loads_in_headless_chromium_with_every_image() {
     let img = image::open(&shot).expect("screenshot is a PNG");
     assert_eq!((img.width(), img.height()), (1200, 900));
 }
+
+#[test]
+fn sweep_report_loads_in_headless_chromium_with_its_plots() {
+    let Some(exe) = chromium() else {
+        if in_ci() {
+            panic!("CI is set but chromium is not installed (apt-get install chromium)");
+        }
+        eprintln!("skipping: chromium not installed (CI not set)");
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/shadows.toml");
+    let exp = dir.path().join("exp.toml");
+    std::fs::write(
+        &exp,
+        format!(
+            "scene = {:?}\nsize = [40, 30]\n[reference]\nspp = 2\n[[approximations]]\nmethod = \"riemann\"\nsamples = [1, 2]\nspp = [1]\n",
+            scene.to_string_lossy()
+        ),
+    )
+    .unwrap();
+    let rep = dir.path().join("sweep");
+    let o = Command::new(env!("CARGO_BIN_EXE_pgt"))
+        .args([
+            "sweep",
+            &exp.to_string_lossy(),
+            "--report",
+            &rep.to_string_lossy(),
+        ])
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let dom = run_chromium(&exe, &rep.join("index.html"), &["--dump-dom".to_string()]);
+    // Three SVG plots, the reference and two runs.
+    assert!(dom.contains("data-pgt-images=\"ok\""), "{dom}");
+    assert!(dom.contains("data-pgt-image-count=\"6\""), "{dom}");
+}

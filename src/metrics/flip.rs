@@ -32,6 +32,8 @@ pub enum FlipError {
     Hdr(f32),
     #[error("FLIP: images differ in size")]
     SizeMismatch,
+    #[error("FLIP: image too large for the nv-flip bindings (3·width·height must fit in 32 bits)")]
+    TooLarge,
 }
 
 /// LDR-FLIP of two linear images whose values lie in [0, 1] (negative values are clamped to 0 by
@@ -43,6 +45,10 @@ pub fn flip_ldr(
 ) -> Result<Flip, FlipError> {
     if reference.width != approximation.width || reference.height != approximation.height {
         return Err(FlipError::SizeMismatch);
+    }
+    // nv-flip computes width·height·3 in u32.
+    if (reference.width as u64) * (reference.height as u64) * 3 > u32::MAX as u64 {
+        return Err(FlipError::TooLarge);
     }
     let largest = reference
         .pixels
