@@ -254,6 +254,28 @@ def flip_vectors(out_dir, rng):
         "mean": float(mean),
         "map": [float(v) for v in err.reshape(-1)],
     }
+
+    # HDR-FLIP on float32 linear images (no zero median luminance, so that FLIP's automatic
+    # exposure range is defined).
+    h, w = 36, 44
+    yy, xx = np.mgrid[0:h, 0:w]
+    light = np.exp(rng.normal(0.0, 1.0, (h, w, 1))) * (0.2 + 4.0 * xx[..., None] / (w - 1))
+    tint = np.stack([0.9 + 0.1 * np.sin(0.3 * yy), 0.7 + 0.3 * np.cos(0.2 * xx), 0.5 + 0.0 * xx], axis=2)
+    ref = (light * tint).astype(np.float32)
+    test = (ref * (1.0 + rng.normal(0.0, 0.15, ref.shape))).clip(0.0, None).astype(np.float32)
+    herr, hmean, hparams = flip.evaluate(ref, test, "HDR", applyMagma=False)
+    doc["hdr"] = {
+        "width": w,
+        "height": h,
+        "reference": [float(v) for v in ref.reshape(-1)],
+        "approximation": [float(v) for v in test.reshape(-1)],
+        "mean": float(hmean),
+        "start_exposure": float(hparams["startExposure"]),
+        "stop_exposure": float(hparams["stopExposure"]),
+        "num_exposures": int(hparams["numExposures"]),
+        "tonemapper": str(hparams.get("tonemapper", "ACES")),
+        "map": [float(v) for v in np.asarray(herr, dtype=np.float64).reshape(-1)],
+    }
     with open(os.path.join(out_dir, "flip_vectors.json"), "w") as f:
         json.dump(doc, f, separators=(",", ":"))
         f.write("\n")

@@ -261,7 +261,9 @@ fn exr_layer_and_hdr_data_range() {
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(v["rmse"]["mean"], 0.0);
     assert_eq!(v["data_range_source"], "derived");
-    assert!(v["flip"].is_null() && v["flip_note"].as_str().unwrap().contains("HDR"));
+    // HDR input: HDR-FLIP, 0 for identical images.
+    assert_eq!(v["flip"], 0.0);
+    assert_eq!(v["flip_kind"], "hdr");
     assert!(text(&o.stderr).contains("derived"));
     let o = pgt(&[
         "compare",

@@ -53,6 +53,9 @@ pub struct CompareArgs {
     /// Skip FLIP.
     #[arg(long)]
     pub no_flip: bool,
+    /// HDR-FLIP exposure range START,STOP in stops (default: chosen from the reference).
+    #[arg(long, value_parser = parse_exposures, allow_hyphen_values = true)]
+    pub flip_exposures: Option<(f32, f32)>,
     /// FLIP's viewing condition in pixels per degree.
     #[arg(long, default_value_t = crate::metrics::flip::DEFAULT_PIXELS_PER_DEGREE)]
     pub ppd: f32,
@@ -86,6 +89,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
         data_range: args.data_range,
         flip: !args.no_flip,
         pixels_per_degree: args.ppd,
+        flip_exposures: args.flip_exposures,
     };
     let cmp = compare(&reference, &approximation, &options).with_context(|| {
         format!(
@@ -138,6 +142,19 @@ pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
         Some(false) => Outcome::GateFailed,
         _ => Outcome::Success,
     })
+}
+
+/// Parses `START,STOP` (stops, finite, START <= STOP).
+fn parse_exposures(s: &str) -> Result<(f32, f32), String> {
+    let err = || format!("expected START,STOP in stops with START <= STOP, got '{s}'");
+    let (a, b) = s.split_once(',').ok_or_else(err)?;
+    let a: f32 = a.trim().parse().map_err(|_| err())?;
+    let b: f32 = b.trim().parse().map_err(|_| err())?;
+    if a.is_finite() && b.is_finite() && a <= b {
+        Ok((a, b))
+    } else {
+        Err(err())
+    }
 }
 
 /// An image file, or a scene file (`.toml`) rendered on the fly by the exact reference with its

@@ -65,9 +65,11 @@ pub enum DataRangeSource {
 pub struct CompareOptions {
     /// The data range R of SSIM and PSNR; `None`: 1 for LDR inputs, derived for HDR.
     pub data_range: Option<f64>,
-    /// Compute FLIP (LDR inputs only).
+    /// Compute FLIP: LDR-FLIP when no value exceeds 1, HDR-FLIP otherwise.
     pub flip: bool,
     pub pixels_per_degree: f32,
+    /// HDR-FLIP's exposure range (start, stop) in stops; `None`: chosen from the reference.
+    pub flip_exposures: Option<(f32, f32)>,
 }
 
 impl Default for CompareOptions {
@@ -76,6 +78,7 @@ impl Default for CompareOptions {
             data_range: None,
             flip: true,
             pixels_per_degree: flip::DEFAULT_PIXELS_PER_DEGREE,
+            flip_exposures: None,
         }
     }
 }
@@ -209,11 +212,19 @@ pub fn compare(
             )
         },
         || {
-            if options.flip {
+            if !options.flip {
+                Err("FLIP not requested".to_string())
+            } else if is_ldr(reference) && is_ldr(approximation) {
                 flip::flip_ldr(reference, approximation, options.pixels_per_degree)
                     .map_err(|e| e.to_string())
             } else {
-                Err("FLIP not requested".to_string())
+                flip::flip_hdr(
+                    reference,
+                    approximation,
+                    options.pixels_per_degree,
+                    options.flip_exposures,
+                )
+                .map_err(|e| e.to_string())
             }
         },
     );

@@ -123,11 +123,17 @@ pub fn write_report(dir: &Path, inputs: &ReportInputs) -> Result<std::path::Path
             .write_png(&dir.join("flip.png"))?;
         figures.push(Figure {
             file: "flip.png",
-            title: "FLIP (LDR)".into(),
-            caption: format!(
-                "magma, scale 0 … 1, {:.1} pixels per degree",
-                flip.pixels_per_degree
-            ),
+            title: if flip.exposures.is_some() { "HDR-FLIP" } else { "FLIP (LDR)" }.into(),
+            caption: match flip.exposures {
+                Some((a, b, n)) => format!(
+                    "magma, scale 0 … 1, {:.1} pixels per degree, ACES, {n} exposures {a:.2} … {b:.2} stops, 8-bit per exposure",
+                    flip.pixels_per_degree
+                ),
+                None => format!(
+                    "magma, scale 0 … 1, {:.1} pixels per degree",
+                    flip.pixels_per_degree
+                ),
+            },
         });
         layers_owned.push(("flip", maps::gray_image(w, h, &flip.map)));
     }
@@ -235,9 +241,14 @@ pub fn metrics_table(s: &Summary) -> String {
     );
     match s.flip {
         Some(f) => {
+            let kind = if s.flip_kind == Some("hdr") {
+                "HDR-FLIP"
+            } else {
+                "FLIP (LDR)"
+            };
             let _ = writeln!(
                 t,
-                "<tr><td>FLIP (LDR)</td><td colspan=\"3\"></td><td><b>{f:.6}</b></td></tr>"
+                "<tr><td>{kind}</td><td colspan=\"3\"></td><td><b>{f:.6}</b></td></tr>"
             );
         }
         None => {

@@ -24,6 +24,10 @@ pub struct Summary {
     /// Largest absolute error per channel with its pixel, and over all channels.
     pub max_abs: Vec<MaxAbs>,
     pub flip: Option<f64>,
+    /// "ldr" or "hdr" (HDR-FLIP) when FLIP was computed.
+    pub flip_kind: Option<&'static str>,
+    /// HDR-FLIP: [first, last] exposure in stops and their count.
+    pub flip_exposures: Option<(f32, f32, usize)>,
     pub flip_note: Option<String>,
     pub gates: Vec<GateCheck>,
     /// `null` without gates.
@@ -76,6 +80,14 @@ impl Summary {
                 })
                 .collect(),
             flip: cmp.flip_mean(),
+            flip_kind: cmp.flip.as_ref().ok().map(|f| {
+                if f.exposures.is_some() {
+                    "hdr"
+                } else {
+                    "ldr"
+                }
+            }),
+            flip_exposures: cmp.flip.as_ref().ok().and_then(|f| f.exposures),
             flip_note: cmp.flip.as_ref().err().cloned(),
             gates,
             passed,
@@ -115,7 +127,12 @@ impl Summary {
             m.channel
         );
         if let Some(f) = self.flip {
-            metrics += &format!(", FLIP {f:.4}");
+            let kind = if self.flip_kind == Some("hdr") {
+                "HDR-FLIP"
+            } else {
+                "FLIP"
+            };
+            metrics += &format!(", {kind} {f:.4}");
         }
         match self.passed {
             None => format!("compared: {metrics}"),
