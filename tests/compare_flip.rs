@@ -116,3 +116,29 @@ fn hdr_flip_matches_flip_evaluator_up_to_8_bit_quantisation() {
     ));
     assert!(flip_hdr(&black, &a, 67.0, Some((-2.0, 3.0))).is_ok());
 }
+
+/// The banded parallel evaluation equals one nv-flip call over the whole image, bit for bit,
+/// at several viewing distances and on an image whose height is not a multiple of the band.
+#[test]
+fn banded_flip_equals_whole_image_flip() {
+    use pgt::metrics::flip::{flip_srgb8, flip_srgb8_whole};
+    let (w, h) = (97u32, 301u32);
+    let mut state = 7u32;
+    let mut noise = || {
+        state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+        (state >> 24) as u8
+    };
+    let r: Vec<u8> = (0..w * h * 3).map(|_| noise()).collect();
+    let a: Vec<u8> = r.iter().map(|&v| v.saturating_add(noise() / 8)).collect();
+    for ppd in [20.0f32, 67.02, 120.0] {
+        let banded = flip_srgb8(w, h, &r, &a, ppd);
+        let whole = flip_srgb8_whole(w, h, &r, &a, ppd);
+        assert_eq!(banded.len(), whole.len());
+        let differing = banded
+            .iter()
+            .zip(&whole)
+            .filter(|(x, y)| x.to_bits() != y.to_bits())
+            .count();
+        assert_eq!(differing, 0, "ppd {ppd}: {differing} pixels differ");
+    }
+}

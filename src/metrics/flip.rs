@@ -76,9 +76,13 @@ pub fn flip_ldr(
             .collect()
     };
     let (w, h) = (reference.width, reference.height);
-    let r = nv_flip::FlipImageRgb8::with_data(w, h, &encode(reference));
-    let a = nv_flip::FlipImageRgb8::with_data(w, h, &encode(approximation));
-    let map = nv_flip::flip(r, a, pixels_per_degree).to_vec();
+    let map = flip_srgb8(
+        w,
+        h,
+        &encode(reference),
+        &encode(approximation),
+        pixels_per_degree,
+    );
     let mean = map.iter().map(|&v| v as f64).sum::<f64>() / map.len().max(1) as f64;
     Ok(Flip {
         mean,
@@ -86,6 +90,58 @@ pub fn flip_ldr(
         pixels_per_degree,
         exposures: None,
     })
+}
+
+/// Rows of one band of the parallel FLIP evaluation.
+const FLIP_BAND: u32 = 128;
+
+/// How far (in pixels) one FLIP pixel sees: the spatial (CSF) filter radius plus the feature
+/// filter radius of NVIDIA's code (`calculateSpatialFilterRadius`: ⌈3·√(0.04/(2π²))·ppd⌉, the
+/// largest Gaussian scale b1.z = 0.04; feature filter ⌈3·0.5·0.082·ppd⌉), plus a margin.
+/// Their sum bounds the reach of the two passes even if they were chained.
+pub fn flip_reach(pixels_per_degree: f32) -> u32 {
+    let pi_sq = std::f32::consts::PI * std::f32::consts::PI;
+    let spatial = (3.0 * (0.04f32 / (2.0 * pi_sq)).sqrt() * pixels_per_degree).ceil();
+    let feature = (3.0 * 0.5 * 0.082f32 * pixels_per_degree).ceil();
+    (spatial + feature) as u32 + 2
+}
+
+/// LDR-FLIP map of two 8-bit sRGB images (row-major RGB bytes), evaluated in parallel bands of
+/// rows: each band is run by nv-flip with [`flip_reach`] extra rows above and below, and only its
+/// own rows are kept. FLIP is local (no image-wide statistics), so the map equals the one of a
+/// single call (tests/compare_flip.rs checks bit equality); nv-flip itself is single-threaded.
+pub fn flip_srgb8(w: u32, h: u32, reference: &[u8], approximation: &[u8], ppd: f32) -> Vec<f32> {
+    use rayon::prelude::*;
+    let halo = flip_reach(ppd);
+    let row = 3 * w as usize;
+    let bands: Vec<u32> = (0..h).step_by(FLIP_BAND as usize).collect();
+    let parts: Vec<Vec<f32>> = bands
+        .par_iter()
+        .map(|&y0| {
+            let y1 = (y0 + FLIP_BAND).min(h);
+            let (lo, hi) = (y0.saturating_sub(halo), (y1 + halo).min(h));
+            let rows = lo as usize * row..hi as usize * row;
+            let r = nv_flip::FlipImageRgb8::with_data(w, hi - lo, &reference[rows.clone()]);
+            let a = nv_flip::FlipImageRgb8::with_data(w, hi - lo, &approximation[rows]);
+            let map = nv_flip::flip(r, a, ppd).to_vec();
+            let skip = ((y0 - lo) * w) as usize;
+            map[skip..skip + ((y1 - y0) * w) as usize].to_vec()
+        })
+        .collect();
+    parts.concat()
+}
+
+/// Single-call LDR-FLIP (no bands), the reference that [`flip_srgb8`] is tested against.
+pub fn flip_srgb8_whole(
+    w: u32,
+    h: u32,
+    reference: &[u8],
+    approximation: &[u8],
+    ppd: f32,
+) -> Vec<f32> {
+    let r = nv_flip::FlipImageRgb8::with_data(w, h, reference);
+    let a = nv_flip::FlipImageRgb8::with_data(w, h, approximation);
+    nv_flip::flip(r, a, ppd).to_vec()
 }
 
 /// ACES filmic tone mapper of HDR-FLIP (NVIDIA `tensor.h`, `ToneMappingCoefficients[1]`; the
@@ -185,9 +241,13 @@ pub fn flip_hdr(
         .into_par_iter()
         .map(|i| {
             let exposure = start + i as f32 * step;
-            let r = nv_flip::FlipImageRgb8::with_data(w, h, &tone_mapped(reference, exposure));
-            let a = nv_flip::FlipImageRgb8::with_data(w, h, &tone_mapped(approximation, exposure));
-            nv_flip::flip(r, a, pixels_per_degree).to_vec()
+            flip_srgb8(
+                w,
+                h,
+                &tone_mapped(reference, exposure),
+                &tone_mapped(approximation, exposure),
+                pixels_per_degree,
+            )
         })
         .collect();
     let mut map = maps[0].clone();
