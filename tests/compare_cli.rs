@@ -280,6 +280,7 @@ fn exr_layer_and_hdr_data_range() {
     let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
     assert!(v["rmse"]["mean"].as_f64().unwrap() > 0.01);
     assert_eq!(v["data_range_source"], "given");
+    assert!(v["reference_uncertainty"].is_null());
 }
 
 #[test]

@@ -105,13 +105,24 @@ pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
         );
     }
     let checks = gate.evaluate(&cmp, &reference, &approximation)?;
-    let summary = Summary::new(
+    let mut summary = Summary::new(
         &args.reference.display().to_string(),
         &args.approximation.display().to_string(),
         &cmp,
         checks,
         start.elapsed().as_secs_f64(),
     );
+    summary.reference_uncertainty = reference_estimate(&args.reference, args.layer.as_deref())
+        .filter(|e| (e.width, e.height) == (reference.width, reference.height))
+        .map(|e| crate::metrics::errors::reference_uncertainty(&reference, &approximation, &e));
+    if let Some(u) = &summary.reference_uncertainty {
+        eprintln!(
+            "reference error estimate: max {:.3e}, mean {:.3e}; the difference exceeds it at {:.3}% of pixel-channels",
+            u.max_estimate,
+            u.mean_estimate,
+            100.0 * u.exceeding_fraction
+        );
+    }
     if let Some(dir) = &args.report {
         let inputs = ReportInputs {
             reference: &reference,
@@ -142,6 +153,19 @@ pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
         Some(false) => Outcome::GateFailed,
         _ => Outcome::Success,
     })
+}
+
+/// The reference's per-pixel error estimate: the `err` layer of a reference EXR (DESIGN.md §3,
+/// §7), when the whole image is compared (no `--layer`) and the file has one.
+fn reference_estimate(reference: &Path, layer: Option<&str>) -> Option<RgbImage> {
+    let is_exr = reference
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if !is_exr || layer.is_some_and(|l| !l.is_empty()) {
+        return None;
+    }
+    crate::image_io::read_exr_layer(reference, "err").ok()
 }
 
 /// Parses `START,STOP` (stops, finite, START <= STOP).

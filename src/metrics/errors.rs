@@ -104,3 +104,65 @@ pub fn channel_errors(
         }
     })
 }
+
+/// The approximation's error measured against the reference's own uncertainty: the reference's
+/// per-pixel quadrature error estimate (its EXR `err` layer, DESIGN.md §3).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct ReferenceUncertainty {
+    /// Largest and mean estimate over all pixels and channels.
+    pub max_estimate: f64,
+    pub mean_estimate: f64,
+    /// Fraction of pixel-channels where |a − r| exceeds the reference's estimate there: the
+    /// differences that the reference is sure about.
+    pub exceeding_fraction: f64,
+}
+
+/// Compares |a − r| with the reference's error estimate `estimate` (same size, checked by the
+/// caller).
+pub fn reference_uncertainty(
+    reference: &RgbImage,
+    approximation: &RgbImage,
+    estimate: &RgbImage,
+) -> ReferenceUncertainty {
+    let (mut max, mut sum, mut exceeding) = (0.0f64, 0.0f64, 0usize);
+    for ((r, a), e) in reference
+        .pixels
+        .iter()
+        .zip(&approximation.pixels)
+        .zip(&estimate.pixels)
+    {
+        for c in 0..3 {
+            let est = (e[c] as f64).abs();
+            max = max.max(est);
+            sum += est;
+            if (a[c] as f64 - r[c] as f64).abs() > est {
+                exceeding += 1;
+            }
+        }
+    }
+    let n = (3 * reference.pixels.len()).max(1) as f64;
+    ReferenceUncertainty {
+        max_estimate: max,
+        mean_estimate: sum / n,
+        exceeding_fraction: exceeding as f64 / n,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn uncertainty_counts_differences_above_the_estimate() {
+        let r = RgbImage::new(2, 1);
+        let mut a = RgbImage::new(2, 1);
+        a.pixels[0] = [0.1, 0.001, 0.0];
+        let mut e = RgbImage::new(2, 1);
+        e.pixels = vec![[0.01; 3], [0.03; 3]];
+        let u = reference_uncertainty(&r, &a, &e);
+        // Only R of pixel 0 (0.1 > 0.01) exceeds its estimate: 1 of 6 pixel-channels.
+        assert_eq!(u.exceeding_fraction, 1.0 / 6.0);
+        assert_eq!(u.max_estimate, 0.03f32 as f64);
+        assert!((u.mean_estimate - 0.02).abs() < 1e-9);
+    }
+}

@@ -259,6 +259,15 @@ pub fn metrics_table(s: &Summary) -> String {
             );
         }
     }
+    if let Some(u) = &s.reference_uncertainty {
+        let _ = writeln!(
+            t,
+            "<tr><td>reference error estimate</td><td colspan=\"4\">max {:.3e}, mean {:.3e}; |a − r| exceeds it at {:.3}% of pixel-channels</td></tr>",
+            u.max_estimate,
+            u.mean_estimate,
+            100.0 * u.exceeding_fraction
+        );
+    }
     if let Some(note) = &s.ssim_note {
         let _ = writeln!(
             t,

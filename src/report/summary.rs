@@ -29,6 +29,8 @@ pub struct Summary {
     /// HDR-FLIP: [first, last] exposure in stops and their count.
     pub flip_exposures: Option<(f32, f32, usize)>,
     pub flip_note: Option<String>,
+    /// Against the reference's own error estimate (its EXR `err` layer), when it has one.
+    pub reference_uncertainty: Option<crate::metrics::errors::ReferenceUncertainty>,
     pub gates: Vec<GateCheck>,
     /// `null` without gates.
     pub passed: Option<bool>,
@@ -89,6 +91,7 @@ impl Summary {
             }),
             flip_exposures: cmp.flip.as_ref().ok().and_then(|f| f.exposures),
             flip_note: cmp.flip.as_ref().err().cloned(),
+            reference_uncertainty: None,
             gates,
             passed,
             seconds,
