@@ -179,7 +179,7 @@ fn sweep_report_loads_in_headless_chromium_with_its_plots() {
         String::from_utf8_lossy(&o.stderr)
     );
     let dom = run_chromium(&exe, &rep.join("index.html"), &["--dump-dom".to_string()]);
-    // Three SVG plots, the reference and two runs.
+    // Three SVG plots, the reference, and two runs with their error heatmaps.
     assert!(dom.contains("data-pgt-images=\"ok\""), "{dom}");
-    assert!(dom.contains("data-pgt-image-count=\"6\""), "{dom}");
+    assert!(dom.contains("data-pgt-image-count=\"8\""), "{dom}");
 }

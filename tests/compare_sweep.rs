@@ -45,6 +45,7 @@ fn riemann_sweep_reports_and_caches_the_reference() {
     ] {
         assert!(rep.join(f).is_file(), "{f} missing");
     }
+    assert!(rep.join("riemann_samples_4_spp_1_abs_error.png").is_file());
     let svg = std::fs::read_to_string(rep.join("rmse.svg")).unwrap();
     assert!(
         svg.starts_with("<svg") && svg.contains("against spp"),

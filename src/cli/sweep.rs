@@ -34,11 +34,12 @@
 use super::Outcome;
 use crate::error::PgtError;
 use crate::image_io::{read_exr_layer, write_image, RgbImage};
-use crate::metrics::{compare, CompareOptions, Comparison};
+use crate::metrics::{compare, maps, CompareOptions, Comparison};
 use crate::reference::{self, Integrator, RenderOptions};
 use crate::report::html::{escape, make_readable, page, write_text};
 use crate::report::plot::{line_plot_svg, PlotSpec, Series};
 use crate::report::summary::short;
+use crate::report::{heatmap, ColorMap, Scale};
 use crate::scene::{Scene, SceneLoadOptions};
 use anyhow::Context;
 use clap::Args;
@@ -218,6 +219,9 @@ struct RunResult {
     seconds: f64,
     cmp: Comparison,
     image_file: String,
+    /// |a − r|, mean over channels, per pixel (for the heatmaps on a common scale).
+    abs_error: Vec<f32>,
+    heatmap_file: String,
 }
 
 pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
@@ -325,12 +329,33 @@ pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
             run.label(),
             cmp.error_values(|e| e.rmse).mean
         );
+        let abs_error = maps::channel_mean(&maps::abs_error(&reference_image, &image));
+        let heatmap_file = format!("{}_abs_error.png", run.file_stem());
         results.push(RunResult {
             run,
             seconds,
             cmp,
             image_file,
+            abs_error,
+            heatmap_file,
         });
+    }
+    // Error heatmaps on one scale for all runs, so that they can be compared by eye.
+    let all: Vec<f32> = results
+        .iter()
+        .map(|r| Scale::zero_to_max(&r.abs_error).hi as f32)
+        .collect();
+    let scale = Scale::zero_to_max(&all);
+    for r in &results {
+        let path = dir.join(&r.heatmap_file);
+        heatmap(
+            &r.abs_error,
+            reference_image.width,
+            reference_image.height,
+            scale,
+            ColorMap::Magma,
+        )
+        .write_png(&path)?;
     }
     write_plots(dir, &results)?;
     let page_path = dir.join("index.html");
@@ -502,6 +527,12 @@ fn sweep_page(
             "<figure><img src=\"{}\" alt=\"{}\"><figcaption><b>{}</b></figcaption></figure>",
             escape(&r.image_file),
             escape(&r.run.label()),
+            escape(&r.run.label())
+        );
+        let _ = writeln!(
+            b,
+            "<figure><img src=\"{}\" alt=\"error of {}\"><figcaption>|a − r|, mean over R, G, B; magma, one scale for all runs</figcaption></figure>",
+            escape(&r.heatmap_file),
             escape(&r.run.label())
         );
     }
