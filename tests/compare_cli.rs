@@ -77,6 +77,27 @@ fn failing_pair_exits_1_naming_the_metric() {
         !out.contains("max_rmse ="),
         "only failing metrics are named: {out}"
     );
+    // A FLIP gate fails by name too, and --json F writes the summary while stdout keeps the verdict.
+    let json = dir.path().join("s.json");
+    let o = pgt(&[
+        "compare",
+        &r,
+        &a,
+        "--max-flip",
+        "0.001",
+        "--json",
+        &json.to_string_lossy(),
+    ]);
+    assert_eq!(code(&o), 1);
+    assert!(
+        text(&o.stdout).starts_with("FAIL max_flip"),
+        "{}",
+        text(&o.stdout)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&std::fs::read(&json).unwrap()).unwrap();
+    assert_eq!(v["passed"], false);
+    assert_eq!(v["gates"][0]["name"], "max_flip");
+    assert_eq!(v["gates"][0]["passed"], false);
 }
 
 #[test]
