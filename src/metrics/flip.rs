@@ -1,5 +1,5 @@
-//! FLIP, NVIDIA's perceptual difference metric (Andersson et al. 2020), LDR variant only, through
-//! the `nv-flip` bindings to the reference C++ implementation.
+//! FLIP, NVIDIA's perceptual difference metric (Andersson et al. 2020; HDR-FLIP 2021), through
+//! the `nv-flip` bindings to NVIDIA's C++ LDR-FLIP, with the HDR variant built on top of it here.
 //!
 //! LDR-FLIP compares two sRGB images in [0, 1]. pgt's images are linear, so each is encoded to
 //! 8-bit sRGB first (the same encoding as pgt's PNG output). Images with values above 1 are HDR:
@@ -34,7 +34,7 @@ pub struct Flip {
 /// Why FLIP was not computed.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum FlipError {
-    #[error("FLIP: inputs have values above 1 (largest {0}); HDR-FLIP is not implemented, LDR-FLIP would need clamping")]
+    #[error("FLIP: inputs have values above 1 (largest {0}); LDR-FLIP would need clamping; use HDR-FLIP")]
     Hdr(f32),
     #[error("FLIP: images differ in size")]
     SizeMismatch,

@@ -40,8 +40,9 @@ struct Figure {
 
 /// Writes the maps and the page into `dir` (created if missing): `index.html`,
 /// `reference.png`, `approximation.png`, `abs_error.png`, `rel_error.png`, `ssim.png`,
-/// `flip.png` (LDR only), `maps.exr` (values: main layer = abs error, layers `rel`, `ssim`,
-/// `flip`) and `summary.json`. Returns the path of the page.
+/// `flip.png` (LDR- or HDR-FLIP, unless FLIP is off or undefined), `maps.exr` (the values:
+/// main layer = abs error, layers `rel`, `ssim`, `flip`) and `summary.json`. Returns the path of
+/// the page.
 pub fn write_report(dir: &Path, inputs: &ReportInputs) -> Result<std::path::PathBuf> {
     std::fs::create_dir_all(dir).map_err(|e| PgtError::io(dir, e))?;
     let cmp = inputs.comparison;
