@@ -230,7 +230,7 @@ pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
     let exp: Experiment = toml::from_str(&text).map_err(|e| {
         let line = e
             .span()
-            .map(|s| text[..s.start.min(text.len())].lines().count().max(1));
+            .map(|s| crate::metrics::gate::line_of(&text, s.start));
         match line {
             Some(l) => PgtError::at_line(&args.experiment, l, e.message().to_string()),
             None => PgtError::in_file(&args.experiment, e.message().to_string()),

@@ -102,7 +102,7 @@ impl Gate {
         let gate: Gate = toml::from_str(&text).map_err(|e| {
             let line = e
                 .span()
-                .map(|s| text[..s.start.min(text.len())].lines().count().max(1));
+                .map(|s| crate::metrics::gate::line_of(&text, s.start));
             match line {
                 Some(l) => PgtError::at_line(path, l, e.message().to_string()),
                 None => PgtError::in_file(path, e.message().to_string()),
@@ -319,6 +319,15 @@ impl Gate {
     }
 }
 
+/// The 1-based line of byte offset `offset` in `text` (for errors that name file:line).
+pub fn line_of(text: &str, offset: usize) -> usize {
+    text.as_bytes()[..offset.min(text.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
+}
+
 /// One value per pixel of a map kind (see [`MapKind`]).
 pub fn per_pixel(
     kind: MapKind,
@@ -365,6 +374,16 @@ fn flip_reason(cmp: &Comparison) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn error_lines_are_one_based() {
+        assert_eq!(line_of("a\nb\nc", 0), 1);
+        assert_eq!(line_of("a\nb\nc", 2), 2);
+        assert_eq!(line_of("a\nb\nc", 99), 3);
+        let text = "min_ssim = 0.9\nmax_rsme = 0.1\n";
+        let e = toml::from_str::<Gate>(text).unwrap_err();
+        assert_eq!(line_of(text, e.span().unwrap().start), 2);
+    }
 
     #[test]
     fn unknown_keys_are_rejected() {
