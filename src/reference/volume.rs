@@ -22,9 +22,12 @@
 //!
 //! **Kinks.** Q is smooth inside an interval except where a shadow ray grazes a sphere. Those
 //! camera-ray parameters are computed in closed form (`optics::kinks`: ray–cylinder for
-//! directional lights, ray–cone for point lights) and a segment that contains one is split
-//! exactly there when it needs refining (and its error estimate carries a safety factor until it
-//! is). Kinks that the closed form misses are still found by the adaptivity.
+//! directional lights, ray–cone for point lights) and every one is a breakpoint from the start
+//! (a shadow that falls between the nodes of a segment would otherwise be missed by both rules,
+//! and by the error estimate with them). The segments next to a kink are integrated with an
+//! endpoint-smoothing substitution that turns the square-root kink into a smooth integrand, and
+//! their error estimate carries a safety factor. Kinks the closed form might miss (round-off in
+//! the roots) are left to the adaptivity.
 //!
 //! **Θmax = 1.** An interval with σ = ∞ is the end of the ray: T = 0 from its start t0 on. Its
 //! contribution T(0,t0)·Q∞ is the σ → ∞ limit of the integral, which concentrates on x(t0⁺):
@@ -229,6 +232,34 @@ impl RadianceEstimator for VolumeRenderer<'_> {
             });
             transmittance *= (-tau).exp();
         }
+        let mut kinks = Vec::new();
+        if self.integrator == Integrator::Adaptive && finite > 0 {
+            if let (Some(first), Some(last)) = (intervals.first(), intervals.get(finite.saturating_sub(1))) {
+                for light in &self.scene.lights {
+                    shadow_tangencies(ray, (first.t0, last.t1), light, &self.bvh, &self.scene.particles, &mut kinks);
+                }
+            }
+        }
+        // Every kink is a breakpoint from the start: a shadow that falls between the nodes of a
+        // segment would otherwise go unseen by both rules, and the error estimate with it.
+        if !kinks.is_empty() {
+            let mut split = Vec::with_capacity(pieces.len() + kinks.len());
+            for p in &pieces {
+                let iv = &intervals[p.tag];
+                let from = kinks.partition_point(|&t| t <= iv.t0);
+                let to = kinks.partition_point(|&t| t < iv.t1);
+                let mut lo = p.lo;
+                for &t in &kinks[from..to] {
+                    let u = opacity(iv.sigma * (t - iv.t0));
+                    if u > lo && u < p.hi {
+                        split.push(Piece { lo, hi: u, ..*p });
+                        lo = u;
+                    }
+                }
+                split.push(Piece { lo, ..*p });
+            }
+            pieces = split;
+        }
         let background = transmittance * render.background;
         let intervals = &intervals[..finite];
         let t_of = |k: usize, u: f64| {
@@ -245,12 +276,6 @@ impl RadianceEstimator for VolumeRenderer<'_> {
                 (sum, DVec3::ZERO)
             }
             Integrator::Adaptive => {
-                let mut kinks = Vec::new();
-                if let (Some(first), Some(last)) = (intervals.first(), intervals.last()) {
-                    for light in &self.scene.lights {
-                        shadow_tangencies(ray, (first.t0, last.t1), light, &self.bvh, &self.scene.particles, &mut kinks);
-                    }
-                }
                 let kink_in = |k: usize, lo: f64, hi: f64| {
                     let (a, b) = (t_of(k, lo), t_of(k, hi));
                     let from = kinks.partition_point(|&t| t <= a);
