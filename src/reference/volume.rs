@@ -280,6 +280,10 @@ impl RadianceEstimator for VolumeRenderer<'_> {
                     let (a, b) = (t_of(k, lo), t_of(k, hi));
                     let from = kinks.partition_point(|&t| t <= a);
                     let to = kinks.partition_point(|&t| t < b);
+                    if from >= to {
+                        // Also where clamping t(u) to the interval collapses (a, b) to a point.
+                        return None;
+                    }
                     let mid = t_of(k, 0.5 * (lo + hi));
                     let t = kinks[from..to]
                         .iter()
