@@ -14,9 +14,9 @@ use glam::DVec3;
 use pgt::optics::extinction::sigma_from_opacity;
 use pgt::reference::volume::VolumeRenderer;
 use pgt::reference::{Integrator, RadianceEstimator, Sample};
+use pgt::scene::{default_camera, thesis_lights, OpticalModel};
 use rayon::prelude::*;
 use std::time::Instant;
-use pgt::scene::{default_camera, thesis_lights, OpticalModel};
 use volume_support::*;
 
 const PARTICLES: usize = 2758;
@@ -31,7 +31,11 @@ fn run(s: &pgt::scene::Scene, integrator: Integrator) -> (Vec<Sample>, f64) {
     let (w, h) = (s.camera.width, s.camera.height);
     let rows: Vec<Vec<Sample>> = (0..h)
         .into_par_iter()
-        .map(|py| (0..w).map(|px| r.radiance(&s.camera.pixel_ray(px, py))).collect())
+        .map(|py| {
+            (0..w)
+                .map(|px| r.radiance(&s.camera.pixel_ray(px, py)))
+                .collect()
+        })
         .collect();
     (rows.concat(), start.elapsed().as_secs_f64())
 }
@@ -39,20 +43,30 @@ fn run(s: &pgt::scene::Scene, integrator: Integrator) -> (Vec<Sample>, f64) {
 #[test]
 #[ignore]
 fn benchmark_adaptive_against_riemann() {
-    let size: u32 = std::env::var("PGT_BENCH_SIZE").ok().and_then(|v| v.parse().ok()).unwrap_or(64);
+    let size: u32 = std::env::var("PGT_BENCH_SIZE")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(64);
     let side = (PARTICLES as f64 * VOLUME_PER_ATOM).cbrt();
     let mut rng = Rng(1);
     let particles: Vec<_> = (0..PARTICLES)
         .map(|_| {
             let r = rng.range(1.2, 1.9);
-            particle(rng.vec3(0.0, side), r, rng.vec3(0.0, 1.0), sigma_from_opacity(OPACITY, r))
+            particle(
+                rng.vec3(0.0, side),
+                r,
+                rng.vec3(0.0, 1.0),
+                sigma_from_opacity(OPACITY, r),
+            )
         })
         .collect();
     let mut s = scene(OpticalModel::Lit, particles, thesis_lights(), size);
     s.camera = default_camera(&s.particles, size, size);
     s.render.background = DVec3::ZERO;
     s.render.tol = 1e-8;
-    eprintln!("{PARTICLES} spheres in a {side:.1} Å cube, {size}×{size}, lit, 2 directional lights");
+    eprintln!(
+        "{PARTICLES} spheres in a {side:.1} Å cube, {size}×{size}, lit, 2 directional lights"
+    );
     let (truth, seconds) = run(&s, Integrator::Adaptive);
     let max_estimate = |v: &[Sample]| v.iter().map(|x| x.error.max_element()).fold(0.0, f64::max);
     let rays = |v: &[Sample]| v.iter().map(|x| x.shadow_rays).sum::<u64>();
@@ -64,9 +78,21 @@ fn benchmark_adaptive_against_riemann() {
     let cases: Vec<(String, Integrator, f64)> = vec![
         ("adaptive tol 1e-4".into(), Integrator::Adaptive, 1e-4),
         ("adaptive tol 1e-6".into(), Integrator::Adaptive, 1e-6),
-        ("riemann 10".into(), Integrator::Riemann { samples: 10 }, 0.0),
-        ("riemann 100".into(), Integrator::Riemann { samples: 100 }, 0.0),
-        ("riemann 1000".into(), Integrator::Riemann { samples: 1000 }, 0.0),
+        (
+            "riemann 10".into(),
+            Integrator::Riemann { samples: 10 },
+            0.0,
+        ),
+        (
+            "riemann 100".into(),
+            Integrator::Riemann { samples: 100 },
+            0.0,
+        ),
+        (
+            "riemann 1000".into(),
+            Integrator::Riemann { samples: 1000 },
+            0.0,
+        ),
     ];
     for (name, integrator, tol) in cases {
         if tol > 0.0 {

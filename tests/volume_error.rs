@@ -28,33 +28,61 @@ fn render_f64(scene: &Scene) -> Vec<Sample> {
 fn honest_at(model: OpticalModel, seed: u64) {
     let mut rng = Rng(seed);
     let mut s = scene(model, random_particles(&mut rng, 6), two_lights(), SIZE);
-    s.camera = pgt::geometry::Camera::new(DVec3::new(0.5, 0.8, -6.0), DVec3::ZERO, DVec3::Y, 45.0, SIZE, SIZE);
+    s.camera = pgt::geometry::Camera::new(
+        DVec3::new(0.5, 0.8, -6.0),
+        DVec3::ZERO,
+        DVec3::Y,
+        45.0,
+        SIZE,
+        SIZE,
+    );
     s.render.tol = 1e-10;
     let truth = render_f64(&s);
-    let covered = truth.iter().filter(|t| t.radiance != s.render.background).count();
-    assert!(covered > 150, "the particles should cover a good part of the image: {covered}");
+    let covered = truth
+        .iter()
+        .filter(|t| t.radiance != s.render.background)
+        .count();
+    assert!(
+        covered > 150,
+        "the particles should cover a good part of the image: {covered}"
+    );
     for tol in [1e-4, 1e-6] {
         s.render.tol = tol;
         let got = render_f64(&s);
         let mut violations = 0;
         let mut worst = 0.0f64;
         for (pix, (g, t)) in got.iter().zip(&truth).enumerate() {
-            assert!(g.error.max_element() <= tol * (1.0 + 1e-9), "estimate {:?} above tol {tol}", g.error);
+            assert!(
+                g.error.max_element() <= tol * (1.0 + 1e-9),
+                "estimate {:?} above tol {tol}",
+                g.error
+            );
             for c in 0..3 {
                 let actual = (g.radiance[c] - t.radiance[c]).abs();
                 worst = worst.max(actual / tol);
                 if actual > g.error[c] + t.error[c] {
-                    eprintln!("  pixel {pix} channel {c}: actual {actual:.3e} > estimate {:.3e}", g.error[c]);
+                    eprintln!(
+                        "  pixel {pix} channel {c}: actual {actual:.3e} > estimate {:.3e}",
+                        g.error[c]
+                    );
                     violations += 1;
                 }
             }
         }
-        let mean_estimate = got.iter().map(|g| g.error.element_sum()).sum::<f64>() / (3 * SIZE * SIZE) as f64;
+        let mean_estimate =
+            got.iter().map(|g| g.error.element_sum()).sum::<f64>() / (3 * SIZE * SIZE) as f64;
         eprintln!("{model:?} tol {tol}: {violations} violations, worst actual {worst:.3e}·tol, mean estimate {mean_estimate:.3e}");
         let allowed = (3 * SIZE * SIZE) as usize / 1000;
-        assert!(violations <= allowed, "{model:?} tol {tol}: {violations} of {} channels exceed their estimate", 3 * SIZE * SIZE);
+        assert!(
+            violations <= allowed,
+            "{model:?} tol {tol}: {violations} of {} channels exceed their estimate",
+            3 * SIZE * SIZE
+        );
         // And the estimate is not vacuous: the result is within tol of the truth everywhere.
-        assert!(worst <= 1.0, "{model:?} tol {tol}: worst actual error {worst}·tol");
+        assert!(
+            worst <= 1.0,
+            "{model:?} tol {tol}: worst actual error {worst}·tol"
+        );
     }
 }
 

@@ -17,7 +17,12 @@ use volume_support::*;
 fn one_sphere_emission_is_the_closed_form_along_every_ray() {
     let (c, r, sigma) = (DVec3::new(0.3, -0.2, 0.5), 1.3, 0.9);
     let color = DVec3::new(1.0, 0.4, 0.1);
-    let s = scene(OpticalModel::Emission, vec![particle(c, r, color, sigma)], vec![], 41);
+    let s = scene(
+        OpticalModel::Emission,
+        vec![particle(c, r, color, sigma)],
+        vec![],
+        41,
+    );
     let renderer = VolumeRenderer::new(&s, Integrator::Adaptive);
     let mut inside = 0;
     for py in 0..41 {
@@ -25,12 +30,19 @@ fn one_sphere_emission_is_the_closed_form_along_every_ray() {
             let ray = s.camera.pixel_ray(px, py);
             let f = c - ray.origin;
             let b = (f - f.dot(ray.direction) * ray.direction).length();
-            let chord = if b < r { 2.0 * ((r - b) * (r + b)).sqrt() } else { 0.0 };
+            let chord = if b < r {
+                2.0 * ((r - b) * (r + b)).sqrt()
+            } else {
+                0.0
+            };
             inside += (chord > 0.0) as u32;
             let t = (-sigma * chord).exp();
             let expected = s.render.background * t + color * (1.0 - t);
             let got = renderer.radiance(&ray);
-            assert!((got.radiance - expected).abs().max_element() < 1e-12, "{px},{py}: {got:?} vs {expected}");
+            assert!(
+                (got.radiance - expected).abs().max_element() < 1e-12,
+                "{px},{py}: {got:?} vs {expected}"
+            );
             assert_eq!(got.error, DVec3::ZERO);
         }
     }
@@ -45,14 +57,22 @@ fn through_the_centre_transmittance_is_one_minus_opacity() {
         let r = 0.7;
         let mut s = scene(
             OpticalModel::Emission,
-            vec![particle(DVec3::ZERO, r, DVec3::ZERO, sigma_from_opacity(opacity, r))],
+            vec![particle(
+                DVec3::ZERO,
+                r,
+                DVec3::ZERO,
+                sigma_from_opacity(opacity, r),
+            )],
             vec![],
             1,
         );
         s.render.background = DVec3::ONE;
         let ray = Ray::new(DVec3::new(0.0, 0.0, -8.0), DVec3::Z);
         let got = radiance(&s, Integrator::Adaptive, &ray).radiance;
-        assert!((got - DVec3::splat(1.0 - opacity)).abs().max_element() < 1e-14, "{opacity}: {got}");
+        assert!(
+            (got - DVec3::splat(1.0 - opacity)).abs().max_element() < 1e-14,
+            "{opacity}: {got}"
+        );
     }
 }
 
@@ -60,17 +80,38 @@ fn through_the_centre_transmittance_is_one_minus_opacity() {
 /// model and for both integrators.
 #[test]
 fn two_coincident_spheres_are_one_with_twice_sigma() {
-    let (c, r, sigma, color) = (DVec3::new(0.1, 0.2, 0.0), 1.0, 0.8, DVec3::new(0.2, 0.9, 0.5));
+    let (c, r, sigma, color) = (
+        DVec3::new(0.1, 0.2, 0.0),
+        1.0,
+        0.8,
+        DVec3::new(0.2, 0.9, 0.5),
+    );
     for model in MODELS {
-        let two = scene(model, vec![particle(c, r, color, sigma); 2], two_lights(), 9);
-        let one = scene(model, vec![particle(c, r, color, 2.0 * sigma)], two_lights(), 9);
+        let two = scene(
+            model,
+            vec![particle(c, r, color, sigma); 2],
+            two_lights(),
+            9,
+        );
+        let one = scene(
+            model,
+            vec![particle(c, r, color, 2.0 * sigma)],
+            two_lights(),
+            9,
+        );
         for integrator in [Integrator::Adaptive, Integrator::Riemann { samples: 7 }] {
-            let (a, b) = (VolumeRenderer::new(&two, integrator), VolumeRenderer::new(&one, integrator));
+            let (a, b) = (
+                VolumeRenderer::new(&two, integrator),
+                VolumeRenderer::new(&one, integrator),
+            );
             for py in 0..9 {
                 for px in 0..9 {
                     let ray = two.camera.pixel_ray(px, py);
                     let (x, y) = (a.radiance(&ray), b.radiance(&ray));
-                    assert!((x.radiance - y.radiance).abs().max_element() < 1e-14, "{model:?} {px},{py}");
+                    assert!(
+                        (x.radiance - y.radiance).abs().max_element() < 1e-14,
+                        "{model:?} {px},{py}"
+                    );
                 }
             }
         }
@@ -94,18 +135,30 @@ fn shuffling_the_particles_changes_no_pixel() {
         a.render.tol = 1e-6;
         let mut b = a.clone();
         b.particles = shuffled;
-        let (ra, rb) = (VolumeRenderer::new(&a, Integrator::Adaptive), VolumeRenderer::new(&b, Integrator::Adaptive));
+        let (ra, rb) = (
+            VolumeRenderer::new(&a, Integrator::Adaptive),
+            VolumeRenderer::new(&b, Integrator::Adaptive),
+        );
         let mut lit = 0;
         for py in 0..12 {
             for px in 0..12 {
                 let ray = a.camera.pixel_ray(px, py);
                 let (x, y) = (ra.radiance(&ray), rb.radiance(&ray));
-                assert_eq!(x.radiance.to_array().map(f64::to_bits), y.radiance.to_array().map(f64::to_bits));
-                assert_eq!(x.error.to_array().map(f64::to_bits), y.error.to_array().map(f64::to_bits));
+                assert_eq!(
+                    x.radiance.to_array().map(f64::to_bits),
+                    y.radiance.to_array().map(f64::to_bits)
+                );
+                assert_eq!(
+                    x.error.to_array().map(f64::to_bits),
+                    y.error.to_array().map(f64::to_bits)
+                );
                 lit += (x.radiance != a.render.background) as u32;
             }
         }
-        assert!(lit > 20, "{model:?}: the scene should cover part of the image");
+        assert!(
+            lit > 20,
+            "{model:?}: the scene should cover part of the image"
+        );
     }
 }
 
@@ -121,11 +174,19 @@ fn opaque_sphere_lit_model_is_the_sigma_to_infinity_limit() {
         direction: -toward,
         irradiance: e,
     };
-    let opaque = scene(OpticalModel::Lit, vec![particle(DVec3::ZERO, r, color, f64::INFINITY)], vec![light], 15);
+    let opaque = scene(
+        OpticalModel::Lit,
+        vec![particle(DVec3::ZERO, r, color, f64::INFINITY)],
+        vec![light],
+        15,
+    );
     let mut dense = opaque.clone();
     dense.particles[0].sigma = 1e7;
     dense.render.tol = 1e-9;
-    let (ro, rd) = (VolumeRenderer::new(&opaque, Integrator::Adaptive), VolumeRenderer::new(&dense, Integrator::Adaptive));
+    let (ro, rd) = (
+        VolumeRenderer::new(&opaque, Integrator::Adaptive),
+        VolumeRenderer::new(&dense, Integrator::Adaptive),
+    );
     let mut both_sides = [0, 0];
     for py in 0..15 {
         for px in 0..15 {
@@ -148,9 +209,15 @@ fn opaque_sphere_lit_model_is_the_sigma_to_infinity_limit() {
                 color
             };
             let got = ro.radiance(&ray).radiance;
-            assert!((got - expected).abs().max_element() < 1e-12, "{px},{py}: {got} vs {expected}");
+            assert!(
+                (got - expected).abs().max_element() < 1e-12,
+                "{px},{py}: {got} vs {expected}"
+            );
             let finite = rd.radiance(&ray).radiance;
-            assert!((finite - expected).abs().max_element() < 1e-4, "{px},{py}: σ = 1e7 gives {finite}, limit {expected}");
+            assert!(
+                (finite - expected).abs().max_element() < 1e-4,
+                "{px},{py}: σ = 1e7 gives {finite}, limit {expected}"
+            );
         }
     }
     assert!(both_sides[0] > 10 && both_sides[1] > 10, "{both_sides:?}");
@@ -224,7 +291,10 @@ fn extreme_input_never_gives_non_finite_output() {
             // The exact ray through the point light on the axis, with a sample point on it.
             let ray = Ray::new(DVec3::new(0.0, 0.0, -8.0), DVec3::Z);
             let r = VolumeRenderer::new(&s, integrator).radiance(&ray);
-            assert!(r.radiance.is_finite() && r.error.is_finite(), "{model:?}: {r:?}");
+            assert!(
+                r.radiance.is_finite() && r.error.is_finite(),
+                "{model:?}: {r:?}"
+            );
         }
     }
 }

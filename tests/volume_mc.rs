@@ -54,7 +54,13 @@ impl MonteCarlo<'_> {
     }
 
     /// Delta tracking: the first real collision on (0, t_max) with its medium, or `None`.
-    fn track(&self, o: DVec3, d: DVec3, t_max: f64, rng: &mut Rng) -> Option<(DVec3, f64, DVec3, DVec3)> {
+    fn track(
+        &self,
+        o: DVec3,
+        d: DVec3,
+        t_max: f64,
+        rng: &mut Rng,
+    ) -> Option<(DVec3, f64, DVec3, DVec3)> {
         let (bound, t_end) = self.majorant(o, d, t_max);
         if bound <= 0.0 {
             return None;
@@ -93,7 +99,8 @@ impl MonteCarlo<'_> {
     /// (each L_l itself estimated by tracking the shadow ray), or the background on escape.
     fn sample(&self, ray: &Ray, rng: &mut Rng) -> DVec3 {
         let render = &self.scene.render;
-        let Some((x, _, e, albedo)) = self.track(ray.origin, ray.direction, f64::INFINITY, rng) else {
+        let Some((x, _, e, albedo)) = self.track(ray.origin, ray.direction, f64::INFINITY, rng)
+        else {
             return render.background;
         };
         let m = self.scene.lights.len();
@@ -118,7 +125,8 @@ impl MonteCarlo<'_> {
                 let mut inscatter = DVec3::ZERO;
                 for light in &self.scene.lights {
                     let inc = light.incident_at(x).unwrap();
-                    inscatter += inc.irradiance * self.transmittance(x, inc.toward, inc.distance, rng);
+                    inscatter +=
+                        inc.irradiance * self.transmittance(x, inc.toward, inc.distance, rng);
                 }
                 render.emission_weight * e + albedo * inscatter / (4.0 * PI)
             }
@@ -129,7 +137,11 @@ impl MonteCarlo<'_> {
 fn mean_and_standard_error(samples: &[DVec3]) -> (DVec3, DVec3) {
     let n = samples.len() as f64;
     let mean = samples.iter().copied().sum::<DVec3>() / n;
-    let var = samples.iter().map(|s| (*s - mean) * (*s - mean)).sum::<DVec3>() / (n - 1.0);
+    let var = samples
+        .iter()
+        .map(|s| (*s - mean) * (*s - mean))
+        .sum::<DVec3>()
+        / (n - 1.0);
     (mean, (var / n).powf(0.5))
 }
 
@@ -169,7 +181,10 @@ fn agree_on_random_scenes(model: OpticalModel) {
         }
     }
     assert_eq!(compared, 15);
-    assert!(non_trivial >= 10, "too few rays met the particles: {non_trivial}");
+    assert!(
+        non_trivial >= 10,
+        "too few rays met the particles: {non_trivial}"
+    );
 }
 
 #[test]
@@ -199,5 +214,8 @@ fn monte_carlo_oracle_reproduces_the_one_sphere_closed_form() {
     let mut rng = Rng(3);
     let samples: Vec<DVec3> = (0..40_000).map(|_| mc.sample(&ray, &mut rng)).collect();
     let (mean, se) = mean_and_standard_error(&samples);
-    assert!(((mean - expected).abs() - 4.0 * se).max_element() <= 0.0, "{mean} ± {se} vs {expected}");
+    assert!(
+        ((mean - expected).abs() - 4.0 * se).max_element() <= 0.0,
+        "{mean} ± {se} vs {expected}"
+    );
 }

@@ -98,7 +98,12 @@ mod tests {
         let r = composite(&ivs, DVec3::splat(100.0));
         let t = (-0.5f64).exp();
         assert_eq!(r.transmittance, 0.0);
-        assert!((r.radiance - (DVec3::X * (1.0 - t) + DVec3::Y * t)).abs().max_element() < 1e-15);
+        assert!(
+            (r.radiance - (DVec3::X * (1.0 - t) + DVec3::Y * t))
+                .abs()
+                .max_element()
+                < 1e-15
+        );
         assert!(r.radiance.is_finite());
     }
 }

@@ -14,6 +14,10 @@
 //! with σ = +∞ is active the interval has σ = +∞; its colour and albedo are the plain mean over
 //! the infinite particles present (the limit of equal, growing σ), never ∞/∞.
 
+// `!(a > b)` is deliberate throughout: unlike `a <= b` it is also true when a value is NaN, so
+// degenerate input takes the safe branch.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use crate::geometry::Hit;
 use crate::scene::Particle;
 use glam::DVec3;
@@ -48,17 +52,8 @@ impl Interval {
 pub fn canonical_ranks(particles: &[Particle]) -> Vec<u32> {
     let key = |p: &Particle| {
         [
-            p.sigma,
-            p.radius,
-            p.center.x,
-            p.center.y,
-            p.center.z,
-            p.color.x,
-            p.color.y,
-            p.color.z,
-            p.albedo.x,
-            p.albedo.y,
-            p.albedo.z,
+            p.sigma, p.radius, p.center.x, p.center.y, p.center.z, p.color.x, p.color.y, p.color.z,
+            p.albedo.x, p.albedo.y, p.albedo.z,
         ]
     };
     let mut order: Vec<u32> = (0..particles.len() as u32).collect();
@@ -127,7 +122,15 @@ impl<'a> IntervalCutter<'a> {
         scratch: &mut IntervalScratch,
         out: &mut Vec<Interval>,
     ) {
-        cut_into_intervals(hits, (t_min, t_max), self.particles, &self.ranks, skip, scratch, out)
+        cut_into_intervals(
+            hits,
+            (t_min, t_max),
+            self.particles,
+            &self.ranks,
+            skip,
+            scratch,
+            out,
+        )
     }
 }
 

@@ -20,6 +20,10 @@
 //! polygon against the node boxes. The roots are only breakpoints for the quadrature: an
 //! inexact root costs refinement, never correctness.
 
+// `!(a > b)` is deliberate throughout: unlike `a <= b` it is also true when a value is NaN, so
+// degenerate input takes the safe branch.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use crate::geometry::{Bvh, Ray};
 use crate::scene::{Light, Particle};
 use glam::DVec3;
@@ -46,7 +50,8 @@ pub fn shadow_tangencies(
             let centre = 0.5 * (root.min + root.max);
             // Far enough along the light's direction to leave the root box from any point of
             // the segment.
-            let reach = (root.max - root.min).length() + (y0 - centre).length() + (y1 - centre).length();
+            let reach =
+                (root.max - root.min).length() + (y0 - centre).length() + (y1 - centre).length();
             poly = [y0, y1, y1 - direction * reach, y0 - direction * reach];
             4
         }
@@ -74,10 +79,17 @@ pub fn shadow_tangencies(
                 continue;
             }
             let roots = match *light {
-                Light::Directional { direction, .. } => cylinder_roots(ray, -direction, p.center, p.radius),
+                Light::Directional { direction, .. } => {
+                    cylinder_roots(ray, -direction, p.center, p.radius)
+                }
                 Light::Point { position, .. } => cone_roots(ray, position, p.center, p.radius),
             };
-            out.extend(roots.into_iter().flatten().filter(|&t| t > t_lo && t < t_hi));
+            out.extend(
+                roots
+                    .into_iter()
+                    .flatten()
+                    .filter(|&t| t > t_lo && t < t_hi),
+            );
         }
     }
     out.sort_unstable_by(f64::total_cmp);
@@ -143,7 +155,10 @@ fn solve_quadratic(a: f64, b: f64, c: f64) -> [Option<f64>; 2] {
     let q = -0.5 * (b + b.signum() * disc.sqrt());
     let t1 = q / a;
     let t2 = if q != 0.0 { c / q } else { t1 };
-    [Some(t1).filter(|t| t.is_finite()), Some(t2).filter(|t| t.is_finite())]
+    [
+        Some(t1).filter(|t| t.is_finite()),
+        Some(t2).filter(|t| t.is_finite()),
+    ]
 }
 
 /// Separating-axis test of a planar convex polygon against an axis-aligned box (the box faces,
@@ -213,7 +228,9 @@ mod tests {
         let f = x - p.center;
         let t_c = -f.dot(inc.toward);
         let dist = (f + t_c * inc.toward).length();
-        t_c > 0.0 && t_c <= inc.distance * (1.0 + 1e-9) && (dist - p.radius).abs() < 1e-9 * p.radius.max(1.0)
+        t_c > 0.0
+            && t_c <= inc.distance * (1.0 + 1e-9)
+            && (dist - p.radius).abs() < 1e-9 * p.radius.max(1.0)
     }
 
     #[test]
@@ -257,12 +274,17 @@ mod tests {
                 };
                 particles
                     .iter()
-                    .map(|p| intersect_sphere(&sray, p.center, p.radius).is_some_and(|c| c.t_exit > 0.0))
+                    .map(|p| {
+                        intersect_sphere(&sray, p.center, p.radius).is_some_and(|c| c.t_exit > 0.0)
+                    })
                     .collect()
             };
             let inside_at = |t: f64| -> Vec<bool> {
                 let x = ray.at(t);
-                particles.iter().map(|p| (x - p.center).length() < p.radius).collect()
+                particles
+                    .iter()
+                    .map(|p| (x - p.center).length() < p.radius)
+                    .collect()
             };
             let n = 4000;
             let mut changes = 0;
@@ -272,7 +294,10 @@ mod tests {
                 // interval boundary of the renderer, not a tangency.
                 if hits_at(a) != hits_at(b) && inside_at(a) == inside_at(b) {
                     changes += 1;
-                    assert!(kinks.iter().any(|&k| k >= a - 1e-9 && k <= b + 1e-9), "no kink in [{a}, {b}]");
+                    assert!(
+                        kinks.iter().any(|&k| k >= a - 1e-9 && k <= b + 1e-9),
+                        "no kink in [{a}, {b}]"
+                    );
                 }
             }
             assert!(changes > 0);

@@ -38,7 +38,12 @@ pub fn lit_source(w: f64, lights: &[LightSample]) -> DVec3 {
 
 /// DESIGN.md §2, single-scatter model: Q(x) = a·E(x) + α(x)·(1/4π)·Σ_l E_l(x)·T_l(x), with E the
 /// emission colour and α the σ-weighted albedo of the particles at x.
-pub fn single_scatter_source(a: f64, emission: DVec3, albedo: DVec3, lights: &[LightSample]) -> DVec3 {
+pub fn single_scatter_source(
+    a: f64,
+    emission: DVec3,
+    albedo: DVec3,
+    lights: &[LightSample],
+) -> DVec3 {
     let mut inscatter = DVec3::ZERO;
     for l in lights {
         inscatter += l.irradiance * l.transmittance;

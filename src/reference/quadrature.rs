@@ -25,11 +25,16 @@
 //! when no segment can be split any more in f64, it stops and reports the remaining summed
 //! estimate honestly (`converged = false`).
 
+// `!(a > b)` is deliberate throughout: unlike `a <= b` it is also true when a value is NaN, so
+// degenerate input takes the safe branch.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use glam::DVec3;
 use std::cmp::Ordering;
 use std::collections::BinaryHeap;
 
 /// Kronrod abscissae on [−1, 1] (the positive half, then 0) and weights (QUADPACK `qk15`).
+#[allow(clippy::excessive_precision)] // the digits as QUADPACK publishes them
 const XGK: [f64; 8] = [
     0.991_455_371_120_812_639_206_854_697_526_329,
     0.949_107_912_342_758_524_526_189_684_047_851,
@@ -40,6 +45,7 @@ const XGK: [f64; 8] = [
     0.207_784_955_007_898_467_600_689_403_773_245,
     0.0,
 ];
+#[allow(clippy::excessive_precision)] // the digits as QUADPACK publishes them
 const WGK: [f64; 8] = [
     0.022_935_322_010_529_224_963_732_008_058_970,
     0.063_092_092_629_978_553_290_700_663_189_204,
@@ -51,6 +57,7 @@ const WGK: [f64; 8] = [
     0.209_482_141_084_727_828_012_999_174_891_714,
 ];
 /// Gauss weights of the 7-point rule, for the Kronrod nodes XGK[1], XGK[3], XGK[5], XGK[7].
+#[allow(clippy::excessive_precision)] // the digits as QUADPACK publishes them
 const WG: [f64; 4] = [
     0.129_484_966_168_869_693_270_611_432_679_082,
     0.279_705_391_489_276_667_901_467_771_423_780,
@@ -204,27 +211,28 @@ pub fn integrate_adaptive(
     let mut segments: Vec<Segment> = Vec::with_capacity(pieces.len() * 2);
     let mut heap = BinaryHeap::new();
     let mut evaluations = 0;
-    let evaluate = |lo: f64, hi: f64, weight: f64, tag: usize, f: &mut dyn FnMut(usize, f64) -> DVec3| {
-        // A kink inside, or at an end (a segment split at a kink keeps a square-root endpoint
-        // singularity), makes the estimate less reliable: widen the test by a hair to see ends.
-        let hair = (hi - lo) * 1e-9;
-        let near_kink = kink_in(tag, lo - hair, hi + hair).is_some();
-        let r = if near_kink {
-            gauss_kronrod_15_smoothed(&mut |u| f(tag, u), lo, hi)
-        } else {
-            gauss_kronrod_15(&mut |u| f(tag, u), lo, hi)
+    let evaluate =
+        |lo: f64, hi: f64, weight: f64, tag: usize, f: &mut dyn FnMut(usize, f64) -> DVec3| {
+            // A kink inside, or at an end (a segment split at a kink keeps a square-root endpoint
+            // singularity), makes the estimate less reliable: widen the test by a hair to see ends.
+            let hair = (hi - lo) * 1e-9;
+            let near_kink = kink_in(tag, lo - hair, hi + hair).is_some();
+            let r = if near_kink {
+                gauss_kronrod_15_smoothed(&mut |u| f(tag, u), lo, hi)
+            } else {
+                gauss_kronrod_15(&mut |u| f(tag, u), lo, hi)
+            };
+            let safety = if near_kink { KINK_SAFETY } else { 1.0 };
+            Segment {
+                lo,
+                hi,
+                weight,
+                tag,
+                value: weight * r.value,
+                error: (weight * safety) * r.error,
+                alive: true,
+            }
         };
-        let safety = if near_kink { KINK_SAFETY } else { 1.0 };
-        Segment {
-            lo,
-            hi,
-            weight,
-            tag,
-            value: weight * r.value,
-            error: (weight * safety) * r.error,
-            alive: true,
-        }
-    };
     let mut total_error = DVec3::ZERO;
     for p in pieces {
         if !(p.hi > p.lo) || !(p.weight > 0.0) {
@@ -251,7 +259,9 @@ pub fn integrate_adaptive(
         if live >= max_segments {
             break;
         }
-        let Some(Priority(_, i)) = heap.pop() else { break };
+        let Some(Priority(_, i)) = heap.pop() else {
+            break;
+        };
         let s = segments[i];
         let mid = kink_in(s.tag, s.lo, s.hi).unwrap_or(0.5 * (s.lo + s.hi));
         if !(mid > s.lo && mid < s.hi) {
@@ -289,7 +299,11 @@ mod tests {
     fn k15_integrates_polynomials_of_degree_22_exactly() {
         let r = gauss_kronrod_15(&mut |x| DVec3::new(x.powi(22), x.powi(3), 1.0), -1.0, 2.0);
         let exact = DVec3::new((2f64.powi(23) + 1.0) / 23.0, (16.0 - 1.0) / 4.0, 3.0);
-        assert!(((r.value - exact) / exact).abs().max_element() < 1e-13, "{:?}", r.value);
+        assert!(
+            ((r.value - exact) / exact).abs().max_element() < 1e-13,
+            "{:?}",
+            r.value
+        );
     }
 
     #[test]
@@ -303,10 +317,20 @@ mod tests {
                 weight: 1.0,
                 tag: 0,
             }];
-            let r = integrate_adaptive(&pieces, tol, 10_000, |_, x| DVec3::splat((x - 0.7f64).abs().sqrt()), |_, _, _| None);
+            let r = integrate_adaptive(
+                &pieces,
+                tol,
+                10_000,
+                |_, x| DVec3::splat((x - 0.7f64).abs().sqrt()),
+                |_, _, _| None,
+            );
             assert!(r.converged);
             let actual = (r.value.x - exact).abs();
-            assert!(actual <= r.error.x, "tol {tol}: actual {actual} > estimate {}", r.error.x);
+            assert!(
+                actual <= r.error.x,
+                "tol {tol}: actual {actual} > estimate {}",
+                r.error.x
+            );
             assert!(r.error.x <= tol);
         }
     }

@@ -7,7 +7,13 @@ use glam::DVec3;
 /// ∫_{t0}^{t1} e^{−σ(t−t0)}·σ·Q(t) dt ≈ Σ_i e^{−σ(t_i−t0)}·σ·Q(t_i)·Δt with Δt = (t1 − t0)/N and
 /// t_i the midpoints (thesis eq. 4.16, with the λκ = σ factor of DESIGN.md §8). The
 /// transmittance inside the interval is exact; only Q is sampled.
-pub fn midpoint_sum(t0: f64, t1: f64, sigma: f64, samples: u32, mut q: impl FnMut(f64) -> DVec3) -> DVec3 {
+pub fn midpoint_sum(
+    t0: f64,
+    t1: f64,
+    sigma: f64,
+    samples: u32,
+    mut q: impl FnMut(f64) -> DVec3,
+) -> DVec3 {
     let n = samples.max(1);
     let dt = (t1 - t0) / n as f64;
     let mut sum = DVec3::ZERO;

@@ -54,7 +54,9 @@ use crate::geometry::{Bvh, Hit, Ray};
 use crate::optics::emission::{composite, opacity};
 use crate::optics::intervals::{Interval, IntervalCutter, IntervalScratch};
 use crate::optics::kinks::shadow_tangencies;
-use crate::optics::source::{light_weight, lit_source, single_scatter_source, surface_limit_weight, LightSample};
+use crate::optics::source::{
+    light_weight, lit_source, single_scatter_source, surface_limit_weight, LightSample,
+};
 use crate::scene::{OpticalModel, Scene};
 use glam::DVec3;
 
@@ -95,7 +97,13 @@ impl<'a> VolumeRenderer<'a> {
     /// The shadow ray from `x` towards light `l`: L_l(x) (emission model with the light's
     /// irradiance as background), E_l(x) and T_l(x). `None` where the light sends nothing
     /// usable: x exactly at a point light (or so close that I/d² overflows), a measure-zero set.
-    fn light_sample(&self, x: DVec3, l: usize, skip: impl Fn(u32) -> bool, sh: &mut ShadowScratch) -> Option<LightSample> {
+    fn light_sample(
+        &self,
+        x: DVec3,
+        l: usize,
+        skip: impl Fn(u32) -> bool,
+        sh: &mut ShadowScratch,
+    ) -> Option<LightSample> {
         let inc = self.scene.lights[l].incident_at(x)?;
         if !inc.irradiance.is_finite() {
             return None;
@@ -106,8 +114,14 @@ impl<'a> VolumeRenderer<'a> {
         };
         sh.rays += 1;
         self.bvh.all_hits(&ray, 0.0, inc.distance, &mut sh.hits);
-        self.cutter
-            .cut(&sh.hits, 0.0, inc.distance, skip, &mut sh.cut, &mut sh.intervals);
+        self.cutter.cut(
+            &sh.hits,
+            0.0,
+            inc.distance,
+            skip,
+            &mut sh.cut,
+            &mut sh.intervals,
+        );
         let c = composite(&sh.intervals, inc.irradiance);
         Some(LightSample {
             radiance: c.radiance,
@@ -129,15 +143,24 @@ impl<'a> VolumeRenderer<'a> {
 
     fn combine(&self, iv: &Interval, lights: &[LightSample]) -> DVec3 {
         match self.scene.render.model {
-            OpticalModel::SingleScatter => {
-                single_scatter_source(self.scene.render.emission_weight, iv.emission, iv.albedo, lights)
-            }
+            OpticalModel::SingleScatter => single_scatter_source(
+                self.scene.render.emission_weight,
+                iv.emission,
+                iv.albedo,
+                lights,
+            ),
             _ => lit_source(self.light_weight, lights),
         }
     }
 
     /// Q∞, the σ → ∞ limit of the source of a Θmax = 1 interval (module documentation).
-    fn opaque_source(&self, ray: &Ray, iv: &Interval, hits: &[Hit], sh: &mut ShadowScratch) -> DVec3 {
+    fn opaque_source(
+        &self,
+        ray: &Ray,
+        iv: &Interval,
+        hits: &[Hit],
+        sh: &mut ShadowScratch,
+    ) -> DVec3 {
         if self.scene.render.model == OpticalModel::Emission {
             return iv.emission;
         }
@@ -146,11 +169,15 @@ impl<'a> VolumeRenderer<'a> {
         // The Θmax = 1 particles active just after t0 (all start at t0: it is the first such
         // interval); whether the ray entered each through its surface there, and its normal.
         let is_opaque_here = |h: &Hit| {
-            particles[h.index as usize].sigma == f64::INFINITY && h.chord.t_enter.max(0.0) <= iv.t0 && h.chord.t_exit > iv.t0
+            particles[h.index as usize].sigma == f64::INFINITY
+                && h.chord.t_enter.max(0.0) <= iv.t0
+                && h.chord.t_exit > iv.t0
         };
         let mut lights = Vec::with_capacity(self.scene.lights.len());
         for (l, light) in self.scene.lights.iter().enumerate() {
-            let Some(inc) = light.incident_at(x) else { continue };
+            let Some(inc) = light.incident_at(x) else {
+                continue;
+            };
             if !inc.irradiance.is_finite() {
                 continue;
             }
@@ -175,7 +202,9 @@ impl<'a> VolumeRenderer<'a> {
             let keep = surface_limit_weight(c);
             let sample = if keep > 0.0 {
                 let skip = |i: u32| hits.iter().any(|h| h.index == i && is_opaque_here(h));
-                let Some(rest) = self.light_sample(x, l, skip, sh) else { continue };
+                let Some(rest) = self.light_sample(x, l, skip, sh) else {
+                    continue;
+                };
                 LightSample {
                     radiance: rest.radiance * keep + iv.emission * (1.0 - keep),
                     irradiance: rest.irradiance,
@@ -201,8 +230,14 @@ impl RadianceEstimator for VolumeRenderer<'_> {
         self.bvh.all_hits(ray, 0.0, f64::INFINITY, &mut hits);
         let mut intervals = Vec::new();
         let mut cut_scratch = IntervalScratch::default();
-        self.cutter
-            .cut(&hits, 0.0, f64::INFINITY, |_| false, &mut cut_scratch, &mut intervals);
+        self.cutter.cut(
+            &hits,
+            0.0,
+            f64::INFINITY,
+            |_| false,
+            &mut cut_scratch,
+            &mut intervals,
+        );
         if render.model == OpticalModel::Emission {
             return Sample {
                 radiance: composite(&intervals, render.background).radiance,
@@ -234,9 +269,18 @@ impl RadianceEstimator for VolumeRenderer<'_> {
         }
         let mut kinks = Vec::new();
         if self.integrator == Integrator::Adaptive && finite > 0 {
-            if let (Some(first), Some(last)) = (intervals.first(), intervals.get(finite.saturating_sub(1))) {
+            if let (Some(first), Some(last)) =
+                (intervals.first(), intervals.get(finite.saturating_sub(1)))
+            {
                 for light in &self.scene.lights {
-                    shadow_tangencies(ray, (first.t0, last.t1), light, &self.bvh, &self.scene.particles, &mut kinks);
+                    shadow_tangencies(
+                        ray,
+                        (first.t0, last.t1),
+                        light,
+                        &self.bvh,
+                        &self.scene.particles,
+                        &mut kinks,
+                    );
                 }
             }
         }
@@ -271,7 +315,10 @@ impl RadianceEstimator for VolumeRenderer<'_> {
                 let mut sum = DVec3::ZERO;
                 for p in &pieces {
                     let iv = &intervals[p.tag];
-                    sum += p.weight * midpoint_sum(iv.t0, iv.t1, iv.sigma, samples, |t| self.source(ray.at(t), iv, &mut sh));
+                    sum += p.weight
+                        * midpoint_sum(iv.t0, iv.t1, iv.sigma, samples, |t| {
+                            self.source(ray.at(t), iv, &mut sh)
+                        });
                 }
                 (sum, DVec3::ZERO)
             }

@@ -5,7 +5,9 @@ use glam::DVec3;
 use pgt::geometry::{Camera, Ray};
 use pgt::reference::volume::VolumeRenderer;
 use pgt::reference::{Integrator, RadianceEstimator, Sample};
-use pgt::scene::{Falloff, Light, LightWeight, OpticalModel, Particle, RenderMode, RenderSettings, Scene};
+use pgt::scene::{
+    Falloff, Light, LightWeight, OpticalModel, Particle, RenderMode, RenderSettings, Scene,
+};
 
 /// A small deterministic generator (SplitMix64), so the tests need no RNG crate.
 pub struct Rng(pub u64);
@@ -51,10 +53,22 @@ pub fn particle(center: DVec3, radius: f64, color: DVec3, sigma: f64) -> Particl
     }
 }
 
-pub fn scene(model: OpticalModel, particles: Vec<Particle>, lights: Vec<Light>, size: u32) -> Scene {
+pub fn scene(
+    model: OpticalModel,
+    particles: Vec<Particle>,
+    lights: Vec<Light>,
+    size: u32,
+) -> Scene {
     Scene {
         source: "test".into(),
-        camera: Camera::new(DVec3::new(0.0, 0.0, -8.0), DVec3::ZERO, DVec3::Y, 30.0, size, size),
+        camera: Camera::new(
+            DVec3::new(0.0, 0.0, -8.0),
+            DVec3::ZERO,
+            DVec3::Y,
+            30.0,
+            size,
+            size,
+        ),
         render: RenderSettings {
             mode: RenderMode::Volume,
             model,
@@ -89,7 +103,12 @@ pub fn two_lights() -> Vec<Light> {
 pub fn random_particles(rng: &mut Rng, n: usize) -> Vec<Particle> {
     (0..n)
         .map(|_| {
-            let mut p = particle(rng.vec3(-1.2, 1.2), rng.range(0.4, 1.1), rng.vec3(0.0, 1.0), rng.range(0.2, 3.0));
+            let mut p = particle(
+                rng.vec3(-1.2, 1.2),
+                rng.range(0.4, 1.1),
+                rng.vec3(0.0, 1.0),
+                rng.range(0.2, 3.0),
+            );
             p.albedo = rng.vec3(0.0, 1.0);
             p
         })
@@ -100,4 +119,8 @@ pub fn radiance(scene: &Scene, integrator: Integrator, ray: &Ray) -> Sample {
     VolumeRenderer::new(scene, integrator).radiance(ray)
 }
 
-pub const MODELS: [OpticalModel; 3] = [OpticalModel::Emission, OpticalModel::Lit, OpticalModel::SingleScatter];
+pub const MODELS: [OpticalModel; 3] = [
+    OpticalModel::Emission,
+    OpticalModel::Lit,
+    OpticalModel::SingleScatter,
+];
