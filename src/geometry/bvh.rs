@@ -339,6 +339,7 @@ fn slab_test(o: DVec3, inv: DVec3, min: DVec3, max: DVec3, t_min: f64, t_max: f6
 
 /// Binned SAH over centroids: the (axis, position) with the lowest cost, or `None` when no split
 /// beats a leaf.
+#[allow(clippy::needless_range_loop, clippy::neg_cmp_op_on_partial_ord)] // axis indexes several arrays; !(hi > lo) is NaN-safe
 fn choose_split(indices: &[u32], boxes: &[Aabb], centers: &[DVec3], bounds: &Aabb, cbounds: &Aabb) -> Option<(usize, f64)> {
     let mut best: Option<(f64, usize, f64)> = None;
     for axis in 0..3 {

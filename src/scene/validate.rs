@@ -329,7 +329,7 @@ fn record_particle(path: &Path, rec: &ParticleRecord, d: &ResolvedDefaults, lamb
         path,
         location: rec.location.clone(),
     };
-    let center = DVec3::from(at.vec3("particle position", rec.center.to_array())?);
+    let center = at.vec3("particle position", rec.center.to_array())?;
     let radius = at.finite("particle radius", rec.radius)?;
     if radius <= 0.0 {
         return Err(at.err(format!("particle radius must be > 0, got {radius}")));
