@@ -223,6 +223,44 @@ fn opaque_sphere_lit_model_is_the_sigma_to_infinity_limit() {
     assert!(both_sides[0] > 10 && both_sides[1] > 10, "{both_sides:?}");
 }
 
+/// An eye inside a particle starts in it (t_min = 0 clipping): looking out from the centre the
+/// chord is the radius, L = L_bg·e^{−σr} + C·(1 − e^{−σr}); a particle wholly behind the eye
+/// changes nothing (emission model: it is on no camera ray).
+#[test]
+fn eye_inside_a_particle_and_particles_behind_the_eye() {
+    let (r, sigma, color) = (2.0, 0.6, DVec3::new(0.3, 0.9, 0.2));
+    let mut s = scene(
+        OpticalModel::Emission,
+        vec![particle(DVec3::ZERO, r, color, sigma)],
+        vec![],
+        5,
+    );
+    s.camera = pgt::geometry::Camera::new(DVec3::ZERO, DVec3::Z, DVec3::Y, 60.0, 5, 5);
+    let renderer = VolumeRenderer::new(&s, Integrator::Adaptive);
+    let t = (-sigma * r).exp();
+    let expected = s.render.background * t + color * (1.0 - t);
+    for py in 0..5 {
+        for px in 0..5 {
+            let got = renderer.radiance(&s.camera.pixel_ray(px, py)).radiance;
+            assert!(
+                (got - expected).abs().max_element() < 1e-14,
+                "{got} vs {expected}"
+            );
+        }
+    }
+    let mut behind = s.clone();
+    behind
+        .particles
+        .push(particle(DVec3::new(0.0, 0.0, -5.0), 1.0, DVec3::ONE, 3.0));
+    let other = VolumeRenderer::new(&behind, Integrator::Adaptive);
+    for py in 0..5 {
+        for px in 0..5 {
+            let ray = s.camera.pixel_ray(px, py);
+            assert_eq!(renderer.radiance(&ray), other.radiance(&ray));
+        }
+    }
+}
+
 /// An empty scene renders the background in every model, through the public `render`.
 #[test]
 fn empty_scene_renders_the_background() {

@@ -158,6 +158,15 @@ fn agree_on_random_scenes(model: OpticalModel) {
             s.render.light_weight = LightWeight::Sum;
             s.render.emission_weight = 0.0;
         }
+        if scene_seed == 2 {
+            // A point light inside a particle: its shadow rays start and end in gas.
+            let inside = s.particles[0].center + DVec3::new(0.1, 0.05, 0.0) * s.particles[0].radius;
+            s.lights[1] = pgt::scene::Light::Point {
+                position: inside,
+                intensity: DVec3::new(0.5, 0.3, 0.8),
+                falloff: pgt::scene::Falloff::InverseSquare,
+            };
+        }
         let mc = MonteCarlo { scene: &s };
         for _ in 0..5 {
             let target = rng.vec3(-0.8, 0.8);
