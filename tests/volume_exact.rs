@@ -261,6 +261,41 @@ fn eye_inside_a_particle_and_particles_behind_the_eye() {
     }
 }
 
+/// The thesis's midpoint sums converge to the adaptive reference as the sample count grows
+/// (lit and single-scatter, overlapping particles, both light kinds).
+#[test]
+fn riemann_sums_converge_to_the_adaptive_reference() {
+    let mut rng = Rng(5);
+    for model in [OpticalModel::Lit, OpticalModel::SingleScatter] {
+        let mut s = scene(model, random_particles(&mut rng, 6), two_lights(), 8);
+        s.render.tol = 1e-10;
+        let reference = VolumeRenderer::new(&s, Integrator::Adaptive);
+        let errors: Vec<f64> = [4, 40, 400]
+            .iter()
+            .map(|&samples| {
+                let r = VolumeRenderer::new(&s, Integrator::Riemann { samples });
+                let mut worst = 0.0f64;
+                for py in 0..8 {
+                    for px in 0..8 {
+                        let ray = s.camera.pixel_ray(px, py);
+                        let d = r.radiance(&ray).radiance - reference.radiance(&ray).radiance;
+                        worst = worst.max(d.abs().max_element());
+                    }
+                }
+                worst
+            })
+            .collect();
+        assert!(
+            errors[0] > errors[1] && errors[1] > errors[2],
+            "{model:?}: {errors:?}"
+        );
+        assert!(
+            errors[2] < 1e-4 && errors[0] > 1e-4,
+            "{model:?}: {errors:?}"
+        );
+    }
+}
+
 /// An empty scene renders the background in every model, through the public `render`.
 #[test]
 fn empty_scene_renders_the_background() {

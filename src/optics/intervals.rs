@@ -97,6 +97,8 @@ pub struct IntervalCutter<'a> {
 }
 
 impl<'a> IntervalCutter<'a> {
+    /// Ranks the particles once (O(n log n)); cutting a ray is then O(k log k) in the k spheres
+    /// it crosses.
     pub fn new(particles: &'a [Particle]) -> Self {
         IntervalCutter {
             particles,

@@ -84,6 +84,8 @@ struct ShadowScratch {
 }
 
 impl<'a> VolumeRenderer<'a> {
+    /// Builds the BVH and the canonical particle order for `scene`; `integrator` chooses how the
+    /// lit and single-scatter integrals are done (the emission model is always closed-form).
     pub fn new(scene: &'a Scene, integrator: Integrator) -> Self {
         VolumeRenderer {
             scene,
