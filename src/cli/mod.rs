@@ -15,7 +15,11 @@ pub enum Outcome {
 }
 
 #[derive(Debug, Parser)]
-#[command(name = "pgt", version, about = "Particle ground truth: exact renderings of sphere particle scenes, GPU approximations, and their difference")]
+#[command(
+    name = "pgt",
+    version,
+    about = "Particle ground truth: exact renderings of sphere particle scenes, GPU approximations, and their difference"
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,

@@ -100,7 +100,9 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
         }
         RenderMode::Volume => {
             if let Integrator::Riemann { samples: 0 } = options.integrator {
-                return Err(PgtError::Usage("Riemann sums need at least 1 sample per interval".into()));
+                return Err(PgtError::Usage(
+                    "Riemann sums need at least 1 sample per interval".into(),
+                ));
             }
             let renderer = volume::VolumeRenderer::new(scene, options.integrator);
             render_with(&scene.camera, &renderer, options)
@@ -112,17 +114,25 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
 const TILE: u32 = 16;
 
 /// Runs `estimator` over every pixel of `camera`'s image.
-pub fn render_with(camera: &Camera, estimator: &dyn RadianceEstimator, options: &RenderOptions) -> Result<RenderOutput> {
+pub fn render_with(
+    camera: &Camera,
+    estimator: &dyn RadianceEstimator,
+    options: &RenderOptions,
+) -> Result<RenderOutput> {
     let start = Instant::now();
     let (w, h) = (camera.width, camera.height);
     let tiles_x = w.div_ceil(TILE);
     let tiles_y = h.div_ceil(TILE);
-    let tiles: Vec<(u32, u32)> = (0..tiles_y).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).collect();
+    let tiles: Vec<(u32, u32)> = (0..tiles_y)
+        .flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty)))
+        .collect();
     let bar = if options.progress {
         let bar = indicatif::ProgressBar::new(tiles.len() as u64);
         bar.set_style(
-            indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent}% eta {eta}")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            indicatif::ProgressStyle::with_template(
+                "{elapsed_precise} [{bar:40}] {percent}% eta {eta}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
         Some(bar)
     } else {

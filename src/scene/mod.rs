@@ -15,7 +15,9 @@ use glam::DVec3;
 use std::path::{Path, PathBuf};
 
 /// `mode` (DESIGN.md §1): opaque spheres or spheres of gas.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum RenderMode {
     Opaque,
@@ -23,7 +25,9 @@ pub enum RenderMode {
 }
 
 /// `model` (DESIGN.md §2): the source term Q of the volume renderer.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum OpticalModel {
     Emission,
@@ -79,7 +83,10 @@ impl Light {
     #[inline]
     pub fn incident_at(&self, x: DVec3) -> Option<Incident> {
         match *self {
-            Light::Directional { direction, irradiance } => Some(Incident {
+            Light::Directional {
+                direction,
+                irradiance,
+            } => Some(Incident {
                 toward: -direction,
                 distance: f64::INFINITY,
                 irradiance,

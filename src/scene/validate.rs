@@ -1,7 +1,9 @@
 //! Scene validation: the raw TOML tables become a [`Scene`], or an error that names the file,
 //! the line and the field (DESIGN.md §6 "Bad input").
 
-use super::file::{CameraTable, LightTable, ParticleDefaults, ParticleTable, RenderTable, SceneFile};
+use super::file::{
+    CameraTable, LightTable, ParticleDefaults, ParticleTable, RenderTable, SceneFile,
+};
 use super::framing::{default_camera, thesis_lights, DEFAULT_FOV_Y, DEFAULT_SIZE};
 use super::{
     Falloff, IncludeSpec, Light, Particle, ParticleRecord, RenderSettings, Scene, SceneLoadOptions,
@@ -86,7 +88,11 @@ fn toml_error(path: &Path, text: &str, e: toml::de::Error) -> PgtError {
     PgtError::at_line(path, line, e.message().trim().to_string())
 }
 
-pub(super) fn scene_from_toml(text: &str, path: &Path, options: &SceneLoadOptions) -> Result<Scene> {
+pub(super) fn scene_from_toml(
+    text: &str,
+    path: &Path,
+    options: &SceneLoadOptions,
+) -> Result<Scene> {
     let file: SceneFile = toml::from_str(text).map_err(|e| toml_error(path, text, e))?;
     let at = |span: std::ops::Range<usize>| At {
         path,
@@ -119,19 +125,36 @@ pub(super) fn scene_from_toml(text: &str, path: &Path, options: &SceneLoadOption
 
     let mut particles = Vec::with_capacity(file.particles.len());
     for (i, p) in file.particles.iter().enumerate() {
-        particles.push(inline_particle(&at(p.span()), i, p.get_ref(), &resolved_defaults, render.lambda)?);
+        particles.push(inline_particle(
+            &at(p.span()),
+            i,
+            p.get_ref(),
+            &resolved_defaults,
+            render.lambda,
+        )?);
     }
     let mut warnings = Vec::new();
     let base = path.parent().unwrap_or(Path::new("."));
     for inc in &file.include {
         let spec_at = at(inc.span());
         let mut spec = inc.get_ref().clone();
-        spec_at.in_range("include.radius_scale", spec.radius_scale, f64::MIN_POSITIVE, f64::MAX, "> 0")?;
+        spec_at.in_range(
+            "include.radius_scale",
+            spec.radius_scale,
+            f64::MIN_POSITIVE,
+            f64::MAX,
+            "> 0",
+        )?;
         spec.path = base.join(&spec.path);
         let loaded = crate::formats::load_particles(&spec)?;
         warnings.extend(loaded.warnings);
         for rec in &loaded.records {
-            particles.push(record_particle(&spec.path, rec, &resolved_defaults, render.lambda)?);
+            particles.push(record_particle(
+                &spec.path,
+                rec,
+                &resolved_defaults,
+                render.lambda,
+            )?);
         }
     }
 
@@ -144,7 +167,10 @@ pub(super) fn scene_from_toml(text: &str, path: &Path, options: &SceneLoadOption
 
     let camera = camera(&file.camera, &at, &whole, options, &particles)?;
     if particles.is_empty() {
-        warnings.push(format!("{}: the scene has no particles; it renders the background", path.display()));
+        warnings.push(format!(
+            "{}: the scene has no particles; it renders the background",
+            path.display()
+        ));
     }
     Ok(Scene {
         source: path.to_path_buf(),
@@ -172,7 +198,10 @@ pub(super) fn bare_particle_file(path: &Path, options: &SceneLoadOptions) -> Res
         .collect::<Result<Vec<_>>>()?;
     let mut warnings = loaded.warnings;
     if particles.is_empty() {
-        warnings.push(format!("{}: the file has no particles; it renders the background", path.display()));
+        warnings.push(format!(
+            "{}: the file has no particles; it renders the background",
+            path.display()
+        ));
     }
     let (w, h) = options.size.unwrap_or(DEFAULT_SIZE);
     check_size(&whole, w as i64, h as i64)?;
@@ -191,7 +220,9 @@ fn render_settings(at: &At, t: &RenderTable) -> Result<RenderSettings> {
     Ok(RenderSettings {
         mode: t.mode.unwrap_or(d.mode),
         model: t.model.unwrap_or(d.model),
-        background: t.background.map_or(Ok(d.background), |v| at.non_negative3("render.background", v))?,
+        background: t.background.map_or(Ok(d.background), |v| {
+            at.non_negative3("render.background", v)
+        })?,
         lambda: t.lambda.map_or(Ok(d.lambda), |v| {
             let v = at.finite("render.lambda", v)?;
             if v > 0.0 && v <= 1.0 {
@@ -220,7 +251,11 @@ fn check_tol(at: &At, v: f64) -> Result<f64> {
     }
 }
 
-fn apply_overrides(mut r: RenderSettings, o: &SceneLoadOptions, whole: &At) -> Result<RenderSettings> {
+fn apply_overrides(
+    mut r: RenderSettings,
+    o: &SceneLoadOptions,
+    whole: &At,
+) -> Result<RenderSettings> {
     if let Some(m) = o.mode {
         r.mode = m;
     }
@@ -229,7 +264,9 @@ fn apply_overrides(mut r: RenderSettings, o: &SceneLoadOptions, whole: &At) -> R
     }
     if let Some(t) = o.tol {
         if !(t.is_finite() && t > 0.0) {
-            return Err(PgtError::Usage(format!("--tol must be a finite number > 0, got {t}")));
+            return Err(PgtError::Usage(format!(
+                "--tol must be a finite number > 0, got {t}"
+            )));
         }
         r.tol = t;
     }
@@ -258,7 +295,9 @@ impl ResolvedDefaults {
             return Err(at.err("defaults: set opacity or kappa, not both"));
         }
         Ok(ResolvedDefaults {
-            color: d.color.map_or(Ok(DVec3::ONE), |c| at.non_negative3("defaults.color", c))?,
+            color: d
+                .color
+                .map_or(Ok(DVec3::ONE), |c| at.non_negative3("defaults.color", c))?,
             opacity: d
                 .opacity
                 .map(|o| at.in_range("defaults.opacity", o, 0.0, 1.0, "in [0, 1]"))
@@ -267,8 +306,13 @@ impl ResolvedDefaults {
                 .kappa
                 .map(|k| at.in_range("defaults.kappa", k, 0.0, f64::MAX, "≥ 0"))
                 .transpose()?,
-            albedo: d.albedo.map(|a| at.non_negative3("defaults.albedo", a)).transpose()?,
-            ks: d.ks.map_or(Ok(0.0), |v| at.in_range("defaults.ks", v, 0.0, f64::MAX, "≥ 0"))?,
+            albedo: d
+                .albedo
+                .map(|a| at.non_negative3("defaults.albedo", a))
+                .transpose()?,
+            ks: d.ks.map_or(Ok(0.0), |v| {
+                at.in_range("defaults.ks", v, 0.0, f64::MAX, "≥ 0")
+            })?,
             shininess: d.shininess.map_or(Ok(DEFAULT_SHININESS), |v| {
                 at.in_range("defaults.shininess", v, 0.0, f64::MAX, "≥ 0")
             })?,
@@ -289,7 +333,13 @@ impl ResolvedDefaults {
     }
 }
 
-fn inline_particle(at: &At, i: usize, p: &ParticleTable, d: &ResolvedDefaults, lambda: f64) -> Result<Particle> {
+fn inline_particle(
+    at: &At,
+    i: usize,
+    p: &ParticleTable,
+    d: &ResolvedDefaults,
+    lambda: f64,
+) -> Result<Particle> {
     let name = |f: &str| format!("particles[{i}].{f}");
     let center = at.vec3(&name("center"), p.center)?;
     let radius = at.finite(&name("radius"), p.radius)?;
@@ -307,24 +357,33 @@ fn inline_particle(at: &At, i: usize, p: &ParticleTable, d: &ResolvedDefaults, l
         .kappa
         .map(|k| at.in_range(&name("kappa"), k, 0.0, f64::MAX, "≥ 0"))
         .transpose()?;
-    let color = p.color.map_or(Ok(d.color), |c| at.non_negative3(&name("color"), c))?;
+    let color = p
+        .color
+        .map_or(Ok(d.color), |c| at.non_negative3(&name("color"), c))?;
     Ok(Particle {
         center,
         radius,
         color,
         sigma: d.sigma(opacity, kappa, radius, lambda),
-        albedo: p
-            .albedo
-            .map_or(Ok(d.albedo.unwrap_or(color)), |a| at.non_negative3(&name("albedo"), a))?,
-        ks: p.ks.map_or(Ok(d.ks), |v| at.in_range(&name("ks"), v, 0.0, f64::MAX, "≥ 0"))?,
-        shininess: p
-            .shininess
-            .map_or(Ok(d.shininess), |v| at.in_range(&name("shininess"), v, 0.0, f64::MAX, "≥ 0"))?,
+        albedo: p.albedo.map_or(Ok(d.albedo.unwrap_or(color)), |a| {
+            at.non_negative3(&name("albedo"), a)
+        })?,
+        ks: p.ks.map_or(Ok(d.ks), |v| {
+            at.in_range(&name("ks"), v, 0.0, f64::MAX, "≥ 0")
+        })?,
+        shininess: p.shininess.map_or(Ok(d.shininess), |v| {
+            at.in_range(&name("shininess"), v, 0.0, f64::MAX, "≥ 0")
+        })?,
     })
 }
 
 /// A particle from a file format, checked with the location the format recorded.
-fn record_particle(path: &Path, rec: &ParticleRecord, d: &ResolvedDefaults, lambda: f64) -> Result<Particle> {
+fn record_particle(
+    path: &Path,
+    rec: &ParticleRecord,
+    d: &ResolvedDefaults,
+    lambda: f64,
+) -> Result<Particle> {
     let at = At {
         path,
         location: rec.location.clone(),
@@ -334,9 +393,9 @@ fn record_particle(path: &Path, rec: &ParticleRecord, d: &ResolvedDefaults, lamb
     if radius <= 0.0 {
         return Err(at.err(format!("particle radius must be > 0, got {radius}")));
     }
-    let color = rec
-        .color
-        .map_or(Ok(d.color), |c| at.non_negative3("particle colour", c.to_array()))?;
+    let color = rec.color.map_or(Ok(d.color), |c| {
+        at.non_negative3("particle colour", c.to_array())
+    })?;
     let opacity = rec
         .opacity
         .map(|o| at.in_range("particle opacity", o, 0.0, 1.0, "in [0, 1]"))
@@ -417,12 +476,18 @@ fn camera<'a>(
         (None, None) => DEFAULT_FOV_Y,
     };
     let (position, look_at) = match (t.position, t.look_at) {
-        (Some(p), Some(l)) => (at.vec3("camera.position", p)?, at.vec3("camera.look_at", l)?),
+        (Some(p), Some(l)) => (
+            at.vec3("camera.position", p)?,
+            at.vec3("camera.look_at", l)?,
+        ),
         (None, None) => {
             let framed = default_camera(particles, w, h);
             (framed.position, framed.position + framed.forward)
         }
-        _ => return Err(at.err("camera: set both position and look_at, or neither (to frame the particles)")),
+        _ => {
+            return Err(at
+                .err("camera: set both position and look_at, or neither (to frame the particles)"))
+        }
     };
     let up = at.direction("camera.up", t.up.unwrap_or([0.0, 1.0, 0.0]))?;
     let forward = look_at - position;
@@ -518,8 +583,12 @@ opacity = 0.8
         assert!(e.starts_with("s.toml:2:") && e.contains("modle"), "{e}");
         let e = err_text("[render]\nmodel = \"glow\"\n");
         assert!(e.starts_with("s.toml:2:") && e.contains("glow"), "{e}");
-        let e = err_text("[[lights]]\ntype=\"directional\"\ndirection=[0,0,0]\nirradiance=[1,1,1]\n");
-        assert!(e.contains("lights[0].direction must be a non-zero vector"), "{e}");
+        let e =
+            err_text("[[lights]]\ntype=\"directional\"\ndirection=[0,0,0]\nirradiance=[1,1,1]\n");
+        assert!(
+            e.contains("lights[0].direction must be a non-zero vector"),
+            "{e}"
+        );
         let e = err_text("[camera]\nwidth = 0\n");
         assert!(e.contains("image size"), "{e}");
         let e = err_text("[[particles]]\ncenter=[0,0,0]\nradius=1.0\nopacity=1.5\n");
@@ -543,7 +612,8 @@ opacity = 0.8
             model: None,
             tol: Some(1e-3),
         };
-        let s = Scene::from_toml_str("[camera]\nwidth=100\nheight=100\n", Path::new("s.toml"), &o).unwrap();
+        let s = Scene::from_toml_str("[camera]\nwidth=100\nheight=100\n", Path::new("s.toml"), &o)
+            .unwrap();
         assert_eq!((s.camera.width, s.camera.height), (7, 3));
         assert_eq!(s.render.mode, super::super::RenderMode::Opaque);
         assert_eq!(s.render.tol, 1e-3);
