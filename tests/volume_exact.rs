@@ -296,6 +296,29 @@ fn riemann_sums_converge_to_the_adaptive_reference() {
     }
 }
 
+/// DESIGN.md §3: the image (and its error layer) is bit-identical for any thread count.
+#[test]
+fn image_is_identical_for_any_thread_count() {
+    let mut rng = Rng(9);
+    let mut s = scene(
+        OpticalModel::Lit,
+        random_particles(&mut rng, 8),
+        two_lights(),
+        20,
+    );
+    s.render.tol = 1e-5;
+    let with = |threads| {
+        let opts = RenderOptions {
+            threads: Some(threads),
+            ..RenderOptions::default()
+        };
+        render(&s, &opts).unwrap()
+    };
+    let (one, three) = (with(1), with(3));
+    assert_eq!(one.image.pixels, three.image.pixels);
+    assert_eq!(one.error.unwrap().pixels, three.error.unwrap().pixels);
+}
+
 /// An empty scene renders the background in every model, through the public `render`.
 #[test]
 fn empty_scene_renders_the_background() {
