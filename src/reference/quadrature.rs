@@ -11,12 +11,13 @@
 //! taking the maximum keeps the estimate an overestimate in practice. The three channels are
 //! integrated at the same nodes, and a difference that cancels by chance in one of them is no
 //! evidence that it is resolved: each channel's estimate is raised to the worst channel's error
-//! relative to the integrand's variation (QUADPACK's resasc), scaled to its own variation. Segments the caller flags
-//! as containing or touching a kink (a known non-smooth point, see `optics::kinks`) are
-//! integrated with an endpoint-smoothing substitution ([`gauss_kronrod_15_smoothed`]) and get their estimate
-//! multiplied by [`KINK_SAFETY`], because both rules see a kink equally badly and their
-//! difference can then understate the error; so do the two pieces of a segment split at a kink,
-//! which keep it as a square-root singularity at their common end.
+//! relative to the integrand's variation (QUADPACK's resasc), scaled to its own variation.
+//! Segments that contain or touch a kink the caller knows of (a square-root point where a shadow
+//! ray grazes a sphere, see `optics::kinks`) are integrated with an endpoint-smoothing
+//! substitution ([`gauss_kronrod_15_smoothed`]) and their estimate is multiplied by
+//! [`KINK_SAFETY`]: near a kink both rules err alike and their difference can understate the
+//! error. (The volume renderer also makes every kink a breakpoint before the first pass, so that
+//! no shadow falls unseen between the nodes of a segment.)
 //!
 //! **Global adaptivity.** All segments of one pixel (every interval of the camera ray) share
 //! one error budget: the segment with the largest estimate is split until the summed estimate is
