@@ -18,7 +18,10 @@
 //!   source Q (whatever σ is: a thin interval gives a short u-range, a dense one a u-range
 //!   near 1 whose far end carries almost no weight). That integral is done by globally adaptive
 //!   G7–K15 (`reference::quadrature`) to `tol` per pixel and channel, or by the thesis's
-//!   midpoint sums in t (`reference::riemann`).
+//!   midpoint sums in t (`reference::riemann`). Q is linear in the lights, so the adaptive path
+//!   integrates each light's part on its own (one shadow ray per node, only that light's kinks,
+//!   tol/m each; the estimates add up to ≤ tol), and single-scatter's a·E term, constant per
+//!   interval, exactly.
 //!
 //! **Kinks.** Q is smooth inside an interval except where a shadow ray grazes a sphere. Those
 //! camera-ray parameters are computed in closed form (`optics::kinks`: ray–cylinder for
@@ -155,6 +158,106 @@ impl<'a> VolumeRenderer<'a> {
         }
     }
 
+    /// The part of Q(x) that light `l` contributes (Q is linear in the lights, DESIGN.md §2):
+    /// lit w·L_l(x); single-scatter α(x)·E_l(x)·T_l(x)/4π.
+    fn light_source(&self, x: DVec3, iv: &Interval, l: usize, sh: &mut ShadowScratch) -> DVec3 {
+        let Some(s) = self.light_sample(x, l, |_| false, sh) else {
+            return DVec3::ZERO;
+        };
+        match self.scene.render.model {
+            OpticalModel::SingleScatter => single_scatter_source(0.0, DVec3::ZERO, iv.albedo, &[s]),
+            _ => lit_source(self.light_weight, &[s]),
+        }
+    }
+
+    /// Σ_k T(0,t0_k)·∫₀^{U_k} Q du over the finite intervals, adaptively. Q is linear in the
+    /// lights, so each light is integrated on its own, with only its own kinks as breakpoints
+    /// and one shadow ray per node (integrating the sum would put every light's kinks into
+    /// every light's integral), each to tol/m; the summed estimates are ≤ tol. The
+    /// single-scatter emission term a·E is constant per interval and exact: a·E·U.
+    fn integrate_per_light(
+        &self,
+        ray: &Ray,
+        intervals: &[Interval],
+        pieces: &[Piece],
+        sh: &mut ShadowScratch,
+    ) -> (DVec3, DVec3) {
+        let render = &self.scene.render;
+        let mut value = DVec3::ZERO;
+        let mut error = DVec3::ZERO;
+        if render.model == OpticalModel::SingleScatter {
+            for p in pieces {
+                value +=
+                    (p.weight * (p.hi - p.lo) * render.emission_weight) * intervals[p.tag].emission;
+            }
+        }
+        let (Some(first), Some(last)) = (intervals.first(), intervals.last()) else {
+            return (value, error);
+        };
+        let m = self.scene.lights.len();
+        let t_of = |k: usize, u: f64| {
+            let iv = &intervals[k];
+            (iv.t0 - (-u).ln_1p() / iv.sigma).clamp(iv.t0, iv.t1)
+        };
+        let mut kinks = Vec::new();
+        let mut split = Vec::with_capacity(pieces.len());
+        for (l, light) in self.scene.lights.iter().enumerate() {
+            kinks.clear();
+            shadow_tangencies(
+                ray,
+                (first.t0, last.t1),
+                light,
+                &self.bvh,
+                &self.scene.particles,
+                &mut kinks,
+            );
+            // Every kink is a breakpoint from the start: a shadow that falls between the nodes
+            // of a segment would otherwise go unseen by both rules, and by the error estimate.
+            split.clear();
+            for p in pieces {
+                let iv = &intervals[p.tag];
+                let from = kinks.partition_point(|&t| t <= iv.t0);
+                let to = kinks.partition_point(|&t| t < iv.t1);
+                let mut lo = p.lo;
+                for &t in &kinks[from..to] {
+                    let u = opacity(iv.sigma * (t - iv.t0));
+                    if u > lo && u < p.hi {
+                        split.push(Piece { lo, hi: u, ..*p });
+                        lo = u;
+                    }
+                }
+                split.push(Piece { lo, ..*p });
+            }
+            let kink_in = |k: usize, lo: f64, hi: f64| {
+                let (a, b) = (t_of(k, lo), t_of(k, hi));
+                let from = kinks.partition_point(|&t| t <= a);
+                let to = kinks.partition_point(|&t| t < b);
+                if from >= to {
+                    // Also where clamping t(u) to the interval collapses (a, b) to a point.
+                    return None;
+                }
+                let mid = t_of(k, 0.5 * (lo + hi));
+                let t = kinks[from..to]
+                    .iter()
+                    .copied()
+                    .min_by(|x, y| (x - mid).abs().total_cmp(&(y - mid).abs()))?;
+                let iv = &intervals[k];
+                let u = opacity(iv.sigma * (t - iv.t0));
+                (u > lo && u < hi).then_some(u)
+            };
+            let r = integrate_adaptive(
+                &split,
+                render.tol / m as f64,
+                MAX_SEGMENTS,
+                |k, u| self.light_source(ray.at(t_of(k, u)), &intervals[k], l, sh),
+                kink_in,
+            );
+            value += r.value;
+            error += r.error;
+        }
+        (value, error)
+    }
+
     /// Q∞, the σ → ∞ limit of the source of a Θmax = 1 interval (module documentation).
     fn opaque_source(
         &self,
@@ -269,49 +372,8 @@ impl RadianceEstimator for VolumeRenderer<'_> {
             });
             transmittance *= (-tau).exp();
         }
-        let mut kinks = Vec::new();
-        if self.integrator == Integrator::Adaptive && finite > 0 {
-            if let (Some(first), Some(last)) =
-                (intervals.first(), intervals.get(finite.saturating_sub(1)))
-            {
-                for light in &self.scene.lights {
-                    shadow_tangencies(
-                        ray,
-                        (first.t0, last.t1),
-                        light,
-                        &self.bvh,
-                        &self.scene.particles,
-                        &mut kinks,
-                    );
-                }
-            }
-        }
-        // Every kink is a breakpoint from the start: a shadow that falls between the nodes of a
-        // segment would otherwise go unseen by both rules, and the error estimate with it.
-        if !kinks.is_empty() {
-            let mut split = Vec::with_capacity(pieces.len() + kinks.len());
-            for p in &pieces {
-                let iv = &intervals[p.tag];
-                let from = kinks.partition_point(|&t| t <= iv.t0);
-                let to = kinks.partition_point(|&t| t < iv.t1);
-                let mut lo = p.lo;
-                for &t in &kinks[from..to] {
-                    let u = opacity(iv.sigma * (t - iv.t0));
-                    if u > lo && u < p.hi {
-                        split.push(Piece { lo, hi: u, ..*p });
-                        lo = u;
-                    }
-                }
-                split.push(Piece { lo, ..*p });
-            }
-            pieces = split;
-        }
         let background = transmittance * render.background;
         let intervals = &intervals[..finite];
-        let t_of = |k: usize, u: f64| {
-            let iv = &intervals[k];
-            (iv.t0 - (-u).ln_1p() / iv.sigma).clamp(iv.t0, iv.t1)
-        };
         let (value, error) = match self.integrator {
             Integrator::Riemann { samples } => {
                 let mut sum = DVec3::ZERO;
@@ -324,33 +386,7 @@ impl RadianceEstimator for VolumeRenderer<'_> {
                 }
                 (sum, DVec3::ZERO)
             }
-            Integrator::Adaptive => {
-                let kink_in = |k: usize, lo: f64, hi: f64| {
-                    let (a, b) = (t_of(k, lo), t_of(k, hi));
-                    let from = kinks.partition_point(|&t| t <= a);
-                    let to = kinks.partition_point(|&t| t < b);
-                    if from >= to {
-                        // Also where clamping t(u) to the interval collapses (a, b) to a point.
-                        return None;
-                    }
-                    let mid = t_of(k, 0.5 * (lo + hi));
-                    let t = kinks[from..to]
-                        .iter()
-                        .copied()
-                        .min_by(|x, y| (x - mid).abs().total_cmp(&(y - mid).abs()))?;
-                    let iv = &intervals[k];
-                    let u = opacity(iv.sigma * (t - iv.t0));
-                    (u > lo && u < hi).then_some(u)
-                };
-                let r = integrate_adaptive(
-                    &pieces,
-                    render.tol,
-                    MAX_SEGMENTS,
-                    |k, u| self.source(ray.at(t_of(k, u)), &intervals[k], &mut sh),
-                    kink_in,
-                );
-                (r.value, r.error)
-            }
+            Integrator::Adaptive => self.integrate_per_light(ray, intervals, &pieces, &mut sh),
         };
         Sample {
             radiance: background + end + value,
