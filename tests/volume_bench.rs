@@ -67,6 +67,36 @@ fn benchmark_adaptive_against_riemann() {
     eprintln!(
         "{PARTICLES} spheres in a {side:.1} Å cube, {size}×{size}, lit, 2 directional lights"
     );
+    // The closed-form kink search alone (both lights, whole camera ray), for the overhead.
+    let start = Instant::now();
+    let bvh = s.build_bvh();
+    let kinks: usize = (0..size)
+        .into_par_iter()
+        .map(|py| {
+            let mut out = Vec::new();
+            let mut n = 0;
+            for px in 0..size {
+                let ray = s.camera.pixel_ray(px, py);
+                for light in &s.lights {
+                    out.clear();
+                    pgt::optics::kinks::shadow_tangencies(
+                        &ray,
+                        (0.0, 1e3),
+                        light,
+                        &bvh,
+                        &s.particles,
+                        &mut out,
+                    );
+                    n += out.len();
+                }
+            }
+            n
+        })
+        .sum();
+    eprintln!(
+        "kink search alone: {:.2} s, {kinks} kinks",
+        start.elapsed().as_secs_f64()
+    );
     let (truth, seconds) = run(&s, Integrator::Adaptive);
     let max_estimate = |v: &[Sample]| v.iter().map(|x| x.error.max_element()).fold(0.0, f64::max);
     let rays = |v: &[Sample]| v.iter().map(|x| x.shadow_rays).sum::<u64>();
