@@ -63,7 +63,8 @@ use crate::optics::source::{
 use crate::scene::{OpticalModel, Scene};
 use glam::DVec3;
 
-/// Segments per pixel at most; beyond it the remaining error estimate is reported as it stands.
+/// Segments per pixel and light at most; beyond it the remaining error estimate is reported as
+/// it stands (the pixel then may miss `tol`, and says so in its `err` value).
 pub const MAX_SEGMENTS: usize = 4000;
 
 /// The volume renderer of one scene (DESIGN.md §2, §3).
