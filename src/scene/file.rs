@@ -128,6 +128,9 @@ pub struct IncludeSpec {
     pub skip_hydrogen: bool,
     /// MMPLD: which frame (0-based); the first by default.
     pub frame: Option<usize>,
+    /// Forces a file format whatever the extension (`"pdb"`, `"mmcif"`, `"vrml"`, `"mmpld"`,
+    /// `"xyz"`, `"csv"`).
+    pub format: Option<crate::formats::Format>,
 }
 
 impl IncludeSpec {
@@ -142,6 +145,7 @@ impl IncludeSpec {
             skip_water: false,
             skip_hydrogen: false,
             frame: None,
+            format: None,
         }
     }
 }

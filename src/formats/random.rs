@@ -1,0 +1,1 @@
+//! Random particle sets (placeholder).
