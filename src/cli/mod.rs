@@ -1,6 +1,8 @@
 //! The `pgt` command line (DESIGN.md §7): one file per subcommand. Every subcommand returns an
 //! [`Outcome`]; `main` maps it and errors to exit codes 0 / 1 / 2.
 
+pub mod gen;
+pub mod info;
 pub mod render;
 
 use clap::{Parser, Subcommand};
@@ -25,12 +27,18 @@ pub struct Cli {
 pub enum Command {
     /// Render the exact reference image of a scene (a scene TOML or a bare particle file).
     Render(render::RenderArgs),
+    /// Particle count, bounds, radius range and colours of a particle or scene file.
+    Info(info::InfoArgs),
+    /// Generate synthetic data sets (`pgt gen random`).
+    Gen(gen::GenArgs),
 }
 
 /// Runs the parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
     match cli.command {
         Command::Render(args) => render::run(args),
+        Command::Info(args) => info::run(args),
+        Command::Gen(args) => gen::run(args),
     }
 }
 

@@ -120,7 +120,7 @@ pub fn load_bytes(spec: &IncludeSpec, format: Format, bytes: &[u8]) -> Result<Lo
         }
         Format::Vrml => vrml::load(path, bytes),
         Format::Mmpld => mmpld::load(spec, bytes),
-        Format::Xyz => xyz_csv::load_xyz(path, bytes),
+        Format::Xyz => xyz_csv::load_xyz(path, bytes, spec.frame.unwrap_or(0)),
         Format::Csv => xyz_csv::load_csv(path, bytes),
     }
 }
