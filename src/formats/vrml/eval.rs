@@ -31,7 +31,7 @@ use std::rc::Rc;
 /// Deepest evaluation (nested nodes plus PROTO expansions).
 const MAX_EVAL_DEPTH: usize = 512;
 /// Most node visits one file may cause (DEF/USE can multiply a small file into a huge scene).
-const MAX_VISITS: u64 = 50_000_000;
+const MAX_VISITS: u64 = 20_000_000;
 /// Relative spread of vertex distances below which a mesh counts as a sphere.
 const MESH_SPHERE_TOLERANCE: f64 = 5e-3;
 /// Fewest vertices of a mesh recognised as a sphere.
