@@ -103,7 +103,30 @@ pub fn load_particles(spec: &IncludeSpec) -> Result<LoadedParticles> {
             r.radius *= spec.radius_scale;
         }
     }
+    check_records(&spec.path, &loaded.records)?;
     Ok(loaded)
+}
+
+/// Every particle has a finite centre and a finite radius > 0 (also for `pgt info`, which does
+/// not build a scene); the error points at the particle's line or byte.
+fn check_records(path: &Path, records: &[ParticleRecord]) -> Result<()> {
+    for r in records {
+        let problem = if !r.center.is_finite() {
+            Some(format!("the particle position {} is not finite", r.center))
+        } else if !(r.radius.is_finite() && r.radius > 0.0) {
+            Some(format!("the particle radius must be finite and > 0, got {}", r.radius))
+        } else {
+            None
+        };
+        if let Some(message) = problem {
+            return Err(PgtError::Input {
+                path: path.to_path_buf(),
+                location: r.location.clone(),
+                message,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// Parses a file's bytes as `format` (no `radius_scale`); `spec.path` names it in messages.

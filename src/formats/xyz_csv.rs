@@ -73,7 +73,7 @@ pub fn load_xyz(path: &Path, bytes: &[u8], frame: usize) -> Result<LoadedParticl
             records.reserve(n);
         }
         for k in 0..n {
-            let Some((l, text)) = it.next() else {
+            let Some((l, text)) = it.next().filter(|(_, t)| !t.trim().is_empty()) else {
                 return Err(PgtError::at_line(
                     path,
                     line,
