@@ -8,17 +8,26 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 fn pgt(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_pgt")).args(args).output().expect("run pgt")
+    Command::new(env!("CARGO_BIN_EXE_pgt"))
+        .args(args)
+        .output()
+        .expect("run pgt")
 }
 
 fn json(out: &Output) -> serde_json::Value {
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     serde_json::from_slice(&out.stdout).expect("json")
 }
 
 #[test]
 fn info_json_of_a_pdb_file() {
-    let Some(p) = shared("pdb/1uun_opm_oriented.pdb") else { return };
+    let Some(p) = shared("pdb/1uun_opm_oriented.pdb") else {
+        return;
+    };
     let v = json(&pgt(&["info", p.to_str().expect("utf8"), "--json"]));
     assert_eq!(v["particles"], 11032);
     assert_eq!(v["format"], "pdb");
@@ -46,7 +55,9 @@ fn info_json_of_a_pdb_file() {
 
 #[test]
 fn info_of_a_scene_with_an_include() {
-    let Some(p) = shared("pdb/1uun_opm_oriented.pdb") else { return };
+    let Some(p) = shared("pdb/1uun_opm_oriented.pdb") else {
+        return;
+    };
     let dir = tempfile::tempdir().expect("tmp");
     let scene = dir.path().join("s.toml");
     std::fs::write(
@@ -73,24 +84,60 @@ fn gen_random_is_deterministic_and_readable() {
     let b = dir.path().join("b.csv");
     let c = dir.path().join("c.csv");
     for (f, seed) in [(&a, "5"), (&b, "5"), (&c, "6")] {
-        let out = pgt(&["gen", "random", "--count", "1000", "--seed", seed, "--box", "0,0,0,10,20,30", "--radius", "0.1..0.2", "-o", f.to_str().expect("utf8")]);
-        assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+        let out = pgt(&[
+            "gen",
+            "random",
+            "--count",
+            "1000",
+            "--seed",
+            seed,
+            "--box",
+            "0,0,0,10,20,30",
+            "--radius",
+            "0.1..0.2",
+            "-o",
+            f.to_str().expect("utf8"),
+        ]);
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
     }
-    let (ta, tb, tc) = (std::fs::read(&a).expect("a"), std::fs::read(&b).expect("b"), std::fs::read(&c).expect("c"));
+    let (ta, tb, tc) = (
+        std::fs::read(&a).expect("a"),
+        std::fs::read(&b).expect("b"),
+        std::fs::read(&c).expect("c"),
+    );
     assert_eq!(ta, tb);
     assert_ne!(ta, tc);
     let v = json(&pgt(&["info", a.to_str().expect("utf8"), "--json"]));
     assert_eq!(v["particles"], 1000);
     let (lo, hi) = (&v["bounds"]["min"], &v["bounds"]["max"]);
     assert!(lo[0].as_f64().expect("n") >= -0.2 && hi[2].as_f64().expect("n") <= 30.2);
-    assert!(v["radius"]["min"].as_f64().expect("n") >= 0.1 && v["radius"]["max"].as_f64().expect("n") <= 0.2);
+    assert!(
+        v["radius"]["min"].as_f64().expect("n") >= 0.1
+            && v["radius"]["max"].as_f64().expect("n") <= 0.2
+    );
     // The default is the thesis's count.
     let d = dir.path().join("d.csv");
-    assert!(pgt(&["gen", "random", "-o", d.to_str().expect("utf8")]).status.success());
-    assert_eq!(json(&pgt(&["info", d.to_str().expect("utf8"), "--json"]))["particles"], 73642);
+    assert!(pgt(&["gen", "random", "-o", d.to_str().expect("utf8")])
+        .status
+        .success());
+    assert_eq!(
+        json(&pgt(&["info", d.to_str().expect("utf8"), "--json"]))["particles"],
+        73642
+    );
     // Bad options: exit 2, nothing written.
     let e = dir.path().join("e.csv");
-    let out = pgt(&["gen", "random", "--radius", "2..1", "-o", e.to_str().expect("utf8")]);
+    let out = pgt(&[
+        "gen",
+        "random",
+        "--radius",
+        "2..1",
+        "-o",
+        e.to_str().expect("utf8"),
+    ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(!e.exists());
 }
@@ -98,11 +145,28 @@ fn gen_random_is_deterministic_and_readable() {
 #[test]
 fn bare_files_render() {
     let dir = tempfile::tempdir().expect("tmp");
-    for rel in ["pdb/1rx1.pdb", "vrml/castle_proto_ultra_simple.wrl", "mmpld/test_xyzr_float_rgba_byte.mmpld"] {
+    for rel in [
+        "pdb/1rx1.pdb",
+        "vrml/castle_proto_ultra_simple.wrl",
+        "mmpld/test_xyzr_float_rgba_byte.mmpld",
+    ] {
         let Some(p) = shared(rel) else { continue };
         let out_png = dir.path().join("o.png");
-        let out = pgt(&["render", p.to_str().expect("utf8"), "-o", out_png.to_str().expect("utf8"), "--mode", "opaque", "--size", "48x32"]);
-        assert!(out.status.success(), "{rel}: {}", String::from_utf8_lossy(&out.stderr));
+        let out = pgt(&[
+            "render",
+            p.to_str().expect("utf8"),
+            "-o",
+            out_png.to_str().expect("utf8"),
+            "--mode",
+            "opaque",
+            "--size",
+            "48x32",
+        ]);
+        assert!(
+            out.status.success(),
+            "{rel}: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
         assert!(out_png.exists(), "{rel}");
         std::fs::remove_file(&out_png).expect("rm");
     }
@@ -115,7 +179,17 @@ fn rejects(dir: &Path, name: &str, bytes: &[u8], want: &str) {
     std::fs::write(&p, bytes).expect("write");
     let png = dir.join(format!("{name}.png"));
     let ps = p.to_str().expect("utf8");
-    for args in [vec!["render", ps, "-o", png.to_str().expect("utf8"), "--mode", "opaque"], vec!["info", ps]] {
+    for args in [
+        vec![
+            "render",
+            ps,
+            "-o",
+            png.to_str().expect("utf8"),
+            "--mode",
+            "opaque",
+        ],
+        vec!["info", ps],
+    ] {
         let out = pgt(&args);
         let err = String::from_utf8_lossy(&out.stderr);
         assert_eq!(out.status.code(), Some(2), "{name}: {err}");
@@ -130,18 +204,48 @@ fn bad_input_exits_2_names_the_file_and_writes_nothing() {
     let dir = tempfile::tempdir().expect("tmp");
     let d = dir.path();
     let atom = "ATOM      1  N   ALA A   2      63.130 -67.331 -18.137  1.00 21.97           N  \n";
-    rejects(d, "trunc.pdb", format!("{atom}{}", &atom[..35]).as_bytes(), "trunc.pdb:2");
-    rejects(d, "nan.pdb", atom.replace("63.130", "   nan").as_bytes(), "not finite");
-    rejects(d, "bad.cif", b"data_x\nloop_\n_atom_site.Cartn_x\n_atom_site.Cartn_y\n_atom_site.Cartn_z\n1 2 x\n", "bad.cif:6");
+    rejects(
+        d,
+        "trunc.pdb",
+        format!("{atom}{}", &atom[..35]).as_bytes(),
+        "trunc.pdb:2",
+    );
+    rejects(
+        d,
+        "nan.pdb",
+        atom.replace("63.130", "   nan").as_bytes(),
+        "not finite",
+    );
+    rejects(
+        d,
+        "bad.cif",
+        b"data_x\nloop_\n_atom_site.Cartn_x\n_atom_site.Cartn_y\n_atom_site.Cartn_z\n1 2 x\n",
+        "bad.cif:6",
+    );
     rejects(d, "magic.mmpld", b"MMPLX\0\x66\0\x01\0\0\0", "magic");
     let mut big = b"MMPLD\0".to_vec();
     big.extend_from_slice(&102u16.to_le_bytes());
     big.extend_from_slice(&u32::MAX.to_le_bytes());
     big.extend_from_slice(&[0u8; 64]);
     rejects(d, "count.mmpld", &big, "frames");
-    rejects(d, "brace.wrl", b"#VRML V2.0 utf8\nGroup { children [ Shape { geometry Sphere { } } ]\n", "expected '}'");
-    rejects(d, "proto.wrl", b"#VRML V2.0 utf8\nNoSuchProto { }\n", "unknown node type");
-    rejects(d, "self.wrl", b"#VRML V2.0 utf8\nPROTO A [] { A { } }\n", "instantiates itself");
+    rejects(
+        d,
+        "brace.wrl",
+        b"#VRML V2.0 utf8\nGroup { children [ Shape { geometry Sphere { } } ]\n",
+        "expected '}'",
+    );
+    rejects(
+        d,
+        "proto.wrl",
+        b"#VRML V2.0 utf8\nNoSuchProto { }\n",
+        "unknown node type",
+    );
+    rejects(
+        d,
+        "self.wrl",
+        b"#VRML V2.0 utf8\nPROTO A [] { A { } }\n",
+        "instantiates itself",
+    );
     rejects(d, "use.wrl", b"#VRML V2.0 utf8\nUSE X\n", "use.wrl:2");
     rejects(d, "short.xyz", b"4\ncomment\nC 0 0 0\n", "short.xyz:1");
     rejects(d, "hdr.csv", b"1,2,3\n", "header");

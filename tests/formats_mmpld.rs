@@ -33,22 +33,33 @@ const COUNTS: &[(&str, usize)] = &[
 #[test]
 fn every_mmpld_file_loads_with_the_right_count() {
     for (name, n) in COUNTS {
-        let Some(p) = shared(&format!("mmpld/{name}")) else { continue };
+        let Some(p) = shared(&format!("mmpld/{name}")) else {
+            continue;
+        };
         let l = load(&p);
         assert_eq!(l.records.len(), *n, "{name}");
-        assert!(l.records.iter().all(|r| r.radius > 0.0 && r.center.is_finite()), "{name}");
+        assert!(
+            l.records
+                .iter()
+                .all(|r| r.radius > 0.0 && r.center.is_finite()),
+            "{name}"
+        );
         let bug = l.warnings.iter().any(|w| w.contains("timestamp"));
         assert_eq!(bug, name.contains("v103"), "{name}: {:?}", l.warnings);
     }
 }
 
 fn f32_at(b: &[u8], at: usize) -> f64 {
-    f64::from(f32::from_le_bytes(b[at..at + 4].try_into().expect("4 bytes")))
+    f64::from(f32::from_le_bytes(
+        b[at..at + 4].try_into().expect("4 bytes"),
+    ))
 }
 
 #[test]
 fn xyzr_rgba_byte_particles_match_the_bytes() {
-    let Some(p) = shared("mmpld/test_xyzr_float_rgba_byte.mmpld") else { return };
+    let Some(p) = shared("mmpld/test_xyzr_float_rgba_byte.mmpld") else {
+        return;
+    };
     let b = std::fs::read(&p).expect("read");
     let l = load(&p);
     // Header 60 + seek table 2×8 = 76; timestamp 4, list count 4, types 2, count 8 → data at 94,
@@ -57,16 +68,23 @@ fn xyzr_rgba_byte_particles_match_the_bytes() {
     for (k, r) in l.records.iter().enumerate() {
         let at = 94 + 20 * k;
         assert_eq!(r.location, Location::Byte(at as u64));
-        assert!(close3(r.center, [f32_at(&b, at), f32_at(&b, at + 4), f32_at(&b, at + 8)], 0.0));
+        assert!(close3(
+            r.center,
+            [f32_at(&b, at), f32_at(&b, at + 4), f32_at(&b, at + 8)],
+            0.0
+        ));
         assert_eq!(r.radius, f32_at(&b, at + 12));
-        let want = lin(u32::from(b[at + 16]) << 16 | u32::from(b[at + 17]) << 8 | u32::from(b[at + 18]));
+        let want =
+            lin(u32::from(b[at + 16]) << 16 | u32::from(b[at + 17]) << 8 | u32::from(b[at + 18]));
         assert!(close3(r.color.expect("colour"), want, 1e-12), "{k}");
     }
 }
 
 #[test]
 fn v103_writer_bug_file_uses_global_radius_and_colour() {
-    let Some(p) = shared("mmpld/part_rnk000000_v103.mmpld") else { return };
+    let Some(p) = shared("mmpld/part_rnk000000_v103.mmpld") else {
+        return;
+    };
     let b = std::fs::read(&p).expect("read");
     let l = load(&p);
     // No timestamp: list count at 76, types at 80, global radius at 82, RGBA at 86.
@@ -76,36 +94,55 @@ fn v103_writer_bug_file_uses_global_radius_and_colour() {
     assert!(l.records.iter().all(|r| r.radius == radius));
     let g = lin(0xCCCCCC);
     assert_eq!(&b[86..90], &[204, 204, 204, 204]);
-    assert!(l.records.iter().all(|r| close3(r.color.expect("c"), g, 1e-12)));
+    assert!(l
+        .records
+        .iter()
+        .all(|r| close3(r.color.expect("c"), g, 1e-12)));
     // count at 90, bbox 24 bytes → data at 122, 12 bytes each.
     let last = l.records.last().expect("some");
     let at = 122 + 12 * 5343;
     assert_eq!(last.location, Location::Byte(at as u64));
-    assert!(close3(last.center, [f32_at(&b, at), f32_at(&b, at + 4), f32_at(&b, at + 8)], 0.0));
+    assert!(close3(
+        last.center,
+        [f32_at(&b, at), f32_at(&b, at + 4), f32_at(&b, at + 8)],
+        0.0
+    ));
     assert_eq!(at + 12, b.len());
 }
 
 #[test]
 fn frames_are_selected() {
-    let Some(p) = shared("mmpld/testspheres_old_v100.mmpld") else { return };
+    let Some(p) = shared("mmpld/testspheres_old_v100.mmpld") else {
+        return;
+    };
     let a = load(&p);
     let z = load_with(&p, |s| s.frame = Some(99)).expect("frame 99");
     assert_eq!(z.records.len(), 15);
     assert_ne!(a.records[0].center, z.records[0].center);
-    let e = load_with(&p, |s| s.frame = Some(100)).expect_err("no frame 100").to_string();
-    assert!(e.contains("testspheres_old_v100.mmpld") && e.contains("100 frame"), "{e}");
+    let e = load_with(&p, |s| s.frame = Some(100))
+        .expect_err("no frame 100")
+        .to_string();
+    assert!(
+        e.contains("testspheres_old_v100.mmpld") && e.contains("100 frame"),
+        "{e}"
+    );
 }
 
 #[test]
 fn bad_mmpld_input_is_an_error_with_a_byte_offset() {
-    let Some(p) = shared("mmpld/test_xyzr_float_rgba_byte.mmpld") else { return };
+    let Some(p) = shared("mmpld/test_xyzr_float_rgba_byte.mmpld") else {
+        return;
+    };
     let good = std::fs::read(&p).expect("read");
     let dir = tempfile::tempdir().expect("tmp");
     let q = dir.path().join("bad.mmpld");
     let mut check = |bytes: &[u8], want: &str| {
         std::fs::write(&q, bytes).expect("write");
         let e = load_with(&q, |_| {}).expect_err(want).to_string();
-        assert!(e.contains("bad.mmpld (byte") && e.contains(want), "{want}: {e}");
+        assert!(
+            e.contains("bad.mmpld (byte") && e.contains(want),
+            "{want}: {e}"
+        );
     };
     // Wrong magic.
     let mut b = good.clone();

@@ -30,26 +30,42 @@ fn every_structure_file_loads_with_the_right_count() {
         assert_eq!(l.records.len(), *n, "{rel}");
         // Every atom has a tabulated element (no fallback radius) in these files.
         assert!(
-            !l.warnings.iter().any(|w| w.contains("no recognisable element")),
+            !l.warnings
+                .iter()
+                .any(|w| w.contains("no recognisable element")),
             "{rel}: {:?}",
             l.warnings
         );
-        assert!(l.records.iter().all(|r| r.radius >= 1.2 && r.radius <= 2.31), "{rel}");
+        assert!(
+            l.records
+                .iter()
+                .all(|r| r.radius >= 1.2 && r.radius <= 2.31),
+            "{rel}"
+        );
     }
 }
 
 #[test]
 fn uun_chains_a_and_b_are_the_thesis_count() {
-    let Some(p) = shared("pdb/1uun_opm_oriented.pdb") else { return };
+    let Some(p) = shared("pdb/1uun_opm_oriented.pdb") else {
+        return;
+    };
     let l = load_with(&p, |s| s.chains = Some(vec!["A".into(), "B".into()])).expect("loads");
     assert_eq!(l.records.len(), 2758);
-    let e = load_with(&p, |s| s.chains = Some(vec!["Z".into()])).expect_err("no chain Z").to_string();
-    assert!(e.contains("1uun_opm_oriented.pdb") && e.contains("'Z'"), "{e}");
+    let e = load_with(&p, |s| s.chains = Some(vec!["Z".into()]))
+        .expect_err("no chain Z")
+        .to_string();
+    assert!(
+        e.contains("1uun_opm_oriented.pdb") && e.contains("'Z'"),
+        "{e}"
+    );
 }
 
 #[test]
 fn positions_radii_colours_match_the_text() {
-    let Some(p) = shared("pdb/1aon.pdb") else { return };
+    let Some(p) = shared("pdb/1aon.pdb") else {
+        return;
+    };
     let l = load(&p);
     // Line of the first ATOM record and its columns, read here from the text.
     let atoms = lines_where(&p, |l| l.starts_with("ATOM  ") || l.starts_with("HETATM"));
@@ -57,7 +73,10 @@ fn positions_radii_colours_match_the_text() {
         let r = &l.records[k];
         assert_eq!(r.location, Location::Line(*line));
         let col = |a: usize, b: usize| text[a - 1..b].trim().parse::<f64>().expect("number");
-        assert!(close3(r.center, [col(31, 38), col(39, 46), col(47, 54)], 1e-9), "line {line}");
+        assert!(
+            close3(r.center, [col(31, 38), col(39, 46), col(47, 54)], 1e-9),
+            "line {line}"
+        );
         let (radius, hex) = match text[76..78].trim() {
             "C" => (1.70, 0x909090),
             "N" => (1.55, 0x3050F8),
@@ -66,17 +85,28 @@ fn positions_radii_colours_match_the_text() {
             other => panic!("unexpected element {other} at line {line}"),
         };
         assert_eq!(r.radius, radius, "line {line}");
-        assert!(close3(r.color.expect("coloured"), lin(hex), 1e-12), "line {line}");
+        assert!(
+            close3(r.color.expect("coloured"), lin(hex), 1e-12),
+            "line {line}"
+        );
     }
 }
 
 #[test]
 fn calcium_ion_gets_its_own_radius() {
-    let Some(p) = shared("pdb/1rx1.pdb") else { return };
+    let Some(p) = shared("pdb/1rx1.pdb") else {
+        return;
+    };
     let l = load(&p);
-    let ca = lines_where(&p, |l| l.starts_with("HETATM") && l.get(76..78) == Some("CA"));
+    let ca = lines_where(&p, |l| {
+        l.starts_with("HETATM") && l.get(76..78) == Some("CA")
+    });
     assert_eq!(ca.len(), 1);
-    let r = l.records.iter().find(|r| r.location == Location::Line(ca[0].0)).expect("Ca kept");
+    let r = l
+        .records
+        .iter()
+        .find(|r| r.location == Location::Line(ca[0].0))
+        .expect("Ca kept");
     assert_eq!(r.radius, 2.31);
     assert!(close3(r.color.expect("c"), lin(0x3DFF00), 1e-12));
 }
@@ -92,23 +122,33 @@ fn old_style_and_md_files_infer_elements() {
     if let Some(p) = shared("pdb/1hpv.pdb") {
         let l = load(&p);
         // The ligand 478 has a sulphur S1: find its line and check the radius.
-        let s1 = lines_where(&p, |l| l.starts_with("HETATM") && l.get(12..16) == Some(" S1 "));
+        let s1 = lines_where(&p, |l| {
+            l.starts_with("HETATM") && l.get(12..16) == Some(" S1 ")
+        });
         assert_eq!(s1.len(), 1);
-        let r = l.records.iter().find(|r| r.location == Location::Line(s1[0].0)).expect("kept");
+        let r = l
+            .records
+            .iter()
+            .find(|r| r.location == Location::Line(s1[0].0))
+            .expect("kept");
         assert_eq!(r.radius, 1.80);
     }
 }
 
 #[test]
 fn waters_can_be_skipped() {
-    let Some(p) = shared("pdb/1tii.pdb") else { return };
+    let Some(p) = shared("pdb/1tii.pdb") else {
+        return;
+    };
     let l = load_with(&p, |s| s.skip_water = true).expect("loads");
     assert_eq!(l.records.len(), 5684 - 215);
 }
 
 #[test]
 fn alternate_locations_keep_the_highest_occupancy() {
-    let Some(p) = shared("pdb/3al1.pdb") else { return };
+    let Some(p) = shared("pdb/3al1.pdb") else {
+        return;
+    };
     let l = load(&p);
     let find = |alt: char, name: &str, res: &str| {
         let v = lines_where(&p, |l| {
@@ -130,7 +170,9 @@ fn alternate_locations_keep_the_highest_occupancy() {
 
 #[test]
 fn colour_by_chain_and_uniform() {
-    let Some(p) = shared("pdb/1uun_opm_oriented.pdb") else { return };
+    let Some(p) = shared("pdb/1uun_opm_oriented.pdb") else {
+        return;
+    };
     let l = load_with(&p, |s| s.color_by = ColorBy::Chain).expect("loads");
     // 8 chains × 1379 atoms in file order: the colour changes exactly at the chain boundaries.
     let distinct: std::collections::BTreeSet<String> =
@@ -144,15 +186,23 @@ fn colour_by_chain_and_uniform() {
 
 #[test]
 fn radius_scale_applies_once() {
-    let Some(p) = shared("pdb/1rx1.pdb") else { return };
+    let Some(p) = shared("pdb/1rx1.pdb") else {
+        return;
+    };
     let a = load(&p);
     let b = load_with(&p, |s| s.radius_scale = 0.5).expect("loads");
-    assert!(a.records.iter().zip(&b.records).all(|(x, y)| (x.radius * 0.5 - y.radius).abs() < 1e-12));
+    assert!(a
+        .records
+        .iter()
+        .zip(&b.records)
+        .all(|(x, y)| (x.radius * 0.5 - y.radius).abs() < 1e-12));
 }
 
 #[test]
 fn mmcif_matches_its_text() {
-    let Some(p) = shared("pdb/3SN6.cif") else { return };
+    let Some(p) = shared("pdb/3SN6.cif") else {
+        return;
+    };
     let l = load(&p);
     let rows = lines_where(&p, |l| l.starts_with("ATOM ") || l.starts_with("HETATM "));
     assert_eq!(rows.len(), l.records.len());
@@ -172,7 +222,10 @@ fn mmcif_matches_its_text() {
         assert_eq!(r.radius, want);
     }
     // Chains come from auth_asym_id (column 24); chain R only.
-    let n_r = rows.iter().filter(|(_, t)| t.split_whitespace().nth(23) == Some("R")).count();
+    let n_r = rows
+        .iter()
+        .filter(|(_, t)| t.split_whitespace().nth(23) == Some("R"))
+        .count();
     let r = load_with(&p, |s| s.chains = Some(vec!["R".into()])).expect("loads");
     assert_eq!(r.records.len(), n_r);
     assert!(n_r > 0);
@@ -182,8 +235,15 @@ fn mmcif_matches_its_text() {
 fn models_are_selected() {
     let dir = tempfile::tempdir().expect("tmp");
     let p = dir.path().join("m.pdb");
-    let atom = |x: f64| format!("ATOM      1  CA  ALA A   1    {x:8.3}   0.000   0.000  1.00  0.00           C  \n");
-    let text = format!("MODEL        1\n{}{}ENDMDL\nMODEL        2\n{}ENDMDL\n", atom(1.0), atom(2.0), atom(3.0));
+    let atom = |x: f64| {
+        format!("ATOM      1  CA  ALA A   1    {x:8.3}   0.000   0.000  1.00  0.00           C  \n")
+    };
+    let text = format!(
+        "MODEL        1\n{}{}ENDMDL\nMODEL        2\n{}ENDMDL\n",
+        atom(1.0),
+        atom(2.0),
+        atom(3.0)
+    );
     std::fs::write(&p, text).expect("write");
     let a = load(&p);
     assert_eq!(a.records.len(), 2);
@@ -192,6 +252,8 @@ fn models_are_selected() {
     assert_eq!(b.records.len(), 1);
     assert_eq!(b.records[0].center.x, 3.0);
     assert_eq!(b.records[0].location, Location::Line(6));
-    let e = load_with(&p, |s| s.model = Some(3)).expect_err("no model 3").to_string();
+    let e = load_with(&p, |s| s.model = Some(3))
+        .expect_err("no model 3")
+        .to_string();
     assert!(e.contains("m.pdb") && e.contains("model 3"), "{e}");
 }

@@ -32,7 +32,11 @@ fn random_set_round_trips_through_csv() {
 fn xyz_file_loads() {
     let dir = tempfile::tempdir().expect("tmp");
     let p = dir.path().join("w.xyz");
-    std::fs::write(&p, "3\nwater\nO 0.0 0.0 0.0\nH 0.757 0.586 0.0\nH -0.757 0.586 0.0\n").expect("w");
+    std::fs::write(
+        &p,
+        "3\nwater\nO 0.0 0.0 0.0\nH 0.757 0.586 0.0\nH -0.757 0.586 0.0\n",
+    )
+    .expect("w");
     let l = load(&p);
     assert_eq!(l.records.len(), 3);
     assert_eq!(l.records[1].radius, 1.20);

@@ -28,25 +28,46 @@ fn every_vrml_file_loads_with_the_right_count() {
 
 #[test]
 fn castle_proto_nodes_six_unit_spheres() {
-    let Some(p) = shared("vrml/castle_proto_nodes.wrl") else { return };
+    let Some(p) = shared("vrml/castle_proto_nodes.wrl") else {
+        return;
+    };
     let l = load(&p);
     let xs: Vec<f64> = l.records.iter().map(|r| r.center.x).collect();
     assert_eq!(xs, vec![5.0, 10.0, 15.0, 20.0, 25.0, 30.0]);
-    assert!(l.records.iter().all(|r| r.radius == 1.0 && r.center.y == 0.0));
+    assert!(l
+        .records
+        .iter()
+        .all(|r| r.radius == 1.0 && r.center.y == 0.0));
     // Colours per the file's comments: yellow, unlit (scene default), yellow (instance DEF),
     // red (PROTO default), blue (instance), yellow (default with USE YellowMat).
     let c: Vec<Option<DVec3>> = l.records.iter().map(|r| r.color).collect();
     let (y, r, b) = (DVec3::new(1.0, 1.0, 0.0), DVec3::X, DVec3::Z);
     assert_eq!(c, vec![Some(y), None, Some(y), Some(r), Some(b), Some(y)]);
-    assert!(l.warnings.iter().any(|w| w.contains("6 Text")), "{:?}", l.warnings);
+    assert!(
+        l.warnings.iter().any(|w| w.contains("6 Text")),
+        "{:?}",
+        l.warnings
+    );
 }
 
 #[test]
 fn castle_proto_redefinition_and_radii() {
-    let Some(p) = shared("vrml/castle_proto_ultra_simple.wrl") else { return };
+    let Some(p) = shared("vrml/castle_proto_ultra_simple.wrl") else {
+        return;
+    };
     let l = load(&p);
     let got: Vec<(f64, f64)> = l.records.iter().map(|r| (r.center.x, r.radius)).collect();
-    assert_eq!(got, vec![(0.0, 5.0), (10.0, 4.0), (20.0, 3.0), (30.0, 2.0), (40.0, 1.0), (50.0, 0.5)]);
+    assert_eq!(
+        got,
+        vec![
+            (0.0, 5.0),
+            (10.0, 4.0),
+            (20.0, 3.0),
+            (30.0, 2.0),
+            (40.0, 1.0),
+            (50.0, 0.5)
+        ]
+    );
     // The redefined MySphere is green; RedMaterial (a PROTO'd Material) is red.
     assert_eq!(l.records[2].color, Some(DVec3::Y));
     assert_eq!(l.records[4].color, Some(DVec3::X));
@@ -54,16 +75,22 @@ fn castle_proto_redefinition_and_radii() {
 
 #[test]
 fn drawxtl_radii_and_rotated_frame() {
-    let Some(p) = shared("vrml/drawxtl_be4oteo6.wrl") else { return };
+    let Some(p) = shared("vrml/drawxtl_be4oteo6.wrl") else {
+        return;
+    };
     let l = load(&p);
     let mut radii: Vec<f64> = l.records.iter().map(|r| r.radius).collect();
     radii.sort_by(f64::total_cmp);
     radii.dedup();
     // SOURCES.md: radii 0.23 / 0.30 / 0.45 — the rotations are rigid, so radii are kept.
     for r in &radii {
-        assert!([0.23, 0.30, 0.45].iter().any(|x| (x - r).abs() < 1e-9), "{r}");
+        assert!(
+            [0.23, 0.30, 0.45].iter().any(|x| (x - r).abs() < 1e-9),
+            "{r}"
+        );
     }
-    let colors: std::collections::BTreeSet<String> = l.records.iter().map(|r| format!("{:?}", r.color)).collect();
+    let colors: std::collections::BTreeSet<String> =
+        l.records.iter().map(|r| format!("{:?}", r.color)).collect();
     assert_eq!(colors.len(), 2);
 }
 
@@ -75,7 +102,10 @@ fn rx1_atoms() -> Option<Vec<(DVec3, String)>> {
             .into_iter()
             .map(|(_, t)| {
                 let c = |a: usize, b: usize| t[a - 1..b].trim().parse::<f64>().expect("n");
-                (DVec3::new(c(31, 38), c(39, 46), c(47, 54)), t[76..78].trim().to_string())
+                (
+                    DVec3::new(c(31, 38), c(39, 46), c(47, 54)),
+                    t[76..78].trim().to_string(),
+                )
             })
             .collect(),
     )
@@ -83,13 +113,19 @@ fn rx1_atoms() -> Option<Vec<(DVec3, String)>> {
 
 #[test]
 fn pymol_spheres_are_the_pdb_atoms() {
-    let (Some(p), Some(atoms)) = (shared("vrml/pymol_1rx1_spheres.wrl"), rx1_atoms()) else { return };
+    let (Some(p), Some(atoms)) = (shared("vrml/pymol_1rx1_spheres.wrl"), rx1_atoms()) else {
+        return;
+    };
     let l = load(&p);
     assert_eq!(l.records.len(), atoms.len());
     // SOURCES.md: translation = PDB xyz − (27.400, 44.000, 13.301); vdW C 1.70 N 1.55 O 1.52 S 1.80.
     let view = DVec3::new(27.4, 44.0, 13.301);
     for (r, (x, el)) in l.records.iter().zip(&atoms) {
-        assert!((r.center + view - *x).abs().max_element() < 2e-3, "{} vs {x}", r.center + view);
+        assert!(
+            (r.center + view - *x).abs().max_element() < 2e-3,
+            "{} vs {x}",
+            r.center + view
+        );
         let want = match el.as_str() {
             "C" => Some(1.70),
             "N" => Some(1.55),
@@ -103,22 +139,33 @@ fn pymol_spheres_are_the_pdb_atoms() {
     }
     // Locations point at Sphere lines.
     let text = std::fs::read_to_string(&p).expect("read");
-    let Location::Line(n) = l.records[0].location else { panic!("line") };
+    let Location::Line(n) = l.records[0].location else {
+        panic!("line")
+    };
     assert!(text.lines().nth(n - 1).expect("line").contains("Sphere"));
 }
 
 #[test]
 fn jmol_mesh_spheres_are_the_pdb_atoms() {
-    let (Some(p), Some(atoms)) = (shared("vrml/jmol_1rx1_spacefill.wrl"), rx1_atoms()) else { return };
+    let (Some(p), Some(atoms)) = (shared("vrml/jmol_1rx1_spacefill.wrl"), rx1_atoms()) else {
+        return;
+    };
     let l = load(&p);
     assert_eq!(l.records.len(), atoms.len());
     // Transform{scale 10 10 10 children[Transform{translation -26.926 -44.427498 -12.8755 …
     let centre = DVec3::new(26.926, 44.427498, 12.8755);
     for (r, (x, _)) in l.records.iter().zip(&atoms) {
-        assert!((r.center / 10.0 + centre - *x).abs().max_element() < 2e-3, "{r:?} vs {x}");
+        assert!(
+            (r.center / 10.0 + centre - *x).abs().max_element() < 2e-3,
+            "{r:?} vs {x}"
+        );
     }
     // First atom: `scale 1.85 1.85 1.85` on the unit geodesic, ×10.
-    assert!((l.records[0].radius - 18.5).abs() < 0.1, "{}", l.records[0].radius);
+    assert!(
+        (l.records[0].radius - 18.5).abs() < 0.1,
+        "{}",
+        l.records[0].radius
+    );
     assert!(l.warnings.iter().any(|w| w.contains("1435 IndexedFaceSet")));
 }
 
@@ -139,17 +186,61 @@ fn vrml_ok(body: &str) -> pgt::formats::LoadedParticles {
 #[test]
 fn bad_vrml_names_file_line_and_expectation() {
     let cases: &[(&str, &str, &str)] = &[
-        ("Transform { children [ Shape { geometry Sphere { } } ]\n", "bad.wrl:", "expected '}'"),
-        ("Transform { children [ Shape { geometry Sphere { } }\n}\n", "bad.wrl:", "']'"),
-        ("\n\nFooBar { }\n", "bad.wrl:4", "unknown node type 'FooBar'"),
-        ("Group { children USE Nope }\n", "bad.wrl:2", "undefined name 'Nope'"),
-        ("PROTO Me [] { Me { } }\nMe { }\n", "bad.wrl:2", "instantiates itself"),
-        ("Shape { geometry Sphere { radius nan } }\n", "bad.wrl:2", "expected a field value"),
-        ("Shape { geometry Sphere { radius 1e999 } }\n", "bad.wrl:2", "not finite"),
-        ("Transform { translation 1 2 } \n", "bad.wrl:2", "expected 3 numbers"),
-        ("PROTO P [ field SFFloat r 1 ] { Shape { geometry Sphere { radius IS q } } }\nP { }\n", "bad.wrl:", "not a field"),
-        ("PROTO P [ ] { Group { } }\nP { r 2 }\n", "bad.wrl:3", "no field 'r'"),
-        ("Shape { geometry Sphere { radius \"1 } }\n", "bad.wrl:2", "unterminated string"),
+        (
+            "Transform { children [ Shape { geometry Sphere { } } ]\n",
+            "bad.wrl:",
+            "expected '}'",
+        ),
+        (
+            "Transform { children [ Shape { geometry Sphere { } }\n}\n",
+            "bad.wrl:",
+            "']'",
+        ),
+        (
+            "\n\nFooBar { }\n",
+            "bad.wrl:4",
+            "unknown node type 'FooBar'",
+        ),
+        (
+            "Group { children USE Nope }\n",
+            "bad.wrl:2",
+            "undefined name 'Nope'",
+        ),
+        (
+            "PROTO Me [] { Me { } }\nMe { }\n",
+            "bad.wrl:2",
+            "instantiates itself",
+        ),
+        (
+            "Shape { geometry Sphere { radius nan } }\n",
+            "bad.wrl:2",
+            "expected a field value",
+        ),
+        (
+            "Shape { geometry Sphere { radius 1e999 } }\n",
+            "bad.wrl:2",
+            "not finite",
+        ),
+        (
+            "Transform { translation 1 2 } \n",
+            "bad.wrl:2",
+            "expected 3 numbers",
+        ),
+        (
+            "PROTO P [ field SFFloat r 1 ] { Shape { geometry Sphere { radius IS q } } }\nP { }\n",
+            "bad.wrl:",
+            "not a field",
+        ),
+        (
+            "PROTO P [ ] { Group { } }\nP { r 2 }\n",
+            "bad.wrl:3",
+            "no field 'r'",
+        ),
+        (
+            "Shape { geometry Sphere { radius \"1 } }\n",
+            "bad.wrl:2",
+            "unterminated string",
+        ),
         ("}\n", "bad.wrl:2", "expected a node"),
     ];
     for (body, at, what) in cases {
@@ -165,7 +256,11 @@ fn bad_vrml_names_file_line_and_expectation() {
 
 #[test]
 fn deep_nesting_is_an_error_not_a_stack_overflow() {
-    let body = format!("{}{}", "Group { children [ ".repeat(5000), "] } ".repeat(5000));
+    let body = format!(
+        "{}{}",
+        "Group { children [ ".repeat(5000),
+        "] } ".repeat(5000)
+    );
     assert!(vrml_err(&body).contains("deeper than"));
 }
 
@@ -174,7 +269,10 @@ fn exponential_use_is_bounded() {
     // Each level USEs the previous one 10 times: 10^12 spheres if expanded.
     let mut s = String::from("DEF L0 Shape { geometry Sphere { } }\n");
     for k in 1..=12 {
-        s += &format!("DEF L{k} Group {{ children [ {} ] }}\n", vec![format!("USE L{}", k - 1); 10].join(" "));
+        s += &format!(
+            "DEF L{k} Group {{ children [ {} ] }}\n",
+            vec![format!("USE L{}", k - 1); 10].join(" ")
+        );
     }
     assert!(vrml_err(&s).contains("expands to more than"));
 }
@@ -209,6 +307,9 @@ fn switch_def_use_material_and_transparency() {
          Switch { choice Shape { geometry Sphere { } } }\n",
     );
     assert_eq!(l.records.len(), 2);
-    assert!(l.records.iter().all(|r| r.radius == 2.0 && r.color == Some(DVec3::X) && r.opacity == Some(0.75)));
+    assert!(l
+        .records
+        .iter()
+        .all(|r| r.radius == 2.0 && r.color == Some(DVec3::X) && r.opacity == Some(0.75)));
     assert_eq!(l.records[1].center, DVec3::new(5.0, 0.0, 0.0));
 }

@@ -46,7 +46,9 @@ fn parse_box(s: &str) -> anyhow::Result<(DVec3, DVec3)> {
         .split(',')
         .map(|t| t.trim().parse::<f64>())
         .collect::<Result<_, _>>()
-        .map_err(|_| anyhow::anyhow!("--box: expected a side length S or x0,y0,z0,x1,y1,z1, got '{s}'"))?;
+        .map_err(|_| {
+            anyhow::anyhow!("--box: expected a side length S or x0,y0,z0,x1,y1,z1, got '{s}'")
+        })?;
     let (lo, hi) = match v.as_slice() {
         [side] => (DVec3::splat(-side / 2.0), DVec3::splat(side / 2.0)),
         [a, b, c, d, e, f] => (DVec3::new(*a, *b, *c), DVec3::new(*d, *e, *f)),
@@ -59,9 +61,13 @@ fn parse_box(s: &str) -> anyhow::Result<(DVec3, DVec3)> {
 }
 
 fn parse_radius(s: &str) -> anyhow::Result<(f64, f64)> {
-    let bad = || anyhow::anyhow!("--radius: expected a..b with 0 < a ≤ b (or one value > 0), got '{s}'");
+    let bad =
+        || anyhow::anyhow!("--radius: expected a..b with 0 < a ≤ b (or one value > 0), got '{s}'");
     let (a, b) = match s.split_once("..") {
-        Some((a, b)) => (a.trim().parse::<f64>().map_err(|_| bad())?, b.trim().parse::<f64>().map_err(|_| bad())?),
+        Some((a, b)) => (
+            a.trim().parse::<f64>().map_err(|_| bad())?,
+            b.trim().parse::<f64>().map_err(|_| bad())?,
+        ),
         None => {
             let r = s.trim().parse::<f64>().map_err(|_| bad())?;
             (r, r)
@@ -88,7 +94,11 @@ pub fn run(args: GenArgs) -> anyhow::Result<Outcome> {
             };
             let text = to_csv(&generate(&spec));
             write_atomically(&a.output, text.as_bytes())?;
-            eprintln!("wrote {} random particles to {}", a.count, a.output.display());
+            eprintln!(
+                "wrote {} random particles to {}",
+                a.count,
+                a.output.display()
+            );
             Ok(Outcome::Success)
         }
     }
@@ -102,7 +112,9 @@ fn write_atomically(path: &std::path::Path, bytes: &[u8]) -> crate::Result<()> {
         _ => std::path::Path::new("."),
     };
     let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| crate::PgtError::io(path, e))?;
-    tmp.write_all(bytes).map_err(|e| crate::PgtError::io(path, e))?;
-    tmp.persist(path).map_err(|e| crate::PgtError::io(path, e.error))?;
+    tmp.write_all(bytes)
+        .map_err(|e| crate::PgtError::io(path, e))?;
+    tmp.persist(path)
+        .map_err(|e| crate::PgtError::io(path, e.error))?;
     Ok(())
 }

@@ -87,7 +87,11 @@ pub fn summarize(
         rmax = rmax.max(r);
         rsum += r;
         match col {
-            Some(c) => *counts.entry([c.x.to_bits(), c.y.to_bits(), c.z.to_bits()]).or_insert(0) += 1,
+            Some(c) => {
+                *counts
+                    .entry([c.x.to_bits(), c.y.to_bits(), c.z.to_bits()])
+                    .or_insert(0) += 1
+            }
             None => uncolored += 1,
         }
     }
@@ -124,16 +128,25 @@ pub fn summarize(
 
 /// Loads a file and summarises it.
 pub fn info_of(path: &std::path::Path) -> crate::Result<Info> {
-    let is_toml = path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    let is_toml = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
     let name = path.display().to_string();
     if is_toml {
         let scene = Scene::load(path, &SceneLoadOptions::default())?;
-        let it = scene.particles.iter().map(|p| (p.center, p.radius, Some(p.color)));
+        let it = scene
+            .particles
+            .iter()
+            .map(|p| (p.center, p.radius, Some(p.color)));
         Ok(summarize(name, "scene".into(), it, scene.warnings.clone()))
     } else {
         let loaded = load_particles(&IncludeSpec::bare(path))?;
         let format = Format::from_path(path).map_or("unknown".to_string(), |f| {
-            serde_json::to_value(f).ok().and_then(|v| v.as_str().map(String::from)).unwrap_or_default()
+            serde_json::to_value(f)
+                .ok()
+                .and_then(|v| v.as_str().map(String::from))
+                .unwrap_or_default()
         });
         let it = loaded.records.iter().map(|r| (r.center, r.radius, r.color));
         Ok(summarize(name, format, it, loaded.warnings))
@@ -152,10 +165,16 @@ pub fn run(args: InfoArgs) -> anyhow::Result<Outcome> {
     if let (Some(b), Some(r)) = (&info.bounds, &info.radius) {
         let v = |a: [f64; 3]| format!("[{:.4}, {:.4}, {:.4}]", a[0], a[1], a[2]);
         println!("bounds:    {} .. {}", v(b.min), v(b.max));
-        println!("radius:    {:.4} .. {:.4} (mean {:.4})", r.min, r.max, r.mean);
+        println!(
+            "radius:    {:.4} .. {:.4} (mean {:.4})",
+            r.min, r.max, r.mean
+        );
     }
     let c = &info.colors;
-    println!("colours:   {} distinct, {} without a colour (scene default)", c.distinct, c.uncolored);
+    println!(
+        "colours:   {} distinct, {} without a colour (scene default)",
+        c.distinct, c.uncolored
+    );
     for cc in &c.most_common {
         println!(
             "           linear RGB [{:.4}, {:.4}, {:.4}] × {}",

@@ -33,18 +33,22 @@ pub struct Atom {
 }
 
 /// Residue names of water (PDB, Amber, CHARMM, GROMACS spellings).
-const WATER_NAMES: &[&str] = &["HOH", "WAT", "H2O", "DOD", "D2O", "TIP", "TIP3", "TIP4", "SPC", "SOL"];
+const WATER_NAMES: &[&str] = &[
+    "HOH", "WAT", "H2O", "DOD", "D2O", "TIP", "TIP3", "TIP4", "SPC", "SOL",
+];
 
 /// Chain colours, 8-bit sRGB: the Okabe–Ito colour-blind-safe set followed by Tableau 10;
 /// chain i (in order of first appearance) gets entry i mod the length.
 const CHAIN_PALETTE_SRGB8: &[u32] = &[
-    0xE69F00, 0x56B4E9, 0x009E73, 0xF0E442, 0x0072B2, 0xD55E00, 0xCC79A7, 0x999999, 0x4E79A7, 0xF28E2B, 0xE15759,
-    0x76B7B2, 0x59A14F, 0xEDC948, 0xB07AA1, 0xFF9DA7, 0x9C755F, 0xBAB0AC,
+    0xE69F00, 0x56B4E9, 0x009E73, 0xF0E442, 0x0072B2, 0xD55E00, 0xCC79A7, 0x999999, 0x4E79A7,
+    0xF28E2B, 0xE15759, 0x76B7B2, 0x59A14F, 0xEDC948, 0xB07AA1, 0xFF9DA7, 0x9C755F, 0xBAB0AC,
 ];
 
 /// Whether a residue name is water.
 pub fn is_water(residue_name: &str) -> bool {
-    WATER_NAMES.iter().any(|w| w.eq_ignore_ascii_case(residue_name.trim()))
+    WATER_NAMES
+        .iter()
+        .any(|w| w.eq_ignore_ascii_case(residue_name.trim()))
 }
 
 /// Infers the element from a PDB-style atom name (four characters, element right-justified in the
@@ -57,9 +61,18 @@ pub fn infer_element(name: &str, hetatm: bool) -> Option<Element> {
     let first_is_letter = chars.first().is_some_and(|c| c.is_ascii_alphabetic());
     // A full-width name starting with H (`HG21`, `HO2A`) is a hydrogen, not mercury or holmium;
     // after a two-letter element only digits or blanks may follow (`FE1`, `CL2`).
-    let full_width_h = chars.len() >= 4 && chars.iter().all(|c| !c.is_whitespace()) && chars.first() == Some(&'H');
-    let rest_plain = chars.iter().skip(2).all(|c| c.is_ascii_digit() || c.is_whitespace());
-    if hetatm && first_is_letter && !full_width_h && rest_plain && chars.get(1).is_some_and(|c| c.is_ascii_alphabetic()) {
+    let full_width_h =
+        chars.len() >= 4 && chars.iter().all(|c| !c.is_whitespace()) && chars.first() == Some(&'H');
+    let rest_plain = chars
+        .iter()
+        .skip(2)
+        .all(|c| c.is_ascii_digit() || c.is_whitespace());
+    if hetatm
+        && first_is_letter
+        && !full_width_h
+        && rest_plain
+        && chars.get(1).is_some_and(|c| c.is_ascii_alphabetic())
+    {
         let two: String = chars.iter().take(2).collect();
         if let Some(e) = Element::from_symbol(&two) {
             return Some(e);
@@ -71,7 +84,11 @@ pub fn infer_element(name: &str, hetatm: bool) -> Option<Element> {
 
 /// Applies the selections of `spec` to `atoms` (all models, all alternate locations) and makes
 /// particles: radius = van der Waals radius × `radius_scale` is applied later by the caller.
-pub fn atoms_to_particles(spec: &IncludeSpec, atoms: Vec<Atom>, mut warnings: Vec<String>) -> Result<LoadedParticles> {
+pub fn atoms_to_particles(
+    spec: &IncludeSpec,
+    atoms: Vec<Atom>,
+    mut warnings: Vec<String>,
+) -> Result<LoadedParticles> {
     let path = &spec.path;
     // Model: the requested one, or the first that appears.
     let models: Vec<i64> = {
@@ -108,8 +125,15 @@ pub fn atoms_to_particles(spec: &IncludeSpec, atoms: Vec<Atom>, mut warnings: Ve
         ));
     }
     if let Some(chains) = &spec.chains {
-        let present: BTreeSet<&str> = atoms.iter().filter(|a| a.model == model).map(|a| a.chain.as_str()).collect();
-        let missing: Vec<&String> = chains.iter().filter(|c| !present.contains(c.as_str())).collect();
+        let present: BTreeSet<&str> = atoms
+            .iter()
+            .filter(|a| a.model == model)
+            .map(|a| a.chain.as_str())
+            .collect();
+        let missing: Vec<&String> = chains
+            .iter()
+            .filter(|c| !present.contains(c.as_str()))
+            .collect();
         if !missing.is_empty() {
             return Err(PgtError::in_file(
                 path,
@@ -166,7 +190,7 @@ pub fn atoms_to_particles(spec: &IncludeSpec, atoms: Vec<Atom>, mut warnings: Ve
     let mut records = Vec::with_capacity(kept.len());
     for a in kept {
         if let Some(chains) = &spec.chains {
-            if !chains.iter().any(|c| *c == a.chain) {
+            if !chains.contains(&a.chain) {
                 continue;
             }
         }
@@ -188,7 +212,10 @@ pub fn atoms_to_particles(spec: &IncludeSpec, atoms: Vec<Atom>, mut warnings: Ve
         let color = match spec.color_by {
             ColorBy::Element => Some(element_color(a.element)),
             ColorBy::Chain => Some(srgb8_hex_to_linear(
-                CHAIN_PALETTE_SRGB8.get(ci % CHAIN_PALETTE_SRGB8.len()).copied().unwrap_or(0xFFFFFF),
+                CHAIN_PALETTE_SRGB8
+                    .get(ci % CHAIN_PALETTE_SRGB8.len())
+                    .copied()
+                    .unwrap_or(0xFFFFFF),
             )),
             ColorBy::Uniform => None,
         };

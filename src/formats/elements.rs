@@ -142,7 +142,11 @@ impl Element {
 
     /// Jmol's CPK colour, linear RGB.
     pub fn color(self) -> glam::DVec3 {
-        srgb8_hex_to_linear(ELEMENTS.get(self.index).map_or(FALLBACK_COLOR_SRGB8, |e| e.2))
+        srgb8_hex_to_linear(
+            ELEMENTS
+                .get(self.index)
+                .map_or(FALLBACK_COLOR_SRGB8, |e| e.2),
+        )
     }
 }
 
@@ -153,7 +157,9 @@ pub fn element_color(element: Option<Element>) -> glam::DVec3 {
 
 /// The radius of an element in Å ([`FALLBACK_RADIUS`] where none is tabulated).
 pub fn element_radius(element: Option<Element>) -> f64 {
-    element.and_then(Element::vdw_radius).unwrap_or(FALLBACK_RADIUS)
+    element
+        .and_then(Element::vdw_radius)
+        .unwrap_or(FALLBACK_RADIUS)
 }
 
 /// IEC 61966-2-1 sRGB decoding of one channel in [0, 1] to linear.
@@ -200,7 +206,9 @@ mod tests {
         assert_eq!(srgb_to_linear(0.0), 0.0);
         assert!((srgb_to_linear(1.0) - 1.0).abs() < 1e-12);
         // 0x90 = 144: (144/255 + 0.055)/1.055)^2.4 ≈ 0.2789
-        let c = Element::from_symbol("C").map(Element::color).unwrap_or_default();
+        let c = Element::from_symbol("C")
+            .map(Element::color)
+            .unwrap_or_default();
         assert!((c.x - 0.278894).abs() < 1e-5, "{c}");
         assert_eq!(c.x, c.y);
     }

@@ -94,10 +94,17 @@ fn tokenize<'a>(path: &Path, text: &'a str) -> Result<Vec<Token<'a>>> {
                         return Err(PgtError::at_line(
                             path,
                             line,
-                            format!("unterminated quoted string: expected a closing {}", c as char),
+                            format!(
+                                "unterminated quoted string: expected a closing {}",
+                                c as char
+                            ),
                         ))
                     }
-                    Some(&q) if q == c && bytes.get(j + 1).is_none_or(|n| n.is_ascii_whitespace()) => break,
+                    Some(&q)
+                        if q == c && bytes.get(j + 1).is_none_or(|n| n.is_ascii_whitespace()) =>
+                    {
+                        break
+                    }
                     Some(_) => j += 1,
                 }
             }
@@ -122,7 +129,11 @@ fn tokenize<'a>(path: &Path, text: &'a str) -> Result<Vec<Token<'a>>> {
 
 fn is_reserved(w: &str) -> bool {
     let l = w.to_ascii_lowercase();
-    l == "loop_" || l.starts_with("data_") || l.starts_with("save_") || l == "global_" || l == "stop_"
+    l == "loop_"
+        || l.starts_with("data_")
+        || l.starts_with("save_")
+        || l == "global_"
+        || l == "stop_"
 }
 
 /// A value with its line; `None` for `.` and `?`.
@@ -149,7 +160,11 @@ fn atom_site_table(path: &Path, toks: &[Token]) -> Result<(Vec<String>, Vec<Vec<
             let mut j = i + 1;
             while let Some(t) = toks.get(j).filter(|t| is_atom_tag(t)) {
                 if let Tok::Word(w) = t.tok {
-                    names.push(w.get(PREFIX.len()..).unwrap_or_default().to_ascii_lowercase());
+                    names.push(
+                        w.get(PREFIX.len()..)
+                            .unwrap_or_default()
+                            .to_ascii_lowercase(),
+                    );
                 }
                 j += 1;
             }
@@ -173,7 +188,10 @@ fn atom_site_table(path: &Path, toks: &[Token]) -> Result<(Vec<String>, Vec<Vec<
                     ),
                 ));
             }
-            let rows = values.chunks(names.len().max(1)).map(<[Value]>::to_vec).collect();
+            let rows = values
+                .chunks(names.len().max(1))
+                .map(<[Value]>::to_vec)
+                .collect();
             return Ok((names, rows));
         }
         i += 1;
@@ -186,16 +204,28 @@ fn atom_site_table(path: &Path, toks: &[Token]) -> Result<(Vec<String>, Vec<Vec<
         if let Some(t) = toks.get(k).filter(|t| is_atom_tag(t)) {
             if let Tok::Word(w) = t.tok {
                 let v = toks.get(k + 1).ok_or_else(|| {
-                    PgtError::at_line(path, t.line, format!("expected a value after {w}, found the end of the file"))
+                    PgtError::at_line(
+                        path,
+                        t.line,
+                        format!("expected a value after {w}, found the end of the file"),
+                    )
                 })?;
-                names.push(w.get(PREFIX.len()..).unwrap_or_default().to_ascii_lowercase());
+                names.push(
+                    w.get(PREFIX.len()..)
+                        .unwrap_or_default()
+                        .to_ascii_lowercase(),
+                );
                 row.push(value_of(v));
                 k += 1;
             }
         }
         k += 1;
     }
-    let rows = if row.is_empty() { Vec::new() } else { vec![row] };
+    let rows = if row.is_empty() {
+        Vec::new()
+    } else {
+        vec![row]
+    };
     Ok((names, rows))
 }
 
@@ -212,7 +242,12 @@ pub fn read_atoms(path: &Path, bytes: &[u8]) -> Result<(Vec<Atom>, Vec<String>)>
     let col = |n: &str| names.iter().position(|c| c == n);
     let first = |ns: &[&str]| ns.iter().find_map(|n| col(n));
     let need = |n: &str| {
-        col(n).ok_or_else(|| PgtError::in_file(path, format!("the _atom_site table has no _atom_site.{n} column")))
+        col(n).ok_or_else(|| {
+            PgtError::in_file(
+                path,
+                format!("the _atom_site table has no _atom_site.{n} column"),
+            )
+        })
     };
     let (cx, cy, cz) = (need("cartn_x")?, need("cartn_y")?, need("cartn_z")?);
     let c_elem = col("type_symbol");
@@ -232,11 +267,25 @@ pub fn read_atoms(path: &Path, bytes: &[u8]) -> Result<(Vec<Atom>, Vec<String>)>
         let line = row.first().map_or(1, |v| v.1);
         let number = |c: usize, what: &str| -> Result<f64> {
             let (v, l) = row.get(c).cloned().unwrap_or((None, line));
-            let s = v.ok_or_else(|| PgtError::at_line(path, l, format!("expected a number for {what}, found '.' or '?'")))?;
+            let s = v.ok_or_else(|| {
+                PgtError::at_line(
+                    path,
+                    l,
+                    format!("expected a number for {what}, found '.' or '?'"),
+                )
+            })?;
             match s.parse::<f64>() {
                 Ok(x) if x.is_finite() => Ok(x),
-                Ok(_) => Err(PgtError::at_line(path, l, format!("{what} is not finite: '{s}'"))),
-                Err(_) => Err(PgtError::at_line(path, l, format!("expected a number for {what}, found '{s}'"))),
+                Ok(_) => Err(PgtError::at_line(
+                    path,
+                    l,
+                    format!("{what} is not finite: '{s}'"),
+                )),
+                Err(_) => Err(PgtError::at_line(
+                    path,
+                    l,
+                    format!("expected a number for {what}, found '{s}'"),
+                )),
             }
         };
         let position = DVec3::new(
@@ -255,7 +304,11 @@ pub fn read_atoms(path: &Path, bytes: &[u8]) -> Result<(Vec<Atom>, Vec<String>)>
             .or_else(|| infer_element(&format!("{name:<4}"), hetatm));
         let model = match get(c_model) {
             Some(m) => m.parse::<i64>().map_err(|_| {
-                PgtError::at_line(path, line, format!("expected an integer for _atom_site.pdbx_PDB_model_num, found '{m}'"))
+                PgtError::at_line(
+                    path,
+                    line,
+                    format!("expected an integer for _atom_site.pdbx_PDB_model_num, found '{m}'"),
+                )
             })?,
             None => 1,
         };
@@ -267,7 +320,11 @@ pub fn read_atoms(path: &Path, bytes: &[u8]) -> Result<(Vec<Atom>, Vec<String>)>
             occupancy,
             residue_name: get(c_res).unwrap_or_default(),
             chain: get(c_chain).unwrap_or_default(),
-            residue: format!("{}{}", get(c_seq).unwrap_or_default(), get(c_ins).unwrap_or_default()),
+            residue: format!(
+                "{}{}",
+                get(c_seq).unwrap_or_default(),
+                get(c_ins).unwrap_or_default()
+            ),
             model,
             line,
         });
@@ -293,13 +350,17 @@ mod tests {
     #[test]
     fn incomplete_row_is_an_error() {
         let text = "data_x\nloop_\n_atom_site.Cartn_x\n_atom_site.Cartn_y\n_atom_site.Cartn_z\n1 2 3\n4 5\n";
-        let e = read_atoms(Path::new("t.cif"), text.as_bytes()).expect_err("bad").to_string();
+        let e = read_atoms(Path::new("t.cif"), text.as_bytes())
+            .expect_err("bad")
+            .to_string();
         assert!(e.contains("t.cif:7") && e.contains("multiple"), "{e}");
     }
 
     #[test]
     fn unterminated_text_field() {
-        let e = read_atoms(Path::new("t.cif"), b"data_x\n;abc\n").expect_err("bad").to_string();
+        let e = read_atoms(Path::new("t.cif"), b"data_x\n;abc\n")
+            .expect_err("bad")
+            .to_string();
         assert!(e.contains("t.cif:2"), "{e}");
     }
 }

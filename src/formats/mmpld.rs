@@ -56,7 +56,11 @@ impl<'a> Cursor<'a> {
             None => Err(PgtError::at_byte(
                 self.path,
                 self.pos as u64,
-                format!("expected {what} ({n} bytes), but the {} ends at byte {}", self.region(), self.end),
+                format!(
+                    "expected {what} ({n} bytes), but the {} ends at byte {}",
+                    self.region(),
+                    self.end
+                ),
             )),
         }
     }
@@ -130,12 +134,20 @@ fn byte(b: &[u8], at: usize) -> f64 {
 
 /// sRGB display value (any range) to linear, negatives clamped to 0.
 fn display_to_linear(c: DVec3) -> DVec3 {
-    DVec3::new(srgb_to_linear(c.x.max(0.0)), srgb_to_linear(c.y.max(0.0)), srgb_to_linear(c.z.max(0.0)))
+    DVec3::new(
+        srgb_to_linear(c.x.max(0.0)),
+        srgb_to_linear(c.y.max(0.0)),
+        srgb_to_linear(c.z.max(0.0)),
+    )
 }
 
 /// The grey-ramp colour map for intensities.
 fn intensity_color(i: f64, min: f64, max: f64) -> DVec3 {
-    let t = if max > min { ((i - min) / (max - min)).clamp(0.0, 1.0) } else { 0.0 };
+    let t = if max > min {
+        ((i - min) / (max - min)).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
     let t = if t.is_finite() { t } else { 0.0 };
     DVec3::splat(srgb_to_linear(t))
 }
@@ -159,7 +171,10 @@ fn header_and_table(path: &Path, bytes: &[u8]) -> Result<(Header, Vec<u64>)> {
     };
     let magic = c.arr::<6>("the magic \"MMPLD\\0\"")?;
     if &magic != MAGIC {
-        return Err(c.err(0, format!("not an MMPLD file: expected the magic \"MMPLD\\0\", found {magic:?}")));
+        return Err(c.err(
+            0,
+            format!("not an MMPLD file: expected the magic \"MMPLD\\0\", found {magic:?}"),
+        ));
     }
     let version = c.u16("the version")?;
     if !(100..=103).contains(&version) {
@@ -231,7 +246,10 @@ pub fn load(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
         return Err(PgtError::at_byte(
             path,
             10,
-            format!("frame {frame} requested, but the file has {} frame(s) (0-based)", h.frames),
+            format!(
+                "frame {frame} requested, but the file has {} frame(s) (0-based)",
+                h.frames
+            ),
         ));
     }
     let (start, end) = match (table.get(frame), table.get(frame + 1)) {
@@ -242,16 +260,18 @@ pub fn load(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
     let first = parse_frame(path, bytes, start, end, h.version, with_ts);
     let records = match first {
         Ok(r) => r,
-        Err(e) if h.version == 103 => match parse_frame(path, bytes, start, end, h.version, false) {
-            Ok(r) => {
-                warnings.push(format!(
+        Err(e) if h.version == 103 => {
+            match parse_frame(path, bytes, start, end, h.version, false) {
+                Ok(r) => {
+                    warnings.push(format!(
                     "{}: frame {frame} of this version-1.3 file has no timestamp (a known MegaMol writer bug); read it without",
                     path.display()
                 ));
-                r
+                    r
+                }
+                Err(_) => return Err(e),
             }
-            Err(_) => return Err(e),
-        },
+        }
         Err(e) => return Err(e),
     };
     Ok(LoadedParticles { records, warnings })
@@ -265,7 +285,12 @@ fn parse_frame(
     version: u16,
     timestamp: bool,
 ) -> Result<Vec<ParticleRecord>> {
-    let mut c = Cursor { bytes, pos: start, end, path };
+    let mut c = Cursor {
+        bytes,
+        pos: start,
+        end,
+        path,
+    };
     if timestamp {
         c.f32("the frame timestamp")?;
     }
@@ -294,17 +319,31 @@ fn parse_frame(
             4 => 12,
             5 => 16,
             6 | 7 => 8,
-            _ => return Err(c.err(vt_at + 1, format!("unknown colour type {ct} (expected 0–7)"))),
+            _ => {
+                return Err(c.err(
+                    vt_at + 1,
+                    format!("unknown colour type {ct} (expected 0–7)"),
+                ))
+            }
         };
-        let global_radius = if matches!(vt, 1 | 3 | 4) { f64::from(c.f32("the global radius")?) } else { 1.0 };
+        let global_radius = if matches!(vt, 1 | 3 | 4) {
+            f64::from(c.f32("the global radius")?)
+        } else {
+            1.0
+        };
         let global_color = if ct == 0 {
             let rgba = c.arr::<4>("the global RGBA colour")?;
-            display_to_linear(DVec3::new(f64::from(rgba[0]), f64::from(rgba[1]), f64::from(rgba[2])) / 255.0)
+            display_to_linear(
+                DVec3::new(f64::from(rgba[0]), f64::from(rgba[1]), f64::from(rgba[2])) / 255.0,
+            )
         } else {
             DVec3::ONE
         };
         let (imin, imax) = if matches!(ct, 3 | 7) {
-            (f64::from(c.f32("the intensity minimum")?), f64::from(c.f32("the intensity maximum")?))
+            (
+                f64::from(c.f32("the intensity minimum")?),
+                f64::from(c.f32("the intensity maximum")?),
+            )
         } else {
             (0.0, 1.0)
         };
@@ -314,7 +353,9 @@ fn parse_frame(
             c.take(24, "the list bounding box")?;
         }
         let stride = if vt == 0 { 0 } else { vstride + cstride };
-        let data_bytes = (stride as u64).checked_mul(count).filter(|&n| n <= (end.saturating_sub(c.pos)) as u64);
+        let data_bytes = (stride as u64)
+            .checked_mul(count)
+            .filter(|&n| n <= (end.saturating_sub(c.pos)) as u64);
         let Some(data_bytes) = data_bytes else {
             return Err(c.err(
                 count_at,
@@ -330,23 +371,46 @@ fn parse_frame(
             out.reserve(count as usize);
             for (k, p) in data.chunks_exact(stride).enumerate() {
                 let (center, radius) = match vt {
-                    1 => (DVec3::new(le_f32(p, 0), le_f32(p, 4), le_f32(p, 8)), global_radius),
-                    2 => (DVec3::new(le_f32(p, 0), le_f32(p, 4), le_f32(p, 8)), le_f32(p, 12)),
-                    3 => (DVec3::new(le_i16(p, 0), le_i16(p, 2), le_i16(p, 4)), global_radius),
-                    _ => (DVec3::new(le_f64(p, 0), le_f64(p, 8), le_f64(p, 16)), global_radius),
+                    1 => (
+                        DVec3::new(le_f32(p, 0), le_f32(p, 4), le_f32(p, 8)),
+                        global_radius,
+                    ),
+                    2 => (
+                        DVec3::new(le_f32(p, 0), le_f32(p, 4), le_f32(p, 8)),
+                        le_f32(p, 12),
+                    ),
+                    3 => (
+                        DVec3::new(le_i16(p, 0), le_i16(p, 2), le_i16(p, 4)),
+                        global_radius,
+                    ),
+                    _ => (
+                        DVec3::new(le_f64(p, 0), le_f64(p, 8), le_f64(p, 16)),
+                        global_radius,
+                    ),
                 };
                 let o = vstride;
                 let color = match ct {
                     0 => global_color,
-                    1 | 2 => display_to_linear(DVec3::new(byte(p, o), byte(p, o + 1), byte(p, o + 2)) / 255.0),
+                    1 | 2 => display_to_linear(
+                        DVec3::new(byte(p, o), byte(p, o + 1), byte(p, o + 2)) / 255.0,
+                    ),
                     3 => intensity_color(le_f32(p, o), imin, imax),
-                    4 | 5 => display_to_linear(DVec3::new(le_f32(p, o), le_f32(p, o + 4), le_f32(p, o + 8))),
-                    6 => display_to_linear(DVec3::new(le_u16(p, o), le_u16(p, o + 2), le_u16(p, o + 4)) / 65535.0),
+                    4 | 5 => display_to_linear(DVec3::new(
+                        le_f32(p, o),
+                        le_f32(p, o + 4),
+                        le_f32(p, o + 8),
+                    )),
+                    6 => display_to_linear(
+                        DVec3::new(le_u16(p, o), le_u16(p, o + 2), le_u16(p, o + 4)) / 65535.0,
+                    ),
                     _ => intensity_color(le_f64(p, o), imin, imax),
                 };
                 let at = data_at + k * stride;
                 if !center.is_finite() || !color.is_finite() {
-                    return Err(c.err(at, format!("particle {k} of the list has a non-finite position or colour")));
+                    return Err(c.err(
+                        at,
+                        format!("particle {k} of the list has a non-finite position or colour"),
+                    ));
                 }
                 out.push(ParticleRecord {
                     center,
@@ -364,7 +428,12 @@ fn parse_frame(
             let size = usize::try_from(size)
                 .ok()
                 .filter(|&s| s <= end.saturating_sub(c.pos))
-                .ok_or_else(|| c.err(size_at, format!("cluster data of {size} bytes does not fit in the frame")))?;
+                .ok_or_else(|| {
+                    c.err(
+                        size_at,
+                        format!("cluster data of {size} bytes does not fit in the frame"),
+                    )
+                })?;
             c.take(size, "the cluster data")?;
         }
     }
@@ -439,8 +508,13 @@ mod tests {
 
     #[test]
     fn lying_count_is_an_error_not_an_allocation() {
-        let e = load(&spec(), &one_list(102, true, 2, u64::MAX / 2)).expect_err("lie").to_string();
-        assert!(e.contains("t.mmpld (byte") && e.contains("particles"), "{e}");
+        let e = load(&spec(), &one_list(102, true, 2, u64::MAX / 2))
+            .expect_err("lie")
+            .to_string();
+        assert!(
+            e.contains("t.mmpld (byte") && e.contains("particles"),
+            "{e}"
+        );
     }
 
     #[test]

@@ -35,7 +35,9 @@ pub struct LoadedParticles {
 }
 
 /// The particle file formats pgt reads.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum Format {
     Pdb,
@@ -69,12 +71,18 @@ pub const MAX_FILE_BYTES: u64 = 4 << 30;
 pub fn read_input(path: &Path) -> Result<Vec<u8>> {
     let meta = std::fs::metadata(path).map_err(|e| PgtError::io(path, e))?;
     if meta.is_dir() {
-        return Err(PgtError::in_file(path, "is a directory, not a particle file"));
+        return Err(PgtError::in_file(
+            path,
+            "is a directory, not a particle file",
+        ));
     }
     if meta.len() > MAX_FILE_BYTES {
         return Err(PgtError::in_file(
             path,
-            format!("the file is {} bytes; pgt reads particle files of at most {MAX_FILE_BYTES} bytes", meta.len()),
+            format!(
+                "the file is {} bytes; pgt reads particle files of at most {MAX_FILE_BYTES} bytes",
+                meta.len()
+            ),
         ));
     }
     std::fs::read(path).map_err(|e| PgtError::io(path, e))
@@ -86,7 +94,11 @@ pub fn load_particles(spec: &IncludeSpec) -> Result<LoadedParticles> {
     let format = match spec.format.or_else(|| Format::from_path(&spec.path)) {
         Some(f) => f,
         None => {
-            let ext = spec.path.extension().and_then(|e| e.to_str()).unwrap_or_default();
+            let ext = spec
+                .path
+                .extension()
+                .and_then(|e| e.to_str())
+                .unwrap_or_default();
             return Err(PgtError::in_file(
                 &spec.path,
                 format!(
@@ -114,7 +126,10 @@ fn check_records(path: &Path, records: &[ParticleRecord]) -> Result<()> {
         let problem = if !r.center.is_finite() {
             Some(format!("the particle position {} is not finite", r.center))
         } else if !(r.radius.is_finite() && r.radius > 0.0) {
-            Some(format!("the particle radius must be finite and > 0, got {}", r.radius))
+            Some(format!(
+                "the particle radius must be finite and > 0, got {}",
+                r.radius
+            ))
         } else {
             None
         };

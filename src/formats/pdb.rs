@@ -25,12 +25,28 @@ pub fn read_atoms(path: &Path, bytes: &[u8]) -> Result<(Vec<Atom>, Vec<String>)>
         let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
         let record = field(raw, 1, 6);
         match record.trim_end() {
-            "ATOM" | "HETATM" => atoms.push(atom(path, raw, line_no, model, record.starts_with("HETATM"))?),
+            "ATOM" | "HETATM" => atoms.push(atom(
+                path,
+                raw,
+                line_no,
+                model,
+                record.starts_with("HETATM"),
+            )?),
             "MODEL" => {
-                let rest = String::from_utf8_lossy(raw.get(6..).unwrap_or_default()).trim().to_string();
-                model = rest.split_whitespace().next().and_then(|s| s.parse().ok()).ok_or_else(|| {
-                    PgtError::at_line(path, line_no, format!("expected a model number after MODEL, found '{rest}'"))
-                })?;
+                let rest = String::from_utf8_lossy(raw.get(6..).unwrap_or_default())
+                    .trim()
+                    .to_string();
+                model = rest
+                    .split_whitespace()
+                    .next()
+                    .and_then(|s| s.parse().ok())
+                    .ok_or_else(|| {
+                        PgtError::at_line(
+                            path,
+                            line_no,
+                            format!("expected a model number after MODEL, found '{rest}'"),
+                        )
+                    })?;
             }
             _ => {}
         }
@@ -45,20 +61,33 @@ fn field(line: &[u8], from: usize, to: usize) -> String {
     String::from_utf8_lossy(line.get(start..end).unwrap_or_default()).into_owned()
 }
 
-fn coordinate(path: &Path, line: &[u8], line_no: usize, axis: &str, from: usize, to: usize) -> Result<f64> {
+fn coordinate(
+    path: &Path,
+    line: &[u8],
+    line_no: usize,
+    axis: &str,
+    from: usize,
+    to: usize,
+) -> Result<f64> {
     let text = field(line, from, to);
     let v: f64 = text.trim().parse().map_err(|_| {
         PgtError::at_line(
             path,
             line_no,
-            format!("expected the {axis} coordinate (a number) in columns {from}–{to}, found '{}'", text.trim()),
+            format!(
+                "expected the {axis} coordinate (a number) in columns {from}–{to}, found '{}'",
+                text.trim()
+            ),
         )
     })?;
     if !v.is_finite() {
         return Err(PgtError::at_line(
             path,
             line_no,
-            format!("the {axis} coordinate in columns {from}–{to} is not finite: '{}'", text.trim()),
+            format!(
+                "the {axis} coordinate in columns {from}–{to} is not finite: '{}'",
+                text.trim()
+            ),
         ));
     }
     Ok(v)
@@ -78,14 +107,22 @@ fn atom(path: &Path, raw: &[u8], line_no: usize, model: i64, hetatm: bool) -> Re
                 return Err(PgtError::at_line(
                     path,
                     line_no,
-                    format!("expected the occupancy (a number) in columns 55–60, found '{}'", occ_text.trim()),
+                    format!(
+                        "expected the occupancy (a number) in columns 55–60, found '{}'",
+                        occ_text.trim()
+                    ),
                 ))
             }
         }
     };
     let name_field = field(raw, 13, 16);
     let element_field = field(raw, 77, 78);
-    let element = if element_field.trim().chars().all(|c| c.is_ascii_alphabetic()) && !element_field.trim().is_empty() {
+    let element = if element_field
+        .trim()
+        .chars()
+        .all(|c| c.is_ascii_alphabetic())
+        && !element_field.trim().is_empty()
+    {
         Element::from_symbol(&element_field).or_else(|| infer_element(&name_field, hetatm))
     } else {
         infer_element(&name_field, hetatm)
@@ -110,7 +147,8 @@ fn atom(path: &Path, raw: &[u8], line_no: usize, model: i64, hetatm: bool) -> Re
 mod tests {
     use super::*;
 
-    const LINE: &str = "ATOM      2  CA  ALA A   2      63.914 -67.078 -16.894  1.00 17.23           C  ";
+    const LINE: &str =
+        "ATOM      2  CA  ALA A   2      63.914 -67.078 -16.894  1.00 17.23           C  ";
 
     #[test]
     fn reads_columns() {
@@ -125,14 +163,18 @@ mod tests {
     #[test]
     fn short_line_is_an_error_with_line() {
         let text = format!("HEADER\n{}\n", &LINE[..40]);
-        let e = read_atoms(Path::new("t.pdb"), text.as_bytes()).expect_err("short").to_string();
+        let e = read_atoms(Path::new("t.pdb"), text.as_bytes())
+            .expect_err("short")
+            .to_string();
         assert!(e.contains("t.pdb:2") && e.contains("y coordinate"), "{e}");
     }
 
     #[test]
     fn nan_is_an_error() {
         let text = LINE.replace("63.914", "   NaN");
-        let e = read_atoms(Path::new("t.pdb"), text.as_bytes()).expect_err("nan").to_string();
+        let e = read_atoms(Path::new("t.pdb"), text.as_bytes())
+            .expect_err("nan")
+            .to_string();
         assert!(e.contains("t.pdb:1") && e.contains("not finite"), "{e}");
     }
 }

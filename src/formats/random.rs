@@ -78,7 +78,11 @@ pub fn generate(spec: &RandomSpec) -> Vec<RandomParticle> {
             let center = spec.box_min + u * extent;
             let radius = spec.radius.0 + rng.next_f64() * (spec.radius.1 - spec.radius.0);
             let color = DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64());
-            RandomParticle { center, radius, color }
+            RandomParticle {
+                center,
+                radius,
+                color,
+            }
         })
         .collect()
 }

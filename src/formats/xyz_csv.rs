@@ -29,8 +29,16 @@ fn lines(bytes: &[u8]) -> impl Iterator<Item = (usize, String)> + '_ {
 fn number(path: &Path, line: usize, what: &str, s: &str) -> Result<f64> {
     match s.trim().parse::<f64>() {
         Ok(v) if v.is_finite() => Ok(v),
-        Ok(_) => Err(PgtError::at_line(path, line, format!("{what} is not finite: '{}'", s.trim()))),
-        Err(_) => Err(PgtError::at_line(path, line, format!("expected a number for {what}, found '{}'", s.trim()))),
+        Ok(_) => Err(PgtError::at_line(
+            path,
+            line,
+            format!("{what} is not finite: '{}'", s.trim()),
+        )),
+        Err(_) => Err(PgtError::at_line(
+            path,
+            line,
+            format!("expected a number for {what}, found '{}'", s.trim()),
+        )),
     }
 }
 
@@ -48,7 +56,10 @@ pub fn load_xyz(path: &Path, bytes: &[u8], frame: usize) -> Result<LoadedParticl
         }
         let Some((line, count_text)) = it.next() else {
             if current == 0 {
-                return Err(PgtError::in_file(path, "empty XYZ file: expected an atom count on the first line"));
+                return Err(PgtError::in_file(
+                    path,
+                    "empty XYZ file: expected an atom count on the first line",
+                ));
             }
             return Err(PgtError::in_file(
                 path,
@@ -56,17 +67,31 @@ pub fn load_xyz(path: &Path, bytes: &[u8], frame: usize) -> Result<LoadedParticl
             ));
         };
         let n: usize = count_text.trim().parse().map_err(|_| {
-            PgtError::at_line(path, line, format!("expected the atom count (an integer), found '{}'", count_text.trim()))
+            PgtError::at_line(
+                path,
+                line,
+                format!(
+                    "expected the atom count (an integer), found '{}'",
+                    count_text.trim()
+                ),
+            )
         })?;
         if n > bytes.len() / 4 {
             return Err(PgtError::at_line(
                 path,
                 line,
-                format!("the atom count {n} is larger than the file can hold ({} bytes)", bytes.len()),
+                format!(
+                    "the atom count {n} is larger than the file can hold ({} bytes)",
+                    bytes.len()
+                ),
             ));
         }
         if it.next().is_none() {
-            return Err(PgtError::at_line(path, line, "expected a comment line after the atom count"));
+            return Err(PgtError::at_line(
+                path,
+                line,
+                "expected a comment line after the atom count",
+            ));
         }
         let keep = current == frame;
         if keep {
@@ -129,13 +154,26 @@ struct Columns {
 }
 
 fn columns(path: &Path, line: usize, header: &str, warnings: &mut Vec<String>) -> Result<Columns> {
-    let names: Vec<String> = header.split(',').map(|s| s.trim().to_ascii_lowercase()).collect();
+    let names: Vec<String> = header
+        .split(',')
+        .map(|s| s.trim().to_ascii_lowercase())
+        .collect();
     let find = |n: &str| names.iter().position(|c| c == n);
-    let expected = "expected a header row naming the columns: x,y,z[,radius][,red,green,blue][,opacity]";
+    let expected =
+        "expected a header row naming the columns: x,y,z[,radius][,red,green,blue][,opacity]";
     let (Some(x), Some(y), Some(z)) = (find("x"), find("y"), find("z")) else {
-        return Err(PgtError::at_line(path, line, format!("{expected}; found '{}'", header.trim())));
+        return Err(PgtError::at_line(
+            path,
+            line,
+            format!("{expected}; found '{}'", header.trim()),
+        ));
     };
-    let rs: Vec<usize> = names.iter().enumerate().filter(|(_, c)| *c == "r").map(|(i, _)| i).collect();
+    let rs: Vec<usize> = names
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| *c == "r")
+        .map(|(i, _)| i)
+        .collect();
     let (g, b) = (find("g"), find("b"));
     let mut cols = Columns {
         xyz: [x, y, z],
@@ -147,9 +185,19 @@ fn columns(path: &Path, line: usize, header: &str, warnings: &mut Vec<String>) -
         cols.radius = find("radius").or(rs.first().copied());
     } else if let (Some(g), Some(b)) = (g, b) {
         // r,g,b colour: the r nearest before g is red; another r (or `radius`) is the radius.
-        let red = rs.iter().rev().find(|&&r| r < g).or(rs.last()).copied().ok_or_else(|| {
-            PgtError::at_line(path, line, "the header has columns g and b but no r for red")
-        })?;
+        let red = rs
+            .iter()
+            .rev()
+            .find(|&&r| r < g)
+            .or(rs.last())
+            .copied()
+            .ok_or_else(|| {
+                PgtError::at_line(
+                    path,
+                    line,
+                    "the header has columns g and b but no r for red",
+                )
+            })?;
         cols.rgb = Some([red, g, b]);
         cols.radius = find("radius").or(rs.iter().copied().find(|&r| r != red));
     } else {
@@ -159,12 +207,24 @@ fn columns(path: &Path, line: usize, header: &str, warnings: &mut Vec<String>) -
     used.extend(cols.radius);
     used.extend(cols.rgb.iter().flatten());
     used.extend(cols.opacity);
-    let unused: Vec<&String> = names.iter().enumerate().filter(|(i, _)| !used.contains(i)).map(|(_, n)| n).collect();
+    let unused: Vec<&String> = names
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| !used.contains(i))
+        .map(|(_, n)| n)
+        .collect();
     if !unused.is_empty() {
-        warnings.push(format!("{}: ignored CSV columns {:?}", path.display(), unused));
+        warnings.push(format!(
+            "{}: ignored CSV columns {:?}",
+            path.display(),
+            unused
+        ));
     }
     if cols.radius.is_none() {
-        warnings.push(format!("{}: no radius column; every particle has radius 1", path.display()));
+        warnings.push(format!(
+            "{}: no radius column; every particle has radius 1",
+            path.display()
+        ));
     }
     Ok(cols)
 }
@@ -190,24 +250,37 @@ pub fn load_csv(path: &Path, bytes: &[u8]) -> Result<LoadedParticles> {
             return Err(PgtError::at_line(
                 path,
                 line,
-                format!("expected {width} comma-separated values (as in the header), found {}", f.len()),
+                format!(
+                    "expected {width} comma-separated values (as in the header), found {}",
+                    f.len()
+                ),
             ));
         }
-        let get = |i: usize, what: &str| number(path, line, what, f.get(i).copied().unwrap_or_default());
+        let get =
+            |i: usize, what: &str| number(path, line, what, f.get(i).copied().unwrap_or_default());
         let [xi, yi, zi] = c.xyz;
         records.push(ParticleRecord {
             center: DVec3::new(get(xi, "x")?, get(yi, "y")?, get(zi, "z")?),
             radius: c.radius.map_or(Ok(1.0), |i| get(i, "radius"))?,
             color: c
                 .rgb
-                .map(|[r, g, b]| Ok::<_, PgtError>(DVec3::new(get(r, "red")?, get(g, "green")?, get(b, "blue")?)))
+                .map(|[r, g, b]| {
+                    Ok::<_, PgtError>(DVec3::new(
+                        get(r, "red")?,
+                        get(g, "green")?,
+                        get(b, "blue")?,
+                    ))
+                })
                 .transpose()?,
             opacity: c.opacity.map(|i| get(i, "opacity")).transpose()?,
             location: Location::Line(line),
         });
     }
     if cols.is_none() {
-        warnings.push(format!("{}: empty CSV file (no header, no particles)", path.display()));
+        warnings.push(format!(
+            "{}: empty CSV file (no header, no particles)",
+            path.display()
+        ));
     }
     Ok(LoadedParticles { records, warnings })
 }
@@ -237,11 +310,17 @@ mod tests {
 
     #[test]
     fn csv_errors() {
-        let e = load_csv(Path::new("t.csv"), b"1,2,3\n").expect_err("no header").to_string();
+        let e = load_csv(Path::new("t.csv"), b"1,2,3\n")
+            .expect_err("no header")
+            .to_string();
         assert!(e.contains("t.csv:1") && e.contains("header"), "{e}");
-        let e = load_csv(Path::new("t.csv"), b"x,y,z\n1,2\n").expect_err("short").to_string();
+        let e = load_csv(Path::new("t.csv"), b"x,y,z\n1,2\n")
+            .expect_err("short")
+            .to_string();
         assert!(e.contains("t.csv:2") && e.contains("expected 3"), "{e}");
-        let e = load_csv(Path::new("t.csv"), b"x,y,z\n1,nan,2\n").expect_err("nan").to_string();
+        let e = load_csv(Path::new("t.csv"), b"x,y,z\n1,nan,2\n")
+            .expect_err("nan")
+            .to_string();
         assert!(e.contains("t.csv:2") && e.contains("not finite"), "{e}");
     }
 
@@ -254,9 +333,13 @@ mod tests {
         let l = load_xyz(Path::new("t.xyz"), text.as_bytes(), 1).expect("ok");
         assert_eq!(l.records[0].center, DVec3::splat(5.0));
         assert_eq!(l.records[0].location, Location::Line(7));
-        let e = load_xyz(Path::new("t.xyz"), text.as_bytes(), 2).expect_err("no frame 2").to_string();
+        let e = load_xyz(Path::new("t.xyz"), text.as_bytes(), 2)
+            .expect_err("no frame 2")
+            .to_string();
         assert!(e.contains("2 frame"), "{e}");
-        let e = load_xyz(Path::new("t.xyz"), b"3\nc\nO 0 0 0\n", 0).expect_err("short").to_string();
+        let e = load_xyz(Path::new("t.xyz"), b"3\nc\nO 0 0 0\n", 0)
+            .expect_err("short")
+            .to_string();
         assert!(e.contains("t.xyz:1") && e.contains("ends after 1"), "{e}");
     }
 }

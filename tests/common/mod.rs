@@ -9,7 +9,12 @@ use std::path::{Path, PathBuf};
 /// `../shared/data/<rel>` relative to the crate root, or `None` (with a note on stdout) when absent.
 pub fn shared(rel: &str) -> Option<PathBuf> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let p = root.parent().unwrap_or(root).join("shared").join("data").join(rel);
+    let p = root
+        .parent()
+        .unwrap_or(root)
+        .join("shared")
+        .join("data")
+        .join(rel);
     if p.exists() {
         Some(p)
     } else {
@@ -20,7 +25,10 @@ pub fn shared(rel: &str) -> Option<PathBuf> {
 
 /// `tests/data/<rel>` in the crate.
 pub fn local(rel: &str) -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests").join("data").join(rel)
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests")
+        .join("data")
+        .join(rel)
 }
 
 /// Loads a file with every option at its default.
@@ -38,7 +46,11 @@ pub fn load_with(path: &Path, f: impl FnOnce(&mut IncludeSpec)) -> pgt::Result<L
 /// 1-based line numbers and text of the lines of a file that satisfy `pred`.
 pub fn lines_where(path: &Path, pred: impl Fn(&str) -> bool) -> Vec<(usize, String)> {
     let text = std::fs::read_to_string(path).expect("read");
-    text.lines().enumerate().filter(|(_, l)| pred(l)).map(|(i, l)| (i + 1, l.to_string())).collect()
+    text.lines()
+        .enumerate()
+        .filter(|(_, l)| pred(l))
+        .map(|(i, l)| (i + 1, l.to_string()))
+        .collect()
 }
 
 /// sRGB 8-bit hex to linear, written independently of pgt's table code.

@@ -82,8 +82,15 @@ pub fn evaluate(path: &Path, roots: &[Rc<Node>]) -> Result<Evaluated> {
     let p = path.display();
     if !ctx.skipped.is_empty() {
         let total: usize = ctx.skipped.values().sum();
-        let list: Vec<String> = ctx.skipped.iter().map(|(k, v)| format!("{v} {k}")).collect();
-        warnings.push(format!("{p}: skipped {total} non-sphere shapes ({})", list.join(", ")));
+        let list: Vec<String> = ctx
+            .skipped
+            .iter()
+            .map(|(k, v)| format!("{v} {k}"))
+            .collect();
+        warnings.push(format!(
+            "{p}: skipped {total} non-sphere shapes ({})",
+            list.join(", ")
+        ));
     }
     if ctx.mesh_spheres > 0 {
         warnings.push(format!(
@@ -98,13 +105,19 @@ pub fn evaluate(path: &Path, roots: &[Rc<Node>]) -> Result<Evaluated> {
         ));
     }
     if ctx.externs > 0 {
-        warnings.push(format!("{p}: {} EXTERNPROTO instances were not loaded", ctx.externs));
+        warnings.push(format!(
+            "{p}: {} EXTERNPROTO instances were not loaded",
+            ctx.externs
+        ));
     }
     if ctx.inlines > 0 {
         warnings.push(format!("{p}: {} Inline nodes were not loaded", ctx.inlines));
     }
     if ctx.billboards > 0 {
-        warnings.push(format!("{p}: {} Billboard nodes drawn without their view-dependent rotation", ctx.billboards));
+        warnings.push(format!(
+            "{p}: {} Billboard nodes drawn without their view-dependent rotation",
+            ctx.billboards
+        ));
     }
     Ok(Evaluated {
         records: ctx.records,
@@ -119,7 +132,9 @@ impl Ctx<'_> {
 
     /// A field of `node` read in `env`, following `IS` to the instance's value.
     fn field(&self, node: &Node, env: &EnvRef, name: &str) -> Result<Option<(Value, EnvRef)>> {
-        let Some(v) = node.field(name) else { return Ok(None) };
+        let Some(v) = node.field(name) else {
+            return Ok(None);
+        };
         let mut v = v.clone();
         let mut env = env.clone();
         let mut hops = 0;
@@ -131,12 +146,12 @@ impl Ctx<'_> {
                     v = bv;
                     env = be;
                 }
-                _ => {
-                    return Err(self.err(
-                        node.line,
-                        format!("'{name} IS {target}': '{target}' is not a field of the enclosing PROTO"),
-                    ))
-                }
+                _ => return Err(self.err(
+                    node.line,
+                    format!(
+                        "'{name} IS {target}': '{target}' is not a field of the enclosing PROTO"
+                    ),
+                )),
             }
         }
         Ok(Some((v, env)))
@@ -188,7 +203,11 @@ impl Ctx<'_> {
             Some((Value::Nodes(v), e)) => Ok(v.into_iter().map(|n| (n, e.clone())).collect()),
             Some((other, _)) => Err(self.err(
                 node.line,
-                format!("{}.{name}: expected nodes, found {}", node.type_name, describe(&other)),
+                format!(
+                    "{}.{name}: expected nodes, found {}",
+                    node.type_name,
+                    describe(&other)
+                ),
             )),
         }
     }
@@ -215,17 +234,24 @@ impl Ctx<'_> {
                 if !bindings.contains_key(name) {
                     return Err(self.err(
                         node.line,
-                        format!("the PROTO '{}' (line {}) has no field '{name}'", proto.name, proto.line),
+                        format!(
+                            "the PROTO '{}' (line {}) has no field '{name}'",
+                            proto.name, proto.line
+                        ),
                     ));
                 }
                 // An instance's own `IS` (inside another PROTO body) is read in the outer env.
                 let resolved = match v {
-                    Value::Is(_) => self.field(&node, &env, name)?.unwrap_or((Value::Empty, None)),
+                    Value::Is(_) => self
+                        .field(&node, &env, name)?
+                        .unwrap_or((Value::Empty, None)),
                     other => (other.clone(), env.clone()),
                 };
                 bindings.insert(name.clone(), resolved);
             }
-            let Some(first) = proto.body.first() else { return Ok(None) };
+            let Some(first) = proto.body.first() else {
+                return Ok(None);
+            };
             env = Some(Rc::new(Env { bindings }));
             node = Rc::clone(first);
         }
@@ -235,12 +261,20 @@ impl Ctx<'_> {
     fn walk(&mut self, node: &Rc<Node>, env: &EnvRef, m: DMat4, depth: usize) -> Result<()> {
         self.visits += 1;
         if self.visits > MAX_VISITS {
-            return Err(self.err(node.line, format!("the scene expands to more than {MAX_VISITS} nodes (DEF/USE)")));
+            return Err(self.err(
+                node.line,
+                format!("the scene expands to more than {MAX_VISITS} nodes (DEF/USE)"),
+            ));
         }
         if depth > MAX_EVAL_DEPTH {
-            return Err(self.err(node.line, format!("nodes nested deeper than {MAX_EVAL_DEPTH} levels")));
+            return Err(self.err(
+                node.line,
+                format!("nodes nested deeper than {MAX_EVAL_DEPTH} levels"),
+            ));
         }
-        let Some((node, env)) = self.resolve(node, env)? else { return Ok(()) };
+        let Some((node, env)) = self.resolve(node, env)? else {
+            return Ok(());
+        };
         match node.type_name.as_str() {
             "Transform" => {
                 let t = self.vec3(&node, &env, "translation", DVec3::ZERO)?;
@@ -267,7 +301,9 @@ impl Ctx<'_> {
                 }
             }
             "Switch" => {
-                let which = self.nums(&node, &env, "whichChoice", 1)?.map_or(-1.0, |v| v[0]);
+                let which = self
+                    .nums(&node, &env, "whichChoice", 1)?
+                    .map_or(-1.0, |v| v[0]);
                 let choices = self.nodes(&node, &env, "choice")?;
                 if which >= 0.0 {
                     if let Some((child, e)) = choices.get(which as usize) {
@@ -291,7 +327,9 @@ impl Ctx<'_> {
         let Some((geom, genv)) = self.nodes(node, env, "geometry")?.into_iter().next() else {
             return Ok(());
         };
-        let Some((geom, genv)) = self.resolve(&geom, &genv)? else { return Ok(()) };
+        let Some((geom, genv)) = self.resolve(&geom, &genv)? else {
+            return Ok(());
+        };
         let (center, radius) = match geom.type_name.as_str() {
             "Sphere" => {
                 let r = self.nums(&geom, &genv, "radius", 1)?.map_or(1.0, |v| v[0]);
@@ -314,7 +352,11 @@ impl Ctx<'_> {
         };
         let lin = DMat3::from_mat4(m);
         let (c0, c1, c2) = (lin.x_axis, lin.y_axis, lin.z_axis);
-        let l2 = [c0.length_squared(), c1.length_squared(), c2.length_squared()];
+        let l2 = [
+            c0.length_squared(),
+            c1.length_squared(),
+            c2.length_squared(),
+        ];
         let mean = (l2[0] + l2[1] + l2[2]) / 3.0;
         let off = c0.dot(c1).abs().max(c0.dot(c2).abs()).max(c1.dot(c2).abs());
         let spread = l2.iter().map(|v| (v - mean).abs()).fold(off, f64::max);
@@ -345,18 +387,25 @@ impl Ctx<'_> {
         if !matches!(coord.kind, NodeKind::Builtin) || coord.type_name != "Coordinate" {
             return Ok(None);
         }
-        let Some(p) = self.nums(&coord, &cenv, "point", 0)? else { return Ok(None) };
+        let Some(p) = self.nums(&coord, &cenv, "point", 0)? else {
+            return Ok(None);
+        };
         if p.len() % 3 != 0 || p.len() / 3 < MESH_SPHERE_MIN_VERTICES {
             return Ok(None);
         }
-        let pts: Vec<DVec3> = p.chunks_exact(3).map(|c| DVec3::new(c[0], c[1], c[2])).collect();
+        let pts: Vec<DVec3> = p
+            .chunks_exact(3)
+            .map(|c| DVec3::new(c[0], c[1], c[2]))
+            .collect();
         let centroid = pts.iter().copied().sum::<DVec3>() / pts.len() as f64;
         let d: Vec<f64> = pts.iter().map(|q| (*q - centroid).length()).collect();
         let mean = d.iter().sum::<f64>() / d.len() as f64;
         if !(mean > 0.0 && mean.is_finite()) {
             return Ok(None);
         }
-        let ok = d.iter().all(|x| (x - mean).abs() <= MESH_SPHERE_TOLERANCE * mean);
+        let ok = d
+            .iter()
+            .all(|x| (x - mean).abs() <= MESH_SPHERE_TOLERANCE * mean);
         Ok(ok.then_some((centroid, mean)))
     }
 
@@ -364,23 +413,33 @@ impl Ctx<'_> {
         let Some((app, aenv)) = self.nodes(shape, env, "appearance")?.into_iter().next() else {
             return Ok((None, None));
         };
-        let Some((app, aenv)) = self.resolve(&app, &aenv)? else { return Ok((None, None)) };
+        let Some((app, aenv)) = self.resolve(&app, &aenv)? else {
+            return Ok((None, None));
+        };
         let Some((mat, menv)) = self.nodes(&app, &aenv, "material")?.into_iter().next() else {
             return Ok((None, None));
         };
-        let Some((mat, menv)) = self.resolve(&mat, &menv)? else { return Ok((None, None)) };
+        let Some((mat, menv)) = self.resolve(&mat, &menv)? else {
+            return Ok((None, None));
+        };
         if mat.type_name != "Material" {
             return Ok((None, None));
         }
         let diffuse = self.vec3(&mat, &menv, "diffuseColor", DVec3::splat(0.8))?;
         let emissive = self.vec3(&mat, &menv, "emissiveColor", DVec3::ZERO)?;
-        let display = if diffuse == DVec3::ZERO && emissive != DVec3::ZERO { emissive } else { diffuse };
+        let display = if diffuse == DVec3::ZERO && emissive != DVec3::ZERO {
+            emissive
+        } else {
+            diffuse
+        };
         let color = DVec3::new(
             srgb_to_linear(display.x.max(0.0)),
             srgb_to_linear(display.y.max(0.0)),
             srgb_to_linear(display.z.max(0.0)),
         );
-        let opacity = self.nums(&mat, &menv, "transparency", 1)?.map(|t| 1.0 - t[0]);
+        let opacity = self
+            .nums(&mat, &menv, "transparency", 1)?
+            .map(|t| 1.0 - t[0]);
         Ok((Some(color), opacity))
     }
 }

@@ -106,7 +106,8 @@ pub fn tokenize(path: &Path, text: &[u8]) -> Result<Vec<Token>> {
                 while text.get(i).is_some_and(|&c| !is_delimiter(c)) {
                     i += 1;
                 }
-                let word = String::from_utf8_lossy(text.get(start..i).unwrap_or_default()).into_owned();
+                let word =
+                    String::from_utf8_lossy(text.get(start..i).unwrap_or_default()).into_owned();
                 let tok = if matches!(c, b'0'..=b'9' | b'+' | b'-' | b'.') {
                     Tok::Num(parse_number(&word).ok_or_else(|| {
                         PgtError::at_line(path, line, format!("expected a number, found '{word}'"))
@@ -146,7 +147,11 @@ mod tests {
     use super::*;
 
     fn toks(s: &str) -> Vec<Tok> {
-        tokenize(Path::new("t.wrl"), s.as_bytes()).expect("ok").into_iter().map(|t| t.tok).collect()
+        tokenize(Path::new("t.wrl"), s.as_bytes())
+            .expect("ok")
+            .into_iter()
+            .map(|t| t.tok)
+            .collect()
     }
 
     #[test]
@@ -169,12 +174,21 @@ mod tests {
 
     #[test]
     fn strings_and_errors() {
-        assert_eq!(toks("\"a \\\"b\\\" # no\""), vec![Tok::Str("a \"b\" # no".into())]);
-        let e = tokenize(Path::new("t.wrl"), b"\n\"abc").expect_err("open").to_string();
+        assert_eq!(
+            toks("\"a \\\"b\\\" # no\""),
+            vec![Tok::Str("a \"b\" # no".into())]
+        );
+        let e = tokenize(Path::new("t.wrl"), b"\n\"abc")
+            .expect_err("open")
+            .to_string();
         assert!(e.contains("t.wrl:2"), "{e}");
-        let e = tokenize(Path::new("t.wrl"), b"1.2.3").expect_err("bad").to_string();
+        let e = tokenize(Path::new("t.wrl"), b"1.2.3")
+            .expect_err("bad")
+            .to_string();
         assert!(e.contains("expected a number"), "{e}");
-        let e = tokenize(Path::new("t.wrl"), b"-nan").expect_err("nan").to_string();
+        let e = tokenize(Path::new("t.wrl"), b"-nan")
+            .expect_err("nan")
+            .to_string();
         assert!(e.contains("expected a number"), "{e}");
     }
 }

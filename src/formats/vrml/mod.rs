@@ -15,11 +15,12 @@ use std::path::Path;
 pub fn load(path: &Path, bytes: &[u8]) -> Result<LoadedParticles> {
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     if !bytes.starts_with(b"#VRML V2.0") {
-        let first: String = String::from_utf8_lossy(bytes.get(..bytes.len().min(40)).unwrap_or_default())
-            .lines()
-            .next()
-            .unwrap_or_default()
-            .to_string();
+        let first: String =
+            String::from_utf8_lossy(bytes.get(..bytes.len().min(40)).unwrap_or_default())
+                .lines()
+                .next()
+                .unwrap_or_default()
+                .to_string();
         return Err(PgtError::at_line(
             path,
             1,

@@ -20,14 +20,60 @@ pub const MAX_DEPTH: usize = 256;
 
 /// The standard node types of VRML97 (ISO/IEC 14772-1 §6).
 const VRML97_NODES: &[&str] = &[
-    "Anchor", "Appearance", "AudioClip", "Background", "Billboard", "Box", "Collision", "Color",
-    "ColorInterpolator", "Cone", "Coordinate", "CoordinateInterpolator", "Cylinder", "CylinderSensor",
-    "DirectionalLight", "ElevationGrid", "Extrusion", "Fog", "FontStyle", "Group", "ImageTexture",
-    "IndexedFaceSet", "IndexedLineSet", "Inline", "LOD", "Material", "MovieTexture", "NavigationInfo", "Normal",
-    "NormalInterpolator", "OrientationInterpolator", "PixelTexture", "PlaneSensor", "PointLight", "PointSet",
-    "PositionInterpolator", "ProximitySensor", "ScalarInterpolator", "Script", "Shape", "Sound", "Sphere",
-    "SphereSensor", "SpotLight", "Switch", "Text", "TextureCoordinate", "TextureTransform", "TimeSensor",
-    "TouchSensor", "Transform", "Viewpoint", "VisibilitySensor", "WorldInfo",
+    "Anchor",
+    "Appearance",
+    "AudioClip",
+    "Background",
+    "Billboard",
+    "Box",
+    "Collision",
+    "Color",
+    "ColorInterpolator",
+    "Cone",
+    "Coordinate",
+    "CoordinateInterpolator",
+    "Cylinder",
+    "CylinderSensor",
+    "DirectionalLight",
+    "ElevationGrid",
+    "Extrusion",
+    "Fog",
+    "FontStyle",
+    "Group",
+    "ImageTexture",
+    "IndexedFaceSet",
+    "IndexedLineSet",
+    "Inline",
+    "LOD",
+    "Material",
+    "MovieTexture",
+    "NavigationInfo",
+    "Normal",
+    "NormalInterpolator",
+    "OrientationInterpolator",
+    "PixelTexture",
+    "PlaneSensor",
+    "PointLight",
+    "PointSet",
+    "PositionInterpolator",
+    "ProximitySensor",
+    "ScalarInterpolator",
+    "Script",
+    "Shape",
+    "Sound",
+    "Sphere",
+    "SphereSensor",
+    "SpotLight",
+    "Switch",
+    "Text",
+    "TextureCoordinate",
+    "TextureTransform",
+    "TimeSensor",
+    "TouchSensor",
+    "Transform",
+    "Viewpoint",
+    "VisibilitySensor",
+    "WorldInfo",
 ];
 
 /// A field value, read by its shape.
@@ -71,7 +117,11 @@ pub struct Node {
 impl Node {
     /// The value of a field as written (`None` if the node does not set it).
     pub fn field(&self, name: &str) -> Option<&Value> {
-        self.fields.iter().rev().find(|(n, _)| n == name).map(|(_, v)| v)
+        self.fields
+            .iter()
+            .rev()
+            .find(|(n, _)| n == name)
+            .map(|(_, v)| v)
     }
 }
 
@@ -186,10 +236,16 @@ impl<'a> Parser<'a> {
     }
 
     fn lookup_proto(&self, name: &str) -> Option<ProtoDef> {
-        self.scopes.iter().rev().find_map(|s| s.protos.get(name).cloned())
+        self.scopes
+            .iter()
+            .rev()
+            .find_map(|s| s.protos.get(name).cloned())
     }
     fn lookup_def(&self, name: &str) -> Option<Rc<Node>> {
-        self.scopes.iter().rev().find_map(|s| s.defs.get(name).cloned())
+        self.scopes
+            .iter()
+            .rev()
+            .find_map(|s| s.defs.get(name).cloned())
     }
     fn scope(&mut self) -> &mut Scope {
         if self.scopes.is_empty() {
@@ -368,9 +424,14 @@ impl<'a> Parser<'a> {
             }
             Some(Tok::Id(w)) => {
                 let node_follows = matches!(w.as_str(), "DEF" | "USE" | "NULL")
-                    || matches!(self.toks.get(self.pos + 1).map(|t| &t.tok), Some(Tok::LBrace));
+                    || matches!(
+                        self.toks.get(self.pos + 1).map(|t| &t.tok),
+                        Some(Tok::LBrace)
+                    );
                 if !node_follows {
-                    return Err(self.expected("a field value (numbers, a string, TRUE/FALSE, a node, NULL or [ … ])"));
+                    return Err(self.expected(
+                        "a field value (numbers, a string, TRUE/FALSE, a node, NULL or [ … ])",
+                    ));
                 }
                 Ok(Value::Node(self.node_statement(depth + 1)?))
             }
@@ -411,9 +472,15 @@ impl<'a> Parser<'a> {
                         Some(_) => return Err(self.expected(&format!("a value or ']' (list opened at line {open})"))),
                     }
                 }
-                let kinds = usize::from(!nums.is_empty()) + usize::from(!strs.is_empty()) + usize::from(!nodes.is_empty());
+                let kinds = usize::from(!nums.is_empty())
+                    + usize::from(!strs.is_empty())
+                    + usize::from(!nodes.is_empty());
                 if kinds > 1 {
-                    return Err(PgtError::at_line(self.path, open, "a list mixes numbers, strings and nodes"));
+                    return Err(PgtError::at_line(
+                        self.path,
+                        open,
+                        "a list mixes numbers, strings and nodes",
+                    ));
                 }
                 Ok(if !nodes.is_empty() {
                     Value::Nodes(nodes)
@@ -440,7 +507,11 @@ impl<'a> Parser<'a> {
                     self.pos += 1;
                     self.id("a field type")?;
                     let name = self.id("a field name")?;
-                    let v = if with_values { self.value(depth)? } else { Value::Empty };
+                    let v = if with_values {
+                        self.value(depth)?
+                    } else {
+                        Value::Empty
+                    };
                     fields.push((name, v));
                 }
                 Some("eventIn") | Some("eventOut") => {
@@ -453,7 +524,9 @@ impl<'a> Parser<'a> {
                         self.pos += 1;
                         return Ok(fields);
                     }
-                    return Err(self.expected("field, exposedField, eventIn, eventOut or ']' in the interface"));
+                    return Err(self.expected(
+                        "field, exposedField, eventIn, eventOut or ']' in the interface",
+                    ));
                 }
             }
         }
@@ -464,7 +537,10 @@ impl<'a> Parser<'a> {
         self.pos += 1;
         let name = self.id("the PROTO's name")?;
         let fields = self.interface(true, depth + 1)?;
-        let previous = self.scope().protos.insert(name.clone(), ProtoDef::BeingDefined(line));
+        let previous = self
+            .scope()
+            .protos
+            .insert(name.clone(), ProtoDef::BeingDefined(line));
         self.expect(Tok::LBrace, "'{' opening the PROTO body")?;
         self.scopes.push(Scope::default());
         let mut body = Vec::new();
