@@ -136,7 +136,7 @@ fn bad_mmpld_input_is_an_error_with_a_byte_offset() {
     let good = std::fs::read(&p).expect("read");
     let dir = tempfile::tempdir().expect("tmp");
     let q = dir.path().join("bad.mmpld");
-    let mut check = |bytes: &[u8], want: &str| {
+    let check = |bytes: &[u8], want: &str| {
         std::fs::write(&q, bytes).expect("write");
         let e = load_with(&q, |_| {}).expect_err(want).to_string();
         assert!(

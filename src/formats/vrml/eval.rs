@@ -146,12 +146,14 @@ impl Ctx<'_> {
                     v = bv;
                     env = be;
                 }
-                _ => return Err(self.err(
-                    node.line,
-                    format!(
+                _ => {
+                    return Err(self.err(
+                        node.line,
+                        format!(
                         "'{name} IS {target}': '{target}' is not a field of the enclosing PROTO"
                     ),
-                )),
+                    ))
+                }
             }
         }
         Ok(Some((v, env)))
