@@ -12,12 +12,33 @@ use pgt::scene::IncludeSpec;
 use std::path::Path;
 
 /// Mutations per input (kept moderate: the machine is shared).
-const ROUNDS: usize = 300;
+const ROUNDS: usize = 1000;
 
 const TOKENS: &[&[u8]] = &[
-    b"{", b"}", b"[", b"]", b"DEF A ", b"USE A ", b"PROTO P [ field SFFloat r 1 ] { Shape { geometry Sphere { radius IS r } } }",
-    b"P { r 2 }", b"IS r", b"NULL", b"nan", b"-1e400", b"\"", b"#", b"\n", b"loop_\n", b";", b"'", b"MODEL 2\n",
-    b"ATOM  ", b"\0\0\0\0\xff\xff\xff\xff", b"0x", b"Transform { scale 0 0 0 children [", b"1,2,3,4,5,6,7\n",
+    b"{",
+    b"}",
+    b"[",
+    b"]",
+    b"DEF A ",
+    b"USE A ",
+    b"PROTO P [ field SFFloat r 1 ] { Shape { geometry Sphere { radius IS r } } }",
+    b"P { r 2 }",
+    b"IS r",
+    b"NULL",
+    b"nan",
+    b"-1e400",
+    b"\"",
+    b"#",
+    b"\n",
+    b"loop_\n",
+    b";",
+    b"'",
+    b"MODEL 2\n",
+    b"ATOM  ",
+    b"\0\0\0\0\xff\xff\xff\xff",
+    b"0x",
+    b"Transform { scale 0 0 0 children [",
+    b"1,2,3,4,5,6,7\n",
 ];
 
 fn mutate(rng: &mut SplitMix64, input: &[u8]) -> Vec<u8> {
@@ -64,6 +85,10 @@ fn smoke(name: &str, format: Format, input: &[u8], seed: u64) {
     let mut errors = 0;
     for i in 0..ROUNDS {
         let m = mutate(&mut rng, input);
+        if std::env::var("SMOKE_TRACE").is_ok() {
+            eprintln!("{name} {i}");
+            std::fs::write("/tmp/fmt_smoke_last", &m).ok();
+        }
         let r = std::panic::catch_unwind(|| load_bytes(&spec, format, &m));
         match r {
             Err(_) => panic!("{name}: panic at iteration {i} (seed {seed})"),
@@ -78,27 +103,50 @@ fn smoke(name: &str, format: Format, input: &[u8], seed: u64) {
 }
 
 fn bytes_or(rel: &str, fallback: &[u8]) -> Vec<u8> {
-    shared(rel).and_then(|p| std::fs::read(p).ok()).unwrap_or_else(|| fallback.to_vec())
+    shared(rel)
+        .and_then(|p| std::fs::read(p).ok())
+        .unwrap_or_else(|| fallback.to_vec())
 }
 
 #[test]
 fn pdb_and_mmcif_survive_mutation() {
-    let pdb = bytes_or("pdb/1rx1.pdb", b"ATOM      1  N   ALA A   2      63.130 -67.331 -18.137  1.00 21.97           N  \n");
+    let pdb = bytes_or(
+        "pdb/1rx1.pdb",
+        b"ATOM      1  N   ALA A   2      63.130 -67.331 -18.137  1.00 21.97           N  \n",
+    );
     // The first 700 lines keep each mutation cheap.
-    let head: Vec<u8> = pdb.split(|&b| b == b'\n').take(700).collect::<Vec<_>>().join(&b'\n');
+    let head: Vec<u8> = pdb
+        .split(|&b| b == b'\n')
+        .take(700)
+        .collect::<Vec<_>>()
+        .join(&b'\n');
     smoke("m.pdb", Format::Pdb, &head, 1);
-    let cif = bytes_or("pdb/3SN6.cif", b"data_x\nloop_\n_atom_site.Cartn_x\n_atom_site.Cartn_y\n_atom_site.Cartn_z\n1 2 3\n");
-    let head: Vec<u8> = cif.split(|&b| b == b'\n').take(2700).collect::<Vec<_>>().join(&b'\n');
+    let cif = bytes_or(
+        "pdb/3SN6.cif",
+        b"data_x\nloop_\n_atom_site.Cartn_x\n_atom_site.Cartn_y\n_atom_site.Cartn_z\n1 2 3\n",
+    );
+    let head: Vec<u8> = cif
+        .split(|&b| b == b'\n')
+        .take(2700)
+        .collect::<Vec<_>>()
+        .join(&b'\n');
     smoke("m.cif", Format::Mmcif, &head, 2);
 }
 
 #[test]
 fn vrml_survives_mutation() {
-    for (k, rel) in ["vrml/castle_proto_nodes.wrl", "vrml/castle_proto_ultra_simple.wrl", "vrml/drawxtl_be4oteo6.wrl"]
-        .iter()
-        .enumerate()
+    for (k, rel) in [
+        "vrml/castle_proto_nodes.wrl",
+        "vrml/castle_proto_ultra_simple.wrl",
+        "vrml/drawxtl_be4oteo6.wrl",
+    ]
+    .iter()
+    .enumerate()
     {
-        let b = bytes_or(rel, b"#VRML V2.0 utf8\nTransform { children Shape { geometry Sphere { } } }\n");
+        let b = bytes_or(
+            rel,
+            b"#VRML V2.0 utf8\nTransform { children Shape { geometry Sphere { } } }\n",
+        );
         smoke("m.wrl", Format::Vrml, &b, 10 + k as u64);
     }
 }
@@ -123,8 +171,18 @@ fn mmpld_survives_mutation() {
 
 #[test]
 fn xyz_and_csv_survive_mutation() {
-    smoke("m.xyz", Format::Xyz, b"3\nwater\nO 0 0 0\nH 1 0 0\nH 0 1 0\n2\nf2\nC 1 1 1\nN 2 2 2\n", 30);
-    smoke("m.csv", Format::Csv, b"x,y,z,r,r,g,b,opacity\n1,2,3,0.5,1,0,0,0.5\n4,5,6,1,0,1,0,1\n", 31);
+    smoke(
+        "m.xyz",
+        Format::Xyz,
+        b"3\nwater\nO 0 0 0\nH 1 0 0\nH 0 1 0\n2\nf2\nC 1 1 1\nN 2 2 2\n",
+        30,
+    );
+    smoke(
+        "m.csv",
+        Format::Csv,
+        b"x,y,z,r,r,g,b,opacity\n1,2,3,0.5,1,0,0,0.5\n4,5,6,1,0,1,0,1\n",
+        31,
+    );
 }
 
 #[test]
@@ -133,5 +191,10 @@ fn local_copies_load() {
     // ../shared still reads real files. Counts as in formats_pdb.rs / SOURCES.md.
     assert_eq!(load(&local("1rx1.pdb")).records.len(), 1435);
     assert_eq!(load(&local("3al1.pdb")).records.len(), 491);
-    assert_eq!(load(&local("test_xyzr_float_rgba_byte.mmpld")).records.len(), 4);
+    assert_eq!(
+        load(&local("test_xyzr_float_rgba_byte.mmpld"))
+            .records
+            .len(),
+        4
+    );
 }

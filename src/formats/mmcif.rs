@@ -40,7 +40,7 @@ fn tokenize<'a>(path: &Path, text: &'a str) -> Result<Vec<Token<'a>>> {
             at_line_start = true;
             continue;
         }
-        if c == b' ' || c == b'\t' || c == b'\r' {
+        if c.is_ascii_whitespace() {
             i += 1;
             at_line_start = false;
             continue;
@@ -116,6 +116,8 @@ fn tokenize<'a>(path: &Path, text: &'a str) -> Result<Vec<Token<'a>>> {
             continue;
         }
         let start = i;
+        // `c` is not whitespace here, so every word is at least one byte long.
+        i += 1;
         while i < bytes.len() && !bytes.get(i).is_some_and(|b| b.is_ascii_whitespace()) {
             i += 1;
         }
@@ -354,6 +356,13 @@ mod tests {
             .expect_err("bad")
             .to_string();
         assert!(e.contains("t.cif:7") && e.contains("multiple"), "{e}");
+    }
+
+    #[test]
+    fn form_feed_is_whitespace() {
+        // Found by the mutation smoke test: a form feed once produced empty words forever.
+        let toks = tokenize(Path::new("t.cif"), "a\x0cb\x0b c").expect("ok");
+        assert_eq!(toks.len(), 3);
     }
 
     #[test]
