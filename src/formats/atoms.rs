@@ -207,8 +207,14 @@ pub fn atoms_to_particles(
             }
             Some(_) => {}
         }
-        let n = chain_index.len();
-        let ci = *chain_index.entry(a.chain.clone()).or_insert(n);
+        let ci = match chain_index.get(&a.chain) {
+            Some(&i) => i,
+            None => {
+                let n = chain_index.len();
+                chain_index.insert(a.chain.clone(), n);
+                n
+            }
+        };
         let color = match spec.color_by {
             ColorBy::Element => Some(element_color(a.element)),
             ColorBy::Chain => Some(srgb8_hex_to_linear(

@@ -55,10 +55,10 @@ pub fn read_atoms(path: &Path, bytes: &[u8]) -> Result<(Vec<Atom>, Vec<String>)>
 }
 
 /// Columns `from..=to` (1-based) of a line, as text; short lines give what is there.
-fn field(line: &[u8], from: usize, to: usize) -> String {
+fn field(line: &[u8], from: usize, to: usize) -> std::borrow::Cow<'_, str> {
     let start = from.saturating_sub(1).min(line.len());
     let end = to.min(line.len());
-    String::from_utf8_lossy(line.get(start..end).unwrap_or_default()).into_owned()
+    String::from_utf8_lossy(line.get(start..end).unwrap_or_default())
 }
 
 fn coordinate(
@@ -137,7 +137,7 @@ fn atom(path: &Path, raw: &[u8], line_no: usize, model: i64, hetatm: bool) -> Re
         occupancy,
         residue_name: field(raw, 18, 20).trim().to_string(),
         chain: field(raw, 22, 22).trim().to_string(),
-        residue: field(raw, 23, 27),
+        residue: field(raw, 23, 27).into_owned(),
         model,
         line: line_no,
     })
