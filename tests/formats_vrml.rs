@@ -313,3 +313,30 @@ fn switch_def_use_material_and_transparency() {
         .all(|r| r.radius == 2.0 && r.color == Some(DVec3::X) && r.opacity == Some(0.75)));
     assert_eq!(l.records[1].center, DVec3::new(5.0, 0.0, 0.0));
 }
+
+#[test]
+fn proto_fields_pass_through_is_and_defaults() {
+    let l = vrml_ok(
+        "PROTO P [ field SFFloat r 1 field SFColor c 0 0 1 ] {\n\
+           Shape { appearance Appearance { material Material { diffuseColor IS c } } geometry Sphere { radius IS r } } }\n\
+         PROTO Q [ field SFFloat s 3 ] { Transform { translation 7 0 0 children P { r IS s } } }\n\
+         P { r 2 } P { } Q { s 4 } Q { }\n\
+         EXTERNPROTO E [ field SFFloat r ] \"e.wrl#E\"\n\
+         E { r 5 }\n\
+         ROUTE A.b TO C.d\n",
+    );
+    let got: Vec<(f64, f64)> = l.records.iter().map(|r| (r.center.x, r.radius)).collect();
+    assert_eq!(got, vec![(0.0, 2.0), (0.0, 1.0), (7.0, 4.0), (7.0, 3.0)]);
+    assert!(l.records.iter().all(|r| r.color == Some(DVec3::Z)));
+    assert!(l.warnings.iter().any(|w| w.contains("1 EXTERNPROTO")), "{:?}", l.warnings);
+}
+
+#[test]
+fn format_can_be_forced() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let p = dir.path().join("spheres.txt");
+    std::fs::write(&p, "#VRML V2.0 utf8\nShape { geometry Sphere { radius 3 } }\n").expect("w");
+    assert!(load_with(&p, |_| {}).expect_err("unknown extension").to_string().contains("unsupported"));
+    let l = load_with(&p, |s| s.format = Some(pgt::formats::Format::Vrml)).expect("forced");
+    assert_eq!(l.records[0].radius, 3.0);
+}
