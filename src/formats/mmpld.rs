@@ -478,6 +478,11 @@ mod tests {
                 b.extend_from_slice(&x.to_le_bytes());
             }
         }
+        if v == 101 {
+            b.extend_from_slice(&2u32.to_le_bytes());
+            b.extend_from_slice(&4u64.to_le_bytes());
+            b.extend_from_slice(&[9u8; 4]);
+        }
         let end = b.len() as u64;
         b[table_at..table_at + 8].copy_from_slice(&start.to_le_bytes());
         b[table_at + 8..table_at + 16].copy_from_slice(&end.to_le_bytes());
@@ -495,6 +500,44 @@ mod tests {
         assert_eq!(l.records[2].center.x, 2.0);
         assert_eq!(l.records[2].radius, 0.5);
         assert_eq!(l.records[0].color, Some(DVec3::new(1.0, 0.0, 0.0)));
+    }
+
+    #[test]
+    fn every_version() {
+        for (v, ts) in [(100, false), (101, false), (102, true), (103, true)] {
+            let l = load(&spec(), &one_list(v, ts, 2, 2)).expect("ok");
+            assert_eq!(l.records.len(), 2, "{v}");
+            assert_eq!(l.records[1].center.x, 1.0, "{v}");
+        }
+    }
+
+    #[test]
+    fn short_xyz_and_u8_rgb() {
+        // One list: SHORT_XYZ (3), UINT8_RGB (1), global radius 0.25, one particle (-2, 3, 7)
+        // coloured (255, 0, 0).
+        let mut b = Vec::new();
+        b.extend_from_slice(MAGIC);
+        b.extend_from_slice(&102u16.to_le_bytes());
+        b.extend_from_slice(&1u32.to_le_bytes());
+        b.extend_from_slice(&[0u8; 48]);
+        b.extend_from_slice(&76u64.to_le_bytes());
+        let end_at = b.len();
+        b.extend_from_slice(&0u64.to_le_bytes());
+        b.extend_from_slice(&0f32.to_le_bytes());
+        b.extend_from_slice(&1i32.to_le_bytes());
+        b.extend_from_slice(&[3, 1]);
+        b.extend_from_slice(&0.25f32.to_le_bytes());
+        b.extend_from_slice(&1u64.to_le_bytes());
+        for v in [-2i16, 3, 7] {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+        b.extend_from_slice(&[255, 0, 0]);
+        let end = b.len() as u64;
+        b[end_at..end_at + 8].copy_from_slice(&end.to_le_bytes());
+        let l = load(&spec(), &b).expect("ok");
+        assert_eq!(l.records[0].center, DVec3::new(-2.0, 3.0, 7.0));
+        assert_eq!(l.records[0].radius, 0.25);
+        assert_eq!(l.records[0].color, Some(DVec3::X));
     }
 
     #[test]
