@@ -328,15 +328,26 @@ fn proto_fields_pass_through_is_and_defaults() {
     let got: Vec<(f64, f64)> = l.records.iter().map(|r| (r.center.x, r.radius)).collect();
     assert_eq!(got, vec![(0.0, 2.0), (0.0, 1.0), (7.0, 4.0), (7.0, 3.0)]);
     assert!(l.records.iter().all(|r| r.color == Some(DVec3::Z)));
-    assert!(l.warnings.iter().any(|w| w.contains("1 EXTERNPROTO")), "{:?}", l.warnings);
+    assert!(
+        l.warnings.iter().any(|w| w.contains("1 EXTERNPROTO")),
+        "{:?}",
+        l.warnings
+    );
 }
 
 #[test]
 fn format_can_be_forced() {
     let dir = tempfile::tempdir().expect("tmp");
     let p = dir.path().join("spheres.txt");
-    std::fs::write(&p, "#VRML V2.0 utf8\nShape { geometry Sphere { radius 3 } }\n").expect("w");
-    assert!(load_with(&p, |_| {}).expect_err("unknown extension").to_string().contains("unsupported"));
+    std::fs::write(
+        &p,
+        "#VRML V2.0 utf8\nShape { geometry Sphere { radius 3 } }\n",
+    )
+    .expect("w");
+    assert!(load_with(&p, |_| {})
+        .expect_err("unknown extension")
+        .to_string()
+        .contains("unsupported"));
     let l = load_with(&p, |s| s.format = Some(pgt::formats::Format::Vrml)).expect("forced");
     assert_eq!(l.records[0].radius, 3.0);
 }

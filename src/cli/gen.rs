@@ -10,6 +10,7 @@ use std::path::PathBuf;
 /// `pgt gen …`: synthetic data sets.
 #[derive(Debug, Args)]
 pub struct GenArgs {
+    /// Which set to generate.
     #[command(subcommand)]
     pub kind: GenKind,
 }
@@ -18,6 +19,7 @@ pub struct GenArgs {
 #[derive(Debug, Subcommand)]
 pub enum GenKind {
     /// Uniformly random spheres in a box (the thesis's random set: 73,642 particles).
+    /// The random set of [`crate::formats::random`].
     Random(RandomArgs),
 }
 

@@ -26,31 +26,43 @@ const TOP_COLORS: usize = 8;
 /// What `pgt info` reports (also the JSON object it prints).
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Info {
+    /// The file as given.
     pub file: String,
     /// `scene` or the particle format.
     pub format: String,
+    /// Number of particles.
     pub particles: usize,
     /// Axis-aligned bounds of the spheres (centre ± radius); absent when there are none.
     pub bounds: Option<Bounds>,
     /// Radius range and mean; absent when there are no particles.
     pub radius: Option<RadiusRange>,
+    /// Colour summary.
     pub colors: ColorSummary,
+    /// Warnings of the loaders.
     pub warnings: Vec<String>,
 }
 
+/// An axis-aligned box.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct Bounds {
+    /// Lower corner.
     pub min: [f64; 3],
+    /// Upper corner.
     pub max: [f64; 3],
 }
 
+/// Smallest, largest and mean radius.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct RadiusRange {
+    /// Smallest radius.
     pub min: f64,
+    /// Largest radius.
     pub max: f64,
+    /// Mean radius.
     pub mean: f64,
 }
 
+/// The particles' colours.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct ColorSummary {
     /// Distinct colours among the particles that have one.
@@ -61,9 +73,12 @@ pub struct ColorSummary {
     pub most_common: Vec<ColorCount>,
 }
 
+/// One colour and how many particles have it.
 #[derive(Debug, Clone, serde::Serialize)]
 pub struct ColorCount {
+    /// Linear RGB.
     pub rgb: [f64; 3],
+    /// Particles with this colour.
     pub count: usize,
 }
 

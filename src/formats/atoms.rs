@@ -20,7 +20,9 @@ pub struct Atom {
     pub name: String,
     /// Alternate location indicator (`None` for blank, `.` or `?`).
     pub alt_loc: Option<String>,
+    /// Occupancy (1 where the file leaves it blank).
     pub occupancy: f64,
+    /// Residue name (`ALA`, `HOH`).
     pub residue_name: String,
     /// Chain identifier, trimmed (may be empty).
     pub chain: String,

@@ -157,6 +157,7 @@ fn intensity_color(i: f64, min: f64, max: f64) -> DVec3 {
 pub struct Header {
     /// 100·major + minor.
     pub version: u16,
+    /// Number of frames.
     pub frames: u32,
 }
 

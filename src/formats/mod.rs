@@ -40,11 +40,17 @@ pub struct LoadedParticles {
 )]
 #[serde(rename_all = "kebab-case")]
 pub enum Format {
+    /// PDB (fixed columns).
     Pdb,
+    /// mmCIF / PDBx.
     Mmcif,
+    /// VRML97.
     Vrml,
+    /// MegaMol MMPLD.
     Mmpld,
+    /// XYZ (element x y z).
     Xyz,
+    /// CSV with a header row.
     Csv,
 }
 

@@ -13,7 +13,9 @@ pub const THESIS_COUNT: usize = 73_642;
 /// What to generate.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RandomSpec {
+    /// Number of particles.
     pub count: usize,
+    /// SplitMix64 seed.
     pub seed: u64,
     /// Lower corner of the box of centres.
     pub box_min: DVec3,
@@ -39,8 +41,11 @@ impl Default for RandomSpec {
 /// One generated particle: centre, radius, linear RGB colour.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RandomParticle {
+    /// Centre.
     pub center: DVec3,
+    /// Radius.
     pub radius: f64,
+    /// Linear RGB colour.
     pub color: DVec3,
 }
 
@@ -49,6 +54,7 @@ pub struct RandomParticle {
 pub struct SplitMix64(u64);
 
 impl SplitMix64 {
+    /// A generator whose state starts at `seed`.
     pub fn new(seed: u64) -> Self {
         SplitMix64(seed)
     }

@@ -46,7 +46,9 @@ type EnvRef = Option<Rc<Env>>;
 
 /// What evaluation produced.
 pub struct Evaluated {
+    /// The spheres, in traversal order.
     pub records: Vec<ParticleRecord>,
+    /// Summary warnings (skipped shapes, recognised meshes, …).
     pub warnings: Vec<String>,
 }
 

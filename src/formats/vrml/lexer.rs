@@ -7,9 +7,13 @@ use std::path::Path;
 /// A token's kind.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Tok {
+    /// `{`
     LBrace,
+    /// `}`
     RBrace,
+    /// `[`
     LBracket,
+    /// `]`
     RBracket,
     /// A number (integers, floats, `0x` hexadecimal).
     Num(f64),
@@ -22,7 +26,9 @@ pub enum Tok {
 /// A token and the 1-based line it starts on.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Token {
+    /// The token.
     pub tok: Tok,
+    /// 1-based line where it starts.
     pub line: usize,
 }
 

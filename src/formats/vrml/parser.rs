@@ -81,7 +81,9 @@ const VRML97_NODES: &[&str] = &[
 pub enum Value {
     /// Numbers (SFFloat, SFVec3f, SFRotation, MFFloat, …; booleans inside lists as 1/0).
     Nums(Vec<f64>),
+    /// `TRUE` / `FALSE`.
     Bool(bool),
+    /// SFString / MFString.
     Strs(Vec<String>),
     /// SFNode; `None` is `NULL`.
     Node(Option<Rc<Node>>),
@@ -107,8 +109,11 @@ pub enum NodeKind {
 /// A node as written.
 #[derive(Debug)]
 pub struct Node {
+    /// The type as written (`Transform`, a PROTO name).
     pub type_name: String,
+    /// What the type name refers to.
     pub kind: NodeKind,
+    /// Fields in file order (a later duplicate wins).
     pub fields: Vec<(String, Value)>,
     /// Line of the type name.
     pub line: usize,
@@ -128,11 +133,13 @@ impl Node {
 /// A PROTO declaration.
 #[derive(Debug)]
 pub struct Proto {
+    /// The PROTO's name.
     pub name: String,
     /// Interface fields with their default values (events have none and are left out).
     pub fields: Vec<(String, Value)>,
     /// The body's root nodes; the first is the one the instance stands for.
     pub body: Vec<Rc<Node>>,
+    /// Line of the `PROTO` keyword.
     pub line: usize,
 }
 
