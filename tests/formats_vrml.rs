@@ -351,3 +351,28 @@ fn format_can_be_forced() {
     let l = load_with(&p, |s| s.format = Some(pgt::formats::Format::Vrml)).expect("forced");
     assert_eq!(l.records[0].radius, 3.0);
 }
+
+#[test]
+fn deep_use_chains_are_an_error_not_a_stack_overflow() {
+    // Each DEF nests the previous one by one level through USE: parse depth stays 2, evaluation
+    // depth grows to 600.
+    let mut s = String::from("DEF A0 Shape { geometry Sphere { } }\n");
+    for k in 1..600 {
+        s += &format!(
+            "DEF A{k} Transform {{ translation 1 0 0 children USE A{} }}\n",
+            k - 1
+        );
+    }
+    assert!(vrml_err(&s).contains("deeper than"));
+    // 100 levels are fine: the sphere ends up at x = 99 (A99 is the last statement).
+    let mut s = String::from("DEF A0 Shape { geometry Sphere { } }\n");
+    for k in 1..100 {
+        s += &format!(
+            "DEF A{k} Transform {{ translation 1 0 0 children USE A{} }}\n",
+            k - 1
+        );
+    }
+    let l = vrml_ok(&s);
+    assert_eq!(l.records.len(), 100);
+    assert_eq!(l.records.last().map(|r| r.center.x), Some(99.0));
+}
