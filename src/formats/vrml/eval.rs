@@ -32,6 +32,9 @@ use std::rc::Rc;
 const MAX_EVAL_DEPTH: usize = 512;
 /// Most node visits one file may cause (DEF/USE can multiply a small file into a huge scene).
 const MAX_VISITS: u64 = 20_000_000;
+/// Most spheres one file may produce (≈ 100 bytes each): DEF/USE can make a few hundred bytes
+/// of text stand for billions of spheres, and pgt refuses rather than allocating for them.
+pub const MAX_SPHERES: usize = 4_000_000;
 /// Relative spread of vertex distances below which a mesh counts as a sphere.
 const MESH_SPHERE_TOLERANCE: f64 = 5e-3;
 /// Fewest vertices of a mesh recognised as a sphere.
@@ -372,6 +375,12 @@ impl Ctx<'_> {
         let (center, radius) = (m.transform_point3(center), radius * scale);
         if !center.is_finite() || !radius.is_finite() {
             return Err(self.err(geom.line, "the sphere's position or radius is not finite"));
+        }
+        if self.records.len() >= MAX_SPHERES {
+            return Err(self.err(
+                geom.line,
+                format!("the scene expands to more than {MAX_SPHERES} spheres; pgt reads at most that many from a VRML file"),
+            ));
         }
         self.records.push(ParticleRecord {
             center,
