@@ -167,3 +167,13 @@ fn bad_mmpld_input_is_an_error_with_a_byte_offset() {
     b[84] = 9;
     check(&b, "vertex type");
 }
+
+#[test]
+fn uniform_colour_applies_to_every_format() {
+    let Some(p) = shared("mmpld/test_xyzr_float_rgba_byte.mmpld") else {
+        return;
+    };
+    let l = load_with(&p, |s| s.color_by = pgt::scene::ColorBy::Uniform).expect("loads");
+    assert_eq!(l.records.len(), 4);
+    assert!(l.records.iter().all(|r| r.color.is_none()));
+}

@@ -95,7 +95,8 @@ pub fn read_input(path: &Path) -> Result<Vec<u8>> {
 }
 
 /// Loads the particles of an `[[include]]` (or a bare particle file), choosing the format by
-/// `spec.format` or else the file's extension, and applies `radius_scale`.
+/// `spec.format` or else the file's extension, and applies `radius_scale` and, for every
+/// format, `color_by = "uniform"` (no particle keeps a colour of its own).
 pub fn load_particles(spec: &IncludeSpec) -> Result<LoadedParticles> {
     let format = match spec.format.or_else(|| Format::from_path(&spec.path)) {
         Some(f) => f,
@@ -119,6 +120,12 @@ pub fn load_particles(spec: &IncludeSpec) -> Result<LoadedParticles> {
     if spec.radius_scale != 1.0 {
         for r in &mut loaded.records {
             r.radius *= spec.radius_scale;
+        }
+    }
+    if spec.color_by == crate::scene::ColorBy::Uniform {
+        // Every format: the file's colours give way to the scene's default colour.
+        for r in &mut loaded.records {
+            r.color = None;
         }
     }
     check_records(&spec.path, &loaded.records)?;
