@@ -376,3 +376,37 @@ fn deep_use_chains_are_an_error_not_a_stack_overflow() {
     assert_eq!(l.records.len(), 100);
     assert_eq!(l.records.last().map(|r| r.center.x), Some(99.0));
 }
+
+#[test]
+fn pymol_colours_are_the_decoded_diffuse_colours_of_the_text() {
+    let Some(p) = shared("vrml/pymol_1rx1_spheres.wrl") else {
+        return;
+    };
+    let l = load(&p);
+    // Every `diffuseColor r g b` of the file, in order, one per sphere.
+    let colours: Vec<[f64; 3]> = lines_where(&p, |t| t.contains("diffuseColor"))
+        .iter()
+        .map(|(_, t)| {
+            let f: Vec<f64> = t
+                .split_whitespace()
+                .skip_while(|w| *w != "diffuseColor")
+                .skip(1)
+                .take(3)
+                .map(|w| w.parse().expect("number"))
+                .collect();
+            [f[0], f[1], f[2]]
+        })
+        .collect();
+    assert_eq!(colours.len(), l.records.len());
+    let decode = |c: f64| {
+        if c <= 0.04045 {
+            c / 12.92
+        } else {
+            ((c + 0.055) / 1.055).powf(2.4)
+        }
+    };
+    for (r, c) in l.records.iter().zip(&colours) {
+        assert!(close3(r.color.expect("coloured"), c.map(decode), 1e-12));
+        assert_eq!(r.opacity, None, "PyMOL writes no transparency");
+    }
+}

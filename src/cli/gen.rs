@@ -116,6 +116,14 @@ fn write_atomically(path: &std::path::Path, bytes: &[u8]) -> crate::Result<()> {
     let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| crate::PgtError::io(path, e))?;
     tmp.write_all(bytes)
         .map_err(|e| crate::PgtError::io(path, e))?;
+    #[cfg(unix)]
+    {
+        // A temporary file is private (0600); the data set is an ordinary file.
+        use std::os::unix::fs::PermissionsExt;
+        tmp.as_file()
+            .set_permissions(std::fs::Permissions::from_mode(0o644))
+            .map_err(|e| crate::PgtError::io(path, e))?;
+    }
     tmp.persist(path)
         .map_err(|e| crate::PgtError::io(path, e.error))?;
     Ok(())

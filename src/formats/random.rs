@@ -122,6 +122,22 @@ mod tests {
     }
 
     #[test]
+    fn first_particle_matches_an_independent_computation() {
+        // Computed with a separate Python SplitMix64 (seed 3): x = −100 + 200·(u₀ >> 11)/2⁵³, …,
+        // radius = 0.5 + 1.5·u₃, colour = u₄..u₆; printed with six decimals.
+        let p = generate(&RandomSpec {
+            count: 1,
+            seed: 3,
+            ..RandomSpec::default()
+        });
+        let csv = to_csv(&p);
+        assert_eq!(
+            csv.lines().nth(1),
+            Some("-77.309932,40.058703,22.594937,0.609300,0.216439,0.636222,0.135146")
+        );
+    }
+
+    #[test]
     fn in_range_and_deterministic() {
         let spec = RandomSpec {
             count: 1000,
