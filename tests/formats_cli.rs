@@ -51,6 +51,22 @@ fn info_json_of_a_pdb_file() {
     let got = v["bounds"]["min"][0].as_f64().expect("number");
     assert!((got - min_x).abs() < 1e-9, "{got} vs {min_x}");
     assert_eq!(v["colors"]["distinct"], 4);
+    // SOURCES.md: chains A–H × 1379 atoms, no MODEL records.
+    let chains = v["details"]["chains"].as_object().expect("chains");
+    assert_eq!(chains.len(), 8);
+    assert!(chains.values().all(|n| n == 1379));
+    assert_eq!(v["details"]["models"], serde_json::json!([1]));
+}
+
+#[test]
+fn info_json_of_an_mmpld_file() {
+    let Some(p) = shared("mmpld/testspheres_old_v100.mmpld") else {
+        return;
+    };
+    let v = json(&pgt(&["info", p.to_str().expect("utf8"), "--json"]));
+    assert_eq!(v["particles"], 15);
+    assert_eq!(v["details"]["version"], "1.0");
+    assert_eq!(v["details"]["frames"], 100);
 }
 
 #[test]

@@ -40,6 +40,9 @@ pub struct Info {
     pub colors: ColorSummary,
     /// Warnings of the loaders.
     pub warnings: Vec<String>,
+    /// Facts of the format: PDB/mmCIF `models` and `chains` (atom records per chain in the
+    /// first model, before alternate locations are resolved); MMPLD `version` and `frames`.
+    pub details: serde_json::Map<String, serde_json::Value>,
 }
 
 /// An axis-aligned box.
@@ -138,7 +141,51 @@ pub fn summarize(
                 .collect(),
         },
         warnings,
+        details: serde_json::Map::new(),
     }
+}
+
+/// The format-specific facts of [`Info::details`].
+fn details(
+    path: &std::path::Path,
+    format: Format,
+) -> crate::Result<serde_json::Map<String, serde_json::Value>> {
+    use serde_json::json;
+    let mut d = serde_json::Map::new();
+    let atoms = match format {
+        Format::Pdb => {
+            Some(crate::formats::pdb::read_atoms(path, &crate::formats::read_input(path)?)?.0)
+        }
+        Format::Mmcif => {
+            Some(crate::formats::mmcif::read_atoms(path, &crate::formats::read_input(path)?)?.0)
+        }
+        Format::Mmpld => {
+            let h = crate::formats::mmpld::header(path, &crate::formats::read_input(path)?)?;
+            d.insert(
+                "version".into(),
+                json!(format!("{}.{}", h.version / 100, h.version % 100)),
+            );
+            d.insert("frames".into(), json!(h.frames));
+            None
+        }
+        _ => None,
+    };
+    if let Some(atoms) = atoms {
+        let mut models: Vec<i64> = Vec::new();
+        for a in &atoms {
+            if !models.contains(&a.model) {
+                models.push(a.model);
+            }
+        }
+        let mut chains = serde_json::Map::new();
+        for a in atoms.iter().filter(|a| Some(&a.model) == models.first()) {
+            let n = chains.get(&a.chain).and_then(|v| v.as_u64()).unwrap_or(0);
+            chains.insert(a.chain.clone(), json!(n + 1));
+        }
+        d.insert("models".into(), json!(models));
+        d.insert("chains".into(), serde_json::Value::Object(chains));
+    }
+    Ok(d)
 }
 
 /// Loads a file and summarises it.
@@ -164,7 +211,11 @@ pub fn info_of(path: &std::path::Path) -> crate::Result<Info> {
                 .unwrap_or_default()
         });
         let it = loaded.records.iter().map(|r| (r.center, r.radius, r.color));
-        Ok(summarize(name, format, it, loaded.warnings))
+        let mut info = summarize(name, format, it, loaded.warnings);
+        if let Some(f) = Format::from_path(path) {
+            info.details = details(path, f)?;
+        }
+        Ok(info)
     }
 }
 
@@ -195,6 +246,9 @@ pub fn run(args: InfoArgs) -> anyhow::Result<Outcome> {
             "           linear RGB [{:.4}, {:.4}, {:.4}] × {}",
             cc.rgb[0], cc.rgb[1], cc.rgb[2], cc.count
         );
+    }
+    for (k, v) in &info.details {
+        println!("{:<10} {v}", format!("{k}:"));
     }
     for w in &info.warnings {
         println!("warning:   {w}");
