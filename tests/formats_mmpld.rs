@@ -177,3 +177,136 @@ fn uniform_colour_applies_to_every_format() {
     assert_eq!(l.records.len(), 4);
     assert!(l.records.iter().all(|r| r.color.is_none()));
 }
+
+mod round_trip {
+    //! Files written here, independently of pgt, from the layout in SOURCES.md, for every
+    //! version, vertex type and colour type; pgt must read back what was written.
+    use super::common::close3;
+    use pgt::formats::{load_bytes, Format};
+    use pgt::scene::IncludeSpec;
+    use proptest::prelude::*;
+
+    #[derive(Debug, Clone)]
+    struct List {
+        vt: u8,
+        ct: u8,
+        /// Integer-valued so that every vertex type (i16 too) stores them exactly.
+        points: Vec<([i16; 3], u8, [u8; 3])>,
+    }
+
+    fn decode(c: f64) -> f64 {
+        if c <= 0.04045 {
+            c / 12.92
+        } else {
+            ((c + 0.055) / 1.055).powf(2.4)
+        }
+    }
+
+    fn write(version: u16, lists: &[List]) -> Vec<u8> {
+        let mut b = b"MMPLD\0".to_vec();
+        b.extend_from_slice(&version.to_le_bytes());
+        b.extend_from_slice(&1u32.to_le_bytes());
+        b.extend_from_slice(&[0u8; 48]);
+        b.extend_from_slice(&76u64.to_le_bytes());
+        b.extend_from_slice(&0u64.to_le_bytes());
+        if version >= 102 {
+            b.extend_from_slice(&1.5f32.to_le_bytes());
+        }
+        b.extend_from_slice(&(lists.len() as i32).to_le_bytes());
+        for l in lists {
+            b.extend_from_slice(&[l.vt, l.ct]);
+            if matches!(l.vt, 1 | 3 | 4) {
+                b.extend_from_slice(&0.75f32.to_le_bytes());
+            }
+            if l.ct == 0 {
+                b.extend_from_slice(&[10, 20, 30, 255]);
+            }
+            if matches!(l.ct, 3 | 7) {
+                b.extend_from_slice(&0f32.to_le_bytes());
+                b.extend_from_slice(&255f32.to_le_bytes());
+            }
+            b.extend_from_slice(&(l.points.len() as u64).to_le_bytes());
+            if version == 103 {
+                b.extend_from_slice(&[0u8; 24]);
+            }
+            for (p, r, c) in &l.points {
+                match l.vt {
+                    1 | 2 => {
+                        for v in p {
+                            b.extend_from_slice(&f32::from(*v).to_le_bytes());
+                        }
+                        if l.vt == 2 {
+                            b.extend_from_slice(&(f32::from(*r) / 8.0 + 0.125).to_le_bytes());
+                        }
+                    }
+                    3 => p.iter().for_each(|v| b.extend_from_slice(&v.to_le_bytes())),
+                    _ => p
+                        .iter()
+                        .for_each(|v| b.extend_from_slice(&f64::from(*v).to_le_bytes())),
+                }
+                match l.ct {
+                    1 => b.extend_from_slice(c),
+                    2 => b.extend_from_slice(&[c[0], c[1], c[2], 255]),
+                    3 => b.extend_from_slice(&f32::from(c[0]).to_le_bytes()),
+                    4 | 5 => {
+                        for v in c {
+                            b.extend_from_slice(&(f32::from(*v) / 255.0).to_le_bytes());
+                        }
+                        if l.ct == 5 {
+                            b.extend_from_slice(&1f32.to_le_bytes());
+                        }
+                    }
+                    6 => {
+                        for v in c {
+                            b.extend_from_slice(&(u16::from(*v) * 257).to_le_bytes());
+                        }
+                        b.extend_from_slice(&u16::MAX.to_le_bytes());
+                    }
+                    7 => b.extend_from_slice(&f64::from(c[0]).to_le_bytes()),
+                    _ => {}
+                }
+            }
+            if version == 101 {
+                b.extend_from_slice(&1u32.to_le_bytes());
+                b.extend_from_slice(&3u64.to_le_bytes());
+                b.extend_from_slice(&[1, 2, 3]);
+            }
+        }
+        let end = b.len() as u64;
+        b[68..76].copy_from_slice(&end.to_le_bytes());
+        b
+    }
+
+    fn list() -> impl Strategy<Value = List> {
+        (
+            1u8..=4,
+            0u8..=7,
+            prop::collection::vec((any::<[i16; 3]>(), any::<u8>(), any::<[u8; 3]>()), 0..6),
+        )
+            .prop_map(|(vt, ct, points)| List { vt, ct, points })
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(64))]
+        #[test]
+        fn reads_back_what_was_written(version in 100u16..=103, lists in prop::collection::vec(list(), 0..4)) {
+            let bytes = write(version, &lists);
+            let spec = IncludeSpec::bare(std::path::Path::new("rt.mmpld"));
+            let got = load_bytes(&spec, Format::Mmpld, &bytes).expect("reads");
+            let want: Vec<_> = lists.iter().flat_map(|l| l.points.iter().map(move |p| (l, p))).collect();
+            prop_assert_eq!(got.records.len(), want.len());
+            for (r, (l, (p, rad, c))) in got.records.iter().zip(want) {
+                prop_assert!(close3(r.center, p.map(f64::from), 0.0));
+                let radius = if l.vt == 2 { f64::from(*rad) / 8.0 + 0.125 } else { 0.75 };
+                prop_assert_eq!(r.radius, radius);
+                let cf = c.map(|v| f64::from(v) / 255.0);
+                let colour = match l.ct {
+                    0 => [10.0 / 255.0, 20.0 / 255.0, 30.0 / 255.0].map(decode),
+                    3 | 7 => [decode(cf[0]); 3],
+                    _ => cf.map(decode),
+                };
+                prop_assert!(close3(r.color.expect("colour"), colour, 1e-6), "{:?} vs {:?}", r.color, colour);
+            }
+        }
+    }
+}
