@@ -267,4 +267,11 @@ fn bad_input_exits_2_names_the_file_and_writes_nothing() {
     rejects(d, "hdr.csv", b"1,2,3\n", "header");
     rejects(d, "radius.csv", b"x,y,z,radius\n0,0,0,-1\n", "radius.csv:2");
     rejects(d, "thing.dat", b"hello", "unsupported particle file type");
+    rejects(
+        d,
+        "opacity.csv",
+        b"x,y,z,opacity\n0,0,0,1.5\n",
+        "opacity.csv:2",
+    );
+    rejects(d, "transp.wrl", b"#VRML V2.0 utf8\nShape { appearance Appearance { material Material { transparency -1 } } geometry Sphere { } }\n", "transp.wrl:2");
 }

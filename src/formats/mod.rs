@@ -132,8 +132,9 @@ pub fn load_particles(spec: &IncludeSpec) -> Result<LoadedParticles> {
     Ok(loaded)
 }
 
-/// Every particle has a finite centre and a finite radius > 0 (also for `pgt info`, which does
-/// not build a scene); the error points at the particle's line or byte.
+/// Every particle has a finite centre, a finite radius > 0, a colour ≥ 0 and an opacity in
+/// [0, 1] (also for `pgt info`, which does not build a scene); the error points at the
+/// particle's line or byte.
 fn check_records(path: &Path, records: &[ParticleRecord]) -> Result<()> {
     for r in records {
         let problem = if !r.center.is_finite() {
@@ -142,6 +143,19 @@ fn check_records(path: &Path, records: &[ParticleRecord]) -> Result<()> {
             Some(format!(
                 "the particle radius must be finite and > 0, got {}",
                 r.radius
+            ))
+        } else if r
+            .color
+            .is_some_and(|c| !(c.is_finite() && c.min_element() >= 0.0))
+        {
+            Some(format!(
+                "the particle colour must be finite and ≥ 0, got {:?}",
+                r.color
+            ))
+        } else if r.opacity.is_some_and(|o| !(0.0..=1.0).contains(&o)) {
+            Some(format!(
+                "the particle opacity must be in [0, 1], got {:?}",
+                r.opacity
             ))
         } else {
             None
