@@ -125,7 +125,7 @@ pub struct IncludeSpec {
     /// PDB/mmCIF: drop hydrogens.
     #[serde(default)]
     pub skip_hydrogen: bool,
-    /// MMPLD: which frame (0-based); the first by default.
+    /// MMPLD and XYZ: which frame (0-based); the first by default.
     pub frame: Option<usize>,
     /// Forces a file format whatever the extension (`"pdb"`, `"mmcif"`, `"vrml"`, `"mmpld"`,
     /// `"xyz"`, `"csv"`).
