@@ -85,9 +85,10 @@ fn smoke(name: &str, format: Format, input: &[u8], seed: u64) {
     let mut errors = 0;
     for i in 0..ROUNDS {
         let m = mutate(&mut rng, input);
+        // SMOKE_TRACE=1: print each iteration and keep its input, to find a hang or an abort.
         if std::env::var("SMOKE_TRACE").is_ok() {
             eprintln!("{name} {i}");
-            std::fs::write("/tmp/fmt_smoke_last", &m).ok();
+            std::fs::write(std::env::temp_dir().join("pgt_smoke_last"), &m).ok();
         }
         let r = std::panic::catch_unwind(|| load_bytes(&spec, format, &m));
         match r {
