@@ -2,10 +2,14 @@
 //! synthetic random set of [`crate::formats::random`], written as CSV, atomically.
 
 use super::Outcome;
-use crate::formats::random::{generate, to_csv, RandomSpec, THESIS_COUNT};
+use crate::formats::random::{particles, write_csv, RandomSpec, THESIS_COUNT};
 use clap::{Args, Subcommand};
 use glam::DVec3;
 use std::path::PathBuf;
+
+/// Most particles `pgt gen random` writes (about 7.5 GB of CSV); a typo beyond it is refused
+/// rather than filling the disk.
+pub const MAX_COUNT: usize = 100_000_000;
 
 /// `pgt gen …`: synthetic data sets.
 #[derive(Debug, Args)]
@@ -94,8 +98,10 @@ pub fn run(args: GenArgs) -> anyhow::Result<Outcome> {
                 box_max,
                 radius: parse_radius(&a.radius)?,
             };
-            let text = to_csv(&generate(&spec));
-            write_atomically(&a.output, text.as_bytes())?;
+            if a.count > MAX_COUNT {
+                anyhow::bail!("--count: at most {MAX_COUNT} particles, got {}", a.count);
+            }
+            write_atomically(&a.output, |w| write_csv(w, particles(&spec)))?;
             eprintln!(
                 "wrote {} random particles to {}",
                 a.count,
@@ -106,16 +112,23 @@ pub fn run(args: GenArgs) -> anyhow::Result<Outcome> {
     }
 }
 
-/// Writes through a temporary file in the same directory, renamed into place when complete.
-fn write_atomically(path: &std::path::Path, bytes: &[u8]) -> crate::Result<()> {
+/// Writes through a temporary file in the same directory (streamed through a buffer), renamed
+/// into place when complete; on any error the temporary file is removed and nothing appears.
+fn write_atomically(
+    path: &std::path::Path,
+    write: impl FnOnce(&mut std::io::BufWriter<&std::fs::File>) -> std::io::Result<()>,
+) -> crate::Result<()> {
     use std::io::Write;
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => std::path::Path::new("."),
     };
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| crate::PgtError::io(path, e))?;
-    tmp.write_all(bytes)
-        .map_err(|e| crate::PgtError::io(path, e))?;
+    let tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| crate::PgtError::io(path, e))?;
+    {
+        let mut w = std::io::BufWriter::new(tmp.as_file());
+        write(&mut w).map_err(|e| crate::PgtError::io(path, e))?;
+        w.flush().map_err(|e| crate::PgtError::io(path, e))?;
+    }
     #[cfg(unix)]
     {
         // A temporary file is private (0600); the data set is an ordinary file.

@@ -74,39 +74,51 @@ impl SplitMix64 {
     }
 }
 
-/// Generates the set (deterministic for a given spec).
-pub fn generate(spec: &RandomSpec) -> Vec<RandomParticle> {
+/// The set as an iterator, one particle at a time (deterministic for a given spec).
+pub fn particles(spec: &RandomSpec) -> impl Iterator<Item = RandomParticle> + '_ {
     let mut rng = SplitMix64::new(spec.seed);
     let extent = spec.box_max - spec.box_min;
-    (0..spec.count)
-        .map(|_| {
-            let u = DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64());
-            let center = spec.box_min + u * extent;
-            let radius = spec.radius.0 + rng.next_f64() * (spec.radius.1 - spec.radius.0);
-            let color = DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64());
-            RandomParticle {
-                center,
-                radius,
-                color,
-            }
-        })
-        .collect()
+    (0..spec.count).map(move |_| {
+        let u = DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64());
+        let center = spec.box_min + u * extent;
+        let radius = spec.radius.0 + rng.next_f64() * (spec.radius.1 - spec.radius.0);
+        let color = DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64());
+        RandomParticle {
+            center,
+            radius,
+            color,
+        }
+    })
 }
 
-/// The set as CSV text with the header `x,y,z,radius,red,green,blue` (six decimals), the format
-/// [`super::xyz_csv::load_csv`] reads.
-pub fn to_csv(particles: &[RandomParticle]) -> String {
-    let mut s = String::with_capacity(particles.len() * 80 + 32);
-    s.push_str("x,y,z,radius,red,green,blue\n");
+/// Generates the whole set in memory.
+pub fn generate(spec: &RandomSpec) -> Vec<RandomParticle> {
+    particles(spec).collect()
+}
+
+/// Writes particles as CSV with the header `x,y,z,radius,red,green,blue` (six decimals), the
+/// format [`super::xyz_csv::load_csv`] reads.
+pub fn write_csv(
+    out: &mut impl std::io::Write,
+    particles: impl IntoIterator<Item = RandomParticle>,
+) -> std::io::Result<()> {
+    writeln!(out, "x,y,z,radius,red,green,blue")?;
     for p in particles {
-        use std::fmt::Write;
-        let _ = writeln!(
-            s,
+        writeln!(
+            out,
             "{:.6},{:.6},{:.6},{:.6},{:.6},{:.6},{:.6}",
             p.center.x, p.center.y, p.center.z, p.radius, p.color.x, p.color.y, p.color.z
-        );
+        )?;
     }
-    s
+    Ok(())
+}
+
+/// The set as CSV text ([`write_csv`] into a string).
+pub fn to_csv(particles: &[RandomParticle]) -> String {
+    let mut v = Vec::with_capacity(particles.len() * 80 + 32);
+    // Writing into a Vec cannot fail.
+    let _ = write_csv(&mut v, particles.iter().copied());
+    String::from_utf8_lossy(&v).into_owned()
 }
 
 #[cfg(test)]
