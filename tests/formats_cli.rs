@@ -146,16 +146,22 @@ fn gen_random_is_deterministic_and_readable() {
     );
     // Bad options: exit 2, nothing written.
     let e = dir.path().join("e.csv");
-    let out = pgt(&[
-        "gen",
-        "random",
-        "--radius",
-        "2..1",
-        "-o",
-        e.to_str().expect("utf8"),
-    ]);
-    assert_eq!(out.status.code(), Some(2));
-    assert!(!e.exists());
+    for bad in [
+        ["--radius", "2..1"],
+        ["--count", "1000000000000"],
+        ["--box", "1,2,3"],
+    ] {
+        let out = pgt(&[
+            "gen",
+            "random",
+            bad[0],
+            bad[1],
+            "-o",
+            e.to_str().expect("utf8"),
+        ]);
+        assert_eq!(out.status.code(), Some(2), "{bad:?}");
+        assert!(!e.exists(), "{bad:?}");
+    }
 }
 
 #[test]
