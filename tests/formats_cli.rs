@@ -281,3 +281,31 @@ fn bad_input_exits_2_names_the_file_and_writes_nothing() {
     );
     rejects(d, "transp.wrl", b"#VRML V2.0 utf8\nShape { appearance Appearance { material Material { transparency -1 } } geometry Sphere { } }\n", "transp.wrl:2");
 }
+
+#[test]
+fn scene_include_can_force_the_format() {
+    let dir = tempfile::tempdir().expect("tmp");
+    std::fs::write(
+        dir.path().join("atoms.txt"),
+        "ATOM      1  N   ALA A   2      63.130 -67.331 -18.137  1.00 21.97           N  \n",
+    )
+    .expect("write");
+    let scene = dir.path().join("s.toml");
+    std::fs::write(
+        &scene,
+        "[[include]]\npath = \"atoms.txt\"\nformat = \"pdb\"\n",
+    )
+    .expect("write");
+    let v = json(&pgt(&["info", scene.to_str().expect("utf8"), "--json"]));
+    assert_eq!(v["particles"], 1);
+    assert_eq!(v["radius"]["min"], 1.55);
+    // A misspelt format is an error naming the scene file.
+    std::fs::write(
+        &scene,
+        "[[include]]\npath = \"atoms.txt\"\nformat = \"pbd\"\n",
+    )
+    .expect("write");
+    let out = pgt(&["info", scene.to_str().expect("utf8")]);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("s.toml"));
+}
