@@ -2,6 +2,8 @@
 //! [`Outcome`]; `main` maps it and errors to exit codes 0 / 1 / 2.
 
 pub mod compare;
+pub mod gen;
+pub mod info;
 pub mod render;
 pub mod sweep;
 
@@ -35,6 +37,10 @@ pub enum Command {
     Compare(compare::CompareArgs),
     /// Render the reference once and an approximation per parameter set; report with plots.
     Sweep(sweep::SweepArgs),
+    /// Particle count, bounds, radius range and colours of a particle or scene file.
+    Info(info::InfoArgs),
+    /// Generate synthetic data sets (`pgt gen random`).
+    Gen(gen::GenArgs),
 }
 
 /// Runs the parsed command line.
@@ -43,6 +49,8 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Render(args) => render::run(args),
         Command::Compare(args) => compare::run(args),
         Command::Sweep(args) => sweep::run(args),
+        Command::Info(args) => info::run(args),
+        Command::Gen(args) => gen::run(args),
     }
 }
 

@@ -125,8 +125,11 @@ pub struct IncludeSpec {
     /// PDB/mmCIF: drop hydrogens.
     #[serde(default)]
     pub skip_hydrogen: bool,
-    /// MMPLD: which frame (0-based); the first by default.
+    /// MMPLD and XYZ: which frame (0-based); the first by default.
     pub frame: Option<usize>,
+    /// Forces a file format whatever the extension (`"pdb"`, `"mmcif"`, `"vrml"`, `"mmpld"`,
+    /// `"xyz"`, `"csv"`).
+    pub format: Option<crate::formats::Format>,
 }
 
 impl IncludeSpec {
@@ -141,6 +144,7 @@ impl IncludeSpec {
             skip_water: false,
             skip_hydrogen: false,
             frame: None,
+            format: None,
         }
     }
 }

@@ -1,0 +1,12 @@
+//! Fuzz target: the mmpld reader must return Ok or Err on any bytes, never panic, loop or
+//! allocate without bound.
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+use pgt::formats::{load_bytes, Format};
+use pgt::scene::IncludeSpec;
+
+fuzz_target!(|data: &[u8]| {
+    let spec = IncludeSpec::bare(std::path::Path::new("fuzz.mmpld"));
+    let _ = load_bytes(&spec, Format::Mmpld, data);
+});

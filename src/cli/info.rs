@@ -1,0 +1,257 @@
+//! `pgt info FILE [--json]` (DESIGN.md §7): particle count, bounds, radius range, colours and
+//! warnings of a particle file (any format pgt reads) or of a scene file (`.toml`, loaded and
+//! validated with [`Scene::load`], so its includes count too).
+
+use super::Outcome;
+use crate::formats::{load_particles, Format};
+use crate::scene::{IncludeSpec, Scene, SceneLoadOptions};
+use clap::Args;
+use glam::DVec3;
+use std::collections::HashMap;
+use std::path::PathBuf;
+
+/// Options of `pgt info`.
+#[derive(Debug, Args)]
+pub struct InfoArgs {
+    /// A particle file (.pdb, .cif, .wrl, .mmpld, .xyz, .csv) or a scene file (.toml).
+    pub file: PathBuf,
+    /// Print JSON on stdout instead of text.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// How many of the most common colours the summary lists.
+const TOP_COLORS: usize = 8;
+
+/// What `pgt info` reports (also the JSON object it prints).
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Info {
+    /// The file as given.
+    pub file: String,
+    /// `scene` or the particle format.
+    pub format: String,
+    /// Number of particles.
+    pub particles: usize,
+    /// Axis-aligned bounds of the spheres (centre ± radius); absent when there are none.
+    pub bounds: Option<Bounds>,
+    /// Radius range and mean; absent when there are no particles.
+    pub radius: Option<RadiusRange>,
+    /// Colour summary.
+    pub colors: ColorSummary,
+    /// Warnings of the loaders.
+    pub warnings: Vec<String>,
+    /// Facts of the format: PDB/mmCIF `models` and `chains` (atom records per chain in the
+    /// first model, before alternate locations are resolved); MMPLD `version` and `frames`.
+    pub details: serde_json::Map<String, serde_json::Value>,
+}
+
+/// An axis-aligned box.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Bounds {
+    /// Lower corner.
+    pub min: [f64; 3],
+    /// Upper corner.
+    pub max: [f64; 3],
+}
+
+/// Smallest, largest and mean radius.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct RadiusRange {
+    /// Smallest radius.
+    pub min: f64,
+    /// Largest radius.
+    pub max: f64,
+    /// Mean radius.
+    pub mean: f64,
+}
+
+/// The particles' colours.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ColorSummary {
+    /// Distinct colours among the particles that have one.
+    pub distinct: usize,
+    /// Particles without a colour of their own (they take the scene's default).
+    pub uncolored: usize,
+    /// The most common colours, linear RGB, with their counts.
+    pub most_common: Vec<ColorCount>,
+}
+
+/// One colour and how many particles have it.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ColorCount {
+    /// Linear RGB.
+    pub rgb: [f64; 3],
+    /// Particles with this colour.
+    pub count: usize,
+}
+
+/// Summarises spheres given as (centre, radius, colour).
+pub fn summarize(
+    file: String,
+    format: String,
+    spheres: impl Iterator<Item = (DVec3, f64, Option<DVec3>)>,
+    warnings: Vec<String>,
+) -> Info {
+    let mut n = 0usize;
+    let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+    let (mut rmin, mut rmax, mut rsum) = (f64::INFINITY, f64::NEG_INFINITY, 0.0);
+    let mut uncolored = 0usize;
+    let mut counts: HashMap<[u64; 3], usize> = HashMap::new();
+    for (c, r, col) in spheres {
+        n += 1;
+        lo = lo.min(c - DVec3::splat(r));
+        hi = hi.max(c + DVec3::splat(r));
+        rmin = rmin.min(r);
+        rmax = rmax.max(r);
+        rsum += r;
+        match col {
+            Some(c) => {
+                *counts
+                    .entry([c.x.to_bits(), c.y.to_bits(), c.z.to_bits()])
+                    .or_insert(0) += 1
+            }
+            None => uncolored += 1,
+        }
+    }
+    let mut top: Vec<([u64; 3], usize)> = counts.iter().map(|(k, v)| (*k, *v)).collect();
+    top.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
+    Info {
+        file,
+        format,
+        particles: n,
+        bounds: (n > 0).then(|| Bounds {
+            min: lo.to_array(),
+            max: hi.to_array(),
+        }),
+        radius: (n > 0).then(|| RadiusRange {
+            min: rmin,
+            max: rmax,
+            mean: rsum / n as f64,
+        }),
+        colors: ColorSummary {
+            distinct: counts.len(),
+            uncolored,
+            most_common: top
+                .into_iter()
+                .take(TOP_COLORS)
+                .map(|(k, count)| ColorCount {
+                    rgb: k.map(f64::from_bits),
+                    count,
+                })
+                .collect(),
+        },
+        warnings,
+        details: serde_json::Map::new(),
+    }
+}
+
+/// The format-specific facts of [`Info::details`].
+fn details(
+    path: &std::path::Path,
+    format: Format,
+) -> crate::Result<serde_json::Map<String, serde_json::Value>> {
+    use serde_json::json;
+    let mut d = serde_json::Map::new();
+    let atoms = match format {
+        Format::Pdb => {
+            Some(crate::formats::pdb::read_atoms(path, &crate::formats::read_input(path)?)?.0)
+        }
+        Format::Mmcif => {
+            Some(crate::formats::mmcif::read_atoms(path, &crate::formats::read_input(path)?)?.0)
+        }
+        Format::Mmpld => {
+            let h = crate::formats::mmpld::header(path, &crate::formats::read_input(path)?)?;
+            d.insert(
+                "version".into(),
+                json!(format!("{}.{}", h.version / 100, h.version % 100)),
+            );
+            d.insert("frames".into(), json!(h.frames));
+            None
+        }
+        _ => None,
+    };
+    if let Some(atoms) = atoms {
+        let mut models: Vec<i64> = Vec::new();
+        for a in &atoms {
+            if !models.contains(&a.model) {
+                models.push(a.model);
+            }
+        }
+        let mut chains = serde_json::Map::new();
+        for a in atoms.iter().filter(|a| Some(&a.model) == models.first()) {
+            let n = chains.get(&a.chain).and_then(|v| v.as_u64()).unwrap_or(0);
+            chains.insert(a.chain.clone(), json!(n + 1));
+        }
+        d.insert("models".into(), json!(models));
+        d.insert("chains".into(), serde_json::Value::Object(chains));
+    }
+    Ok(d)
+}
+
+/// Loads a file and summarises it.
+pub fn info_of(path: &std::path::Path) -> crate::Result<Info> {
+    let is_toml = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    let name = path.display().to_string();
+    if is_toml {
+        let scene = Scene::load(path, &SceneLoadOptions::default())?;
+        let it = scene
+            .particles
+            .iter()
+            .map(|p| (p.center, p.radius, Some(p.color)));
+        Ok(summarize(name, "scene".into(), it, scene.warnings.clone()))
+    } else {
+        let loaded = load_particles(&IncludeSpec::bare(path))?;
+        let format = Format::from_path(path).map_or("unknown".to_string(), |f| {
+            serde_json::to_value(f)
+                .ok()
+                .and_then(|v| v.as_str().map(String::from))
+                .unwrap_or_default()
+        });
+        let it = loaded.records.iter().map(|r| (r.center, r.radius, r.color));
+        let mut info = summarize(name, format, it, loaded.warnings);
+        if let Some(f) = Format::from_path(path) {
+            info.details = details(path, f)?;
+        }
+        Ok(info)
+    }
+}
+
+/// Runs `pgt info`.
+pub fn run(args: InfoArgs) -> anyhow::Result<Outcome> {
+    let info = info_of(&args.file)?;
+    if args.json {
+        println!("{}", serde_json::to_string_pretty(&info)?);
+        return Ok(Outcome::Success);
+    }
+    println!("{} ({})", info.file, info.format);
+    println!("particles: {}", info.particles);
+    if let (Some(b), Some(r)) = (&info.bounds, &info.radius) {
+        let v = |a: [f64; 3]| format!("[{:.4}, {:.4}, {:.4}]", a[0], a[1], a[2]);
+        println!("bounds:    {} .. {}", v(b.min), v(b.max));
+        println!(
+            "radius:    {:.4} .. {:.4} (mean {:.4})",
+            r.min, r.max, r.mean
+        );
+    }
+    let c = &info.colors;
+    println!(
+        "colours:   {} distinct, {} without a colour (scene default)",
+        c.distinct, c.uncolored
+    );
+    for cc in &c.most_common {
+        println!(
+            "           linear RGB [{:.4}, {:.4}, {:.4}] × {}",
+            cc.rgb[0], cc.rgb[1], cc.rgb[2], cc.count
+        );
+    }
+    for (k, v) in &info.details {
+        println!("{:<10} {v}", format!("{k}:"));
+    }
+    for w in &info.warnings {
+        println!("warning:   {w}");
+    }
+    Ok(Outcome::Success)
+}

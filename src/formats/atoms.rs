@@ -1,0 +1,294 @@
+//! What PDB and mmCIF share once their syntax is read: a list of atoms, and the selection and
+//! colouring of DESIGN.md §1 / §6 (model, alternate locations, chains, waters, hydrogens,
+//! `color_by`).
+
+use super::elements::{element_color, element_radius, srgb8_hex_to_linear, Element};
+use super::LoadedParticles;
+use crate::error::{Location, PgtError, Result};
+use crate::scene::{ColorBy, IncludeSpec, ParticleRecord};
+use glam::DVec3;
+use std::collections::{BTreeSet, HashMap};
+
+/// One atom record as read from a structure file.
+#[derive(Debug, Clone)]
+pub struct Atom {
+    /// Position in Å.
+    pub position: DVec3,
+    /// The element, if the file names one or it can be inferred from the atom name.
+    pub element: Option<Element>,
+    /// Atom name (`CA`, `1HB`), trimmed.
+    pub name: String,
+    /// Alternate location indicator (`None` for blank, `.` or `?`).
+    pub alt_loc: Option<String>,
+    /// Occupancy (1 where the file leaves it blank).
+    pub occupancy: f64,
+    /// Residue name (`ALA`, `HOH`).
+    pub residue_name: String,
+    /// Chain identifier, trimmed (may be empty).
+    pub chain: String,
+    /// Residue number with insertion code, as written (identifies the residue within the chain).
+    pub residue: String,
+    /// Model number as written (1 where the file has no models).
+    pub model: i64,
+    /// 1-based line of the record.
+    pub line: usize,
+}
+
+/// Residue names of water (PDB, Amber, CHARMM, GROMACS spellings).
+const WATER_NAMES: &[&str] = &[
+    "HOH", "WAT", "H2O", "DOD", "D2O", "TIP", "TIP3", "TIP4", "SPC", "SOL",
+];
+
+/// Chain colours, 8-bit sRGB: the Okabe–Ito colour-blind-safe set followed by Tableau 10;
+/// chain i (in order of first appearance) gets entry i mod the length.
+const CHAIN_PALETTE_SRGB8: &[u32] = &[
+    0xE69F00, 0x56B4E9, 0x009E73, 0xF0E442, 0x0072B2, 0xD55E00, 0xCC79A7, 0x999999, 0x4E79A7,
+    0xF28E2B, 0xE15759, 0x76B7B2, 0x59A14F, 0xEDC948, 0xB07AA1, 0xFF9DA7, 0x9C755F, 0xBAB0AC,
+];
+
+/// Whether a residue name is water.
+pub fn is_water(residue_name: &str) -> bool {
+    WATER_NAMES
+        .iter()
+        .any(|w| w.eq_ignore_ascii_case(residue_name.trim()))
+}
+
+/// Infers the element from a PDB-style atom name (four characters, element right-justified in the
+/// first two) when the file has no element column: leading digits and blanks are skipped
+/// (`1HB ` → H); a two-letter element is taken only for HETATM records whose name starts in the
+/// first column (` FE ` would be right-justified, `FE  ` is iron, `CA  ` in a HETATM is calcium),
+/// otherwise the first letter (`CA` in an ATOM record is the α carbon, `HD21` is hydrogen).
+pub fn infer_element(name: &str, hetatm: bool) -> Option<Element> {
+    let chars: Vec<char> = name.chars().collect();
+    let first_is_letter = chars.first().is_some_and(|c| c.is_ascii_alphabetic());
+    // A full-width name starting with H (`HG21`, `HO2A`) is a hydrogen, not mercury or holmium;
+    // after a two-letter element only digits or blanks may follow (`FE1`, `CL2`).
+    let full_width_h =
+        chars.len() >= 4 && chars.iter().all(|c| !c.is_whitespace()) && chars.first() == Some(&'H');
+    let rest_plain = chars
+        .iter()
+        .skip(2)
+        .all(|c| c.is_ascii_digit() || c.is_whitespace());
+    if hetatm
+        && first_is_letter
+        && !full_width_h
+        && rest_plain
+        && chars.get(1).is_some_and(|c| c.is_ascii_alphabetic())
+    {
+        let two: String = chars.iter().take(2).collect();
+        if let Some(e) = Element::from_symbol(&two) {
+            return Some(e);
+        }
+    }
+    let first = chars.iter().find(|c| c.is_ascii_alphabetic())?;
+    Element::from_symbol(&first.to_string())
+}
+
+/// Applies the selections of `spec` to `atoms` (all models, all alternate locations) and makes
+/// particles: radius = van der Waals radius × `radius_scale` is applied later by the caller.
+pub fn atoms_to_particles(
+    spec: &IncludeSpec,
+    atoms: Vec<Atom>,
+    mut warnings: Vec<String>,
+) -> Result<LoadedParticles> {
+    let path = &spec.path;
+    // Model: the requested one, or the first that appears.
+    let models: Vec<i64> = {
+        let mut seen = Vec::new();
+        for a in &atoms {
+            if !seen.contains(&a.model) {
+                seen.push(a.model);
+            }
+        }
+        seen
+    };
+    let model = match spec.model {
+        Some(m) => {
+            let m = i64::try_from(m).unwrap_or(i64::MAX);
+            if !models.contains(&m) {
+                return Err(PgtError::in_file(
+                    path,
+                    format!(
+                        "model {m} is not in the file (it has model{} {})",
+                        if models.len() == 1 { "" } else { "s" },
+                        list(models.iter())
+                    ),
+                ));
+            }
+            m
+        }
+        None => models.first().copied().unwrap_or(1),
+    };
+    if spec.model.is_none() && models.len() > 1 {
+        warnings.push(format!(
+            "{}: the file has {} models; using model {model} (set `model = N` to choose)",
+            path.display(),
+            models.len()
+        ));
+    }
+    if let Some(chains) = &spec.chains {
+        let present: BTreeSet<&str> = atoms
+            .iter()
+            .filter(|a| a.model == model)
+            .map(|a| a.chain.as_str())
+            .collect();
+        let missing: Vec<&String> = chains
+            .iter()
+            .filter(|c| !present.contains(c.as_str()))
+            .collect();
+        if !missing.is_empty() {
+            return Err(PgtError::in_file(
+                path,
+                format!(
+                    "chain{} {} not in model {model} (it has chains {})",
+                    if missing.len() == 1 { " is" } else { "s are" },
+                    list(missing.iter()),
+                    list(present.iter())
+                ),
+            ));
+        }
+    }
+
+    // Alternate locations: per (chain, residue, atom name), keep the highest occupancy; ties go
+    // to altLoc 'A', then to the first in the file. The kept atom takes the place of the first.
+    let mut kept: Vec<Atom> = Vec::new();
+    let mut group: HashMap<(String, String, String), usize> = HashMap::new();
+    let mut alt_groups = 0usize;
+    for a in atoms.into_iter().filter(|a| a.model == model) {
+        if a.alt_loc.is_none() {
+            kept.push(a);
+            continue;
+        }
+        let key = (a.chain.clone(), a.residue.clone(), a.name.clone());
+        match group.get(&key) {
+            None => {
+                group.insert(key, kept.len());
+                alt_groups += 1;
+                kept.push(a);
+            }
+            Some(&i) => {
+                if let Some(k) = kept.get_mut(i) {
+                    let better = a.occupancy > k.occupancy
+                        || (a.occupancy == k.occupancy
+                            && a.alt_loc.as_deref() == Some("A")
+                            && k.alt_loc.as_deref() != Some("A"));
+                    if better {
+                        *k = a;
+                    }
+                }
+            }
+        }
+    }
+    if alt_groups > 0 {
+        warnings.push(format!(
+            "{}: {alt_groups} atoms have alternate locations; kept the one with the highest occupancy of each",
+            path.display()
+        ));
+    }
+
+    let mut chain_index: HashMap<String, usize> = HashMap::new();
+    let mut fallback_radius: BTreeSet<String> = BTreeSet::new();
+    let mut unknown_element = 0usize;
+    let mut records = Vec::with_capacity(kept.len());
+    for a in kept {
+        if let Some(chains) = &spec.chains {
+            if !chains.contains(&a.chain) {
+                continue;
+            }
+        }
+        if spec.skip_water && is_water(&a.residue_name) {
+            continue;
+        }
+        if spec.skip_hydrogen && a.element.is_some_and(Element::is_hydrogen) {
+            continue;
+        }
+        match a.element {
+            None => unknown_element += 1,
+            Some(e) if e.vdw_radius().is_none() => {
+                fallback_radius.insert(e.symbol().to_string());
+            }
+            Some(_) => {}
+        }
+        let ci = match chain_index.get(&a.chain) {
+            Some(&i) => i,
+            None => {
+                let n = chain_index.len();
+                chain_index.insert(a.chain.clone(), n);
+                n
+            }
+        };
+        let color = match spec.color_by {
+            ColorBy::Element => Some(element_color(a.element)),
+            ColorBy::Chain => Some(srgb8_hex_to_linear(
+                CHAIN_PALETTE_SRGB8
+                    .get(ci % CHAIN_PALETTE_SRGB8.len())
+                    .copied()
+                    .unwrap_or(0xFFFFFF),
+            )),
+            ColorBy::Uniform => None,
+        };
+        records.push(ParticleRecord {
+            center: a.position,
+            radius: element_radius(a.element),
+            color,
+            opacity: None,
+            location: Location::Line(a.line),
+        });
+    }
+    if unknown_element > 0 {
+        warnings.push(format!(
+            "{}: {unknown_element} atoms have no recognisable element; they get radius {} Å",
+            path.display(),
+            super::elements::FALLBACK_RADIUS
+        ));
+    }
+    if !fallback_radius.is_empty() {
+        warnings.push(format!(
+            "{}: no tabulated van der Waals radius for {}; used {} Å",
+            path.display(),
+            list(fallback_radius.iter()),
+            super::elements::FALLBACK_RADIUS
+        ));
+    }
+    Ok(LoadedParticles { records, warnings })
+}
+
+fn list<T: std::fmt::Display>(items: impl Iterator<Item = T>) -> String {
+    let v: Vec<String> = items.map(|c| format!("'{c}'")).collect();
+    if v.is_empty() {
+        "none".to_string()
+    } else {
+        v.join(", ")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn sym(name: &str, het: bool) -> Option<&'static str> {
+        infer_element(name, het).map(Element::symbol)
+    }
+
+    #[test]
+    fn infers_elements_from_names() {
+        assert_eq!(sym(" CA ", false), Some("C"));
+        assert_eq!(sym("CA  ", false), Some("C"));
+        assert_eq!(sym("CA  ", true), Some("Ca"));
+        assert_eq!(sym("FE  ", true), Some("Fe"));
+        assert_eq!(sym("1HB ", false), Some("H"));
+        assert_eq!(sym("HD21", false), Some("H"));
+        assert_eq!(sym(" N  ", true), Some("N"));
+        assert_eq!(sym("    ", true), None);
+        assert_eq!(sym("1234", true), None);
+        assert_eq!(sym("HO2A", true), Some("H"));
+        assert_eq!(sym("CL1 ", true), Some("Cl"));
+    }
+
+    #[test]
+    fn waters() {
+        assert!(is_water("HOH"));
+        assert!(is_water("wat"));
+        assert!(!is_water("HOX"));
+    }
+}

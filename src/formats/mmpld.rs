@@ -1,0 +1,571 @@
+//! MegaMol particle lists (MMPLD), versions 1.0–1.3, little-endian.
+//!
+//! Layout (from UniStuttgart-VISUS/mmpld and MegaMol's `MMPLDDataSource.cpp`; see
+//! `../shared/data/SOURCES.md`): a 60-byte header (`"MMPLD\0"`, `u16` version = 100·major+minor,
+//! `u32` frames, two `f32[6]` boxes), a seek table of `frames + 1` `u64` offsets (the last is the
+//! end of the data; a table of only `frames` entries, as the mmpld library writes, is accepted
+//! too), then per frame: `f32` timestamp (version ≥ 1.2), `i32` list count, and per list:
+//! `u8` vertex type, `u8` colour type, `f32` global radius (vertex types 1, 3, 4), `u8[4]` global
+//! RGBA (colour type 0), `f32[2]` intensity range (colour types 3, 7), `u64` count, `f32[6]` list
+//! box (version 1.3), the interleaved particles, and cluster info (version 1.1).
+//!
+//! Vertex types: 0 none (the list holds no particles), 1 `f32` xyz, 2 `f32` xyzr, 3 `i16` xyz,
+//! 4 `f64` xyz. Colour types: 0 none (global RGBA), 1 `u8` RGB, 2 `u8` RGBA, 3 `f32` intensity,
+//! 4 `f32` RGB, 5 `f32` RGBA, 6 `u16` RGBA, 7 `f64` intensity.
+//!
+//! **Colours.** MegaMol shows stored colours as they are, so pgt treats them as sRGB display
+//! values in [0, 1] (integers divided by 255 or 65535) and decodes them to linear RGB; negative
+//! values become 0. Alpha is ignored (the scene's `opacity` applies). Intensities go through the
+//! list's [min, max] range to t ∈ [0, 1] (clamped; t = 0 if max ≤ min) and then a **grey ramp**:
+//! sRGB grey t, decoded to linear.
+//!
+//! **The version-1.3 writer bug.** Writers before MegaMol commit fc4e784 wrote version 103 files
+//! without the frame timestamp. For version 103, pgt parses the frame with the timestamp; if that
+//! does not end exactly at the next seek-table offset, it parses it again without, and keeps that
+//! reading (with a warning) if it ends there.
+//!
+//! Every count is checked against the bytes that remain before anything is allocated.
+
+use super::elements::srgb_to_linear;
+use super::LoadedParticles;
+use crate::error::{Location, PgtError, Result};
+use crate::scene::{IncludeSpec, ParticleRecord};
+use glam::DVec3;
+use std::path::Path;
+
+const MAGIC: &[u8; 6] = b"MMPLD\0";
+const HEADER_BYTES: u64 = 60;
+
+/// A little-endian reader over a byte range that reports offsets in errors.
+struct Cursor<'a> {
+    bytes: &'a [u8],
+    pos: usize,
+    /// Reads may not go past this offset (the frame's end).
+    end: usize,
+    path: &'a Path,
+}
+
+impl<'a> Cursor<'a> {
+    fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8]> {
+        let stop = self.pos.checked_add(n).filter(|&s| s <= self.end);
+        match stop.and_then(|s| self.bytes.get(self.pos..s)) {
+            Some(b) => {
+                self.pos += n;
+                Ok(b)
+            }
+            None => Err(PgtError::at_byte(
+                self.path,
+                self.pos as u64,
+                format!(
+                    "expected {what} ({n} bytes), but the {} ends at byte {}",
+                    self.region(),
+                    self.end
+                ),
+            )),
+        }
+    }
+    fn region(&self) -> &'static str {
+        if self.end == self.bytes.len() {
+            "file"
+        } else {
+            "frame"
+        }
+    }
+    fn arr<const N: usize>(&mut self, what: &str) -> Result<[u8; N]> {
+        let b = self.take(N, what)?;
+        let mut a = [0u8; N];
+        a.copy_from_slice(b);
+        Ok(a)
+    }
+    fn u8(&mut self, what: &str) -> Result<u8> {
+        Ok(self.arr::<1>(what)?[0])
+    }
+    fn u16(&mut self, what: &str) -> Result<u16> {
+        Ok(u16::from_le_bytes(self.arr(what)?))
+    }
+    fn u32(&mut self, what: &str) -> Result<u32> {
+        Ok(u32::from_le_bytes(self.arr(what)?))
+    }
+    fn i32(&mut self, what: &str) -> Result<i32> {
+        Ok(i32::from_le_bytes(self.arr(what)?))
+    }
+    fn u64(&mut self, what: &str) -> Result<u64> {
+        Ok(u64::from_le_bytes(self.arr(what)?))
+    }
+    fn f32(&mut self, what: &str) -> Result<f32> {
+        Ok(f32::from_le_bytes(self.arr(what)?))
+    }
+    fn err(&self, at: usize, msg: impl Into<String>) -> PgtError {
+        PgtError::at_byte(self.path, at as u64, msg)
+    }
+}
+
+fn le_f32(b: &[u8], at: usize) -> f64 {
+    let mut a = [0u8; 4];
+    if let Some(s) = b.get(at..at + 4) {
+        a.copy_from_slice(s);
+    }
+    f64::from(f32::from_le_bytes(a))
+}
+fn le_f64(b: &[u8], at: usize) -> f64 {
+    let mut a = [0u8; 8];
+    if let Some(s) = b.get(at..at + 8) {
+        a.copy_from_slice(s);
+    }
+    f64::from_le_bytes(a)
+}
+fn le_i16(b: &[u8], at: usize) -> f64 {
+    let mut a = [0u8; 2];
+    if let Some(s) = b.get(at..at + 2) {
+        a.copy_from_slice(s);
+    }
+    f64::from(i16::from_le_bytes(a))
+}
+fn le_u16(b: &[u8], at: usize) -> f64 {
+    let mut a = [0u8; 2];
+    if let Some(s) = b.get(at..at + 2) {
+        a.copy_from_slice(s);
+    }
+    f64::from(u16::from_le_bytes(a))
+}
+fn byte(b: &[u8], at: usize) -> f64 {
+    f64::from(b.get(at).copied().unwrap_or(0))
+}
+
+/// sRGB display value (any range) to linear, negatives clamped to 0.
+fn display_to_linear(c: DVec3) -> DVec3 {
+    DVec3::new(
+        srgb_to_linear(c.x.max(0.0)),
+        srgb_to_linear(c.y.max(0.0)),
+        srgb_to_linear(c.z.max(0.0)),
+    )
+}
+
+/// The grey-ramp colour map for intensities.
+fn intensity_color(i: f64, min: f64, max: f64) -> DVec3 {
+    let t = if max > min {
+        ((i - min) / (max - min)).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    let t = if t.is_finite() { t } else { 0.0 };
+    DVec3::splat(srgb_to_linear(t))
+}
+
+/// Header facts other tools (`pgt info`) may want.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Header {
+    /// 100·major + minor.
+    pub version: u16,
+    /// Number of frames.
+    pub frames: u32,
+}
+
+/// Reads the header and seek table: version, frame count and the frame offsets (frames + 1,
+/// the last being the end of the data).
+fn header_and_table(path: &Path, bytes: &[u8]) -> Result<(Header, Vec<u64>)> {
+    let mut c = Cursor {
+        bytes,
+        pos: 0,
+        end: bytes.len(),
+        path,
+    };
+    let magic = c.arr::<6>("the magic \"MMPLD\\0\"")?;
+    if &magic != MAGIC {
+        return Err(c.err(
+            0,
+            format!("not an MMPLD file: expected the magic \"MMPLD\\0\", found {magic:?}"),
+        ));
+    }
+    let version = c.u16("the version")?;
+    if !(100..=103).contains(&version) {
+        return Err(c.err(
+            6,
+            format!("unsupported MMPLD version {version} (expected 100–103, i.e. 1.0–1.3)"),
+        ));
+    }
+    let frames = c.u32("the frame count")?;
+    c.take(48, "the bounding and clip boxes")?;
+    let room = (bytes.len() as u64).saturating_sub(HEADER_BYTES) / 8;
+    if u64::from(frames) >= room {
+        return Err(c.err(
+            10,
+            format!(
+                "the header announces {frames} frames, but the file ({} bytes) has room for a seek table of at most {} entries",
+                bytes.len(),
+                room
+            ),
+        ));
+    }
+    let n = frames as usize + 1;
+    let mut table = Vec::with_capacity(n);
+    for _ in 0..n {
+        table.push(c.u64("a seek-table offset")?);
+    }
+    // A table of only `frames` entries (the mmpld library): then the first offset points
+    // at the (frames+1)-th entry's bytes, and the data end is the file end.
+    let full = HEADER_BYTES + 8 * n as u64;
+    if table.first() == Some(&(full - 8)) {
+        table.pop();
+        table.push(bytes.len() as u64);
+    }
+    for (k, w) in table.windows(2).enumerate() {
+        if let [a, b] = *w {
+            if a > b || b > bytes.len() as u64 || a < HEADER_BYTES {
+                return Err(c.err(
+                    60 + 8 * k,
+                    format!(
+                        "the seek table gives frame {k} the bytes {a}..{b}, outside the file ({} bytes) or backwards",
+                        bytes.len()
+                    ),
+                ));
+            }
+        }
+    }
+    Ok((Header { version, frames }, table))
+}
+
+/// Reads the header of an MMPLD file.
+pub fn header(path: &Path, bytes: &[u8]) -> Result<Header> {
+    header_and_table(path, bytes).map(|(h, _)| h)
+}
+
+/// Loads frame `spec.frame` (0-based, default 0) of an MMPLD file.
+pub fn load(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
+    let path = spec.path.as_path();
+    let (h, table) = header_and_table(path, bytes)?;
+    let mut warnings = Vec::new();
+    let frame = spec.frame.unwrap_or(0);
+    if h.frames == 0 {
+        warnings.push(format!("{}: the file has no frames", path.display()));
+        return Ok(LoadedParticles {
+            records: Vec::new(),
+            warnings,
+        });
+    }
+    if frame >= h.frames as usize {
+        return Err(PgtError::at_byte(
+            path,
+            10,
+            format!(
+                "frame {frame} requested, but the file has {} frame(s) (0-based)",
+                h.frames
+            ),
+        ));
+    }
+    let (start, end) = match (table.get(frame), table.get(frame + 1)) {
+        (Some(&a), Some(&b)) => (a as usize, b as usize),
+        _ => return Err(PgtError::at_byte(path, 60, "the seek table is too short")),
+    };
+    let with_ts = h.version >= 102;
+    let first = parse_frame(path, bytes, start, end, h.version, with_ts);
+    let records = match first {
+        Ok(r) => r,
+        Err(e) if h.version == 103 => {
+            match parse_frame(path, bytes, start, end, h.version, false) {
+                Ok(r) => {
+                    warnings.push(format!(
+                    "{}: frame {frame} of this version-1.3 file has no timestamp (a known MegaMol writer bug); read it without",
+                    path.display()
+                ));
+                    r
+                }
+                Err(_) => return Err(e),
+            }
+        }
+        Err(e) => return Err(e),
+    };
+    Ok(LoadedParticles { records, warnings })
+}
+
+fn parse_frame(
+    path: &Path,
+    bytes: &[u8],
+    start: usize,
+    end: usize,
+    version: u16,
+    timestamp: bool,
+) -> Result<Vec<ParticleRecord>> {
+    let mut c = Cursor {
+        bytes,
+        pos: start,
+        end,
+        path,
+    };
+    if timestamp {
+        c.f32("the frame timestamp")?;
+    }
+    let lists_at = c.pos;
+    let lists = c.i32("the list count")?;
+    if lists < 0 {
+        return Err(c.err(lists_at, format!("negative list count {lists}")));
+    }
+    let mut out = Vec::new();
+    for _ in 0..lists {
+        let vt_at = c.pos;
+        let vt = c.u8("a vertex type")?;
+        let ct = c.u8("a colour type")?;
+        let vstride = match vt {
+            0 => 0usize,
+            1 => 12,
+            2 => 16,
+            3 => 6,
+            4 => 24,
+            _ => return Err(c.err(vt_at, format!("unknown vertex type {vt} (expected 0–4)"))),
+        };
+        let cstride = match ct {
+            0 => 0usize,
+            1 => 3,
+            2 | 3 => 4,
+            4 => 12,
+            5 => 16,
+            6 | 7 => 8,
+            _ => {
+                return Err(c.err(
+                    vt_at + 1,
+                    format!("unknown colour type {ct} (expected 0–7)"),
+                ))
+            }
+        };
+        let global_radius = if matches!(vt, 1 | 3 | 4) {
+            f64::from(c.f32("the global radius")?)
+        } else {
+            1.0
+        };
+        let global_color = if ct == 0 {
+            let rgba = c.arr::<4>("the global RGBA colour")?;
+            display_to_linear(
+                DVec3::new(f64::from(rgba[0]), f64::from(rgba[1]), f64::from(rgba[2])) / 255.0,
+            )
+        } else {
+            DVec3::ONE
+        };
+        let (imin, imax) = if matches!(ct, 3 | 7) {
+            (
+                f64::from(c.f32("the intensity minimum")?),
+                f64::from(c.f32("the intensity maximum")?),
+            )
+        } else {
+            (0.0, 1.0)
+        };
+        let count_at = c.pos;
+        let count = c.u64("the particle count")?;
+        if version == 103 {
+            c.take(24, "the list bounding box")?;
+        }
+        let stride = if vt == 0 { 0 } else { vstride + cstride };
+        let data_bytes = (stride as u64)
+            .checked_mul(count)
+            .filter(|&n| n <= (end.saturating_sub(c.pos)) as u64);
+        let Some(data_bytes) = data_bytes else {
+            return Err(c.err(
+                count_at,
+                format!(
+                    "the list announces {count} particles of {stride} bytes, more than the {} bytes left in the frame",
+                    end.saturating_sub(c.pos)
+                ),
+            ));
+        };
+        let data_at = c.pos;
+        let data = c.take(data_bytes as usize, "the particle data")?;
+        if vt != 0 {
+            out.reserve(count as usize);
+            for (k, p) in data.chunks_exact(stride).enumerate() {
+                let (center, radius) = match vt {
+                    1 => (
+                        DVec3::new(le_f32(p, 0), le_f32(p, 4), le_f32(p, 8)),
+                        global_radius,
+                    ),
+                    2 => (
+                        DVec3::new(le_f32(p, 0), le_f32(p, 4), le_f32(p, 8)),
+                        le_f32(p, 12),
+                    ),
+                    3 => (
+                        DVec3::new(le_i16(p, 0), le_i16(p, 2), le_i16(p, 4)),
+                        global_radius,
+                    ),
+                    _ => (
+                        DVec3::new(le_f64(p, 0), le_f64(p, 8), le_f64(p, 16)),
+                        global_radius,
+                    ),
+                };
+                let o = vstride;
+                let color = match ct {
+                    0 => global_color,
+                    1 | 2 => display_to_linear(
+                        DVec3::new(byte(p, o), byte(p, o + 1), byte(p, o + 2)) / 255.0,
+                    ),
+                    3 => intensity_color(le_f32(p, o), imin, imax),
+                    4 | 5 => display_to_linear(DVec3::new(
+                        le_f32(p, o),
+                        le_f32(p, o + 4),
+                        le_f32(p, o + 8),
+                    )),
+                    6 => display_to_linear(
+                        DVec3::new(le_u16(p, o), le_u16(p, o + 2), le_u16(p, o + 4)) / 65535.0,
+                    ),
+                    _ => intensity_color(le_f64(p, o), imin, imax),
+                };
+                let at = data_at + k * stride;
+                if !center.is_finite() || !color.is_finite() {
+                    return Err(c.err(
+                        at,
+                        format!("particle {k} of the list has a non-finite position or colour"),
+                    ));
+                }
+                out.push(ParticleRecord {
+                    center,
+                    radius,
+                    color: Some(color),
+                    opacity: None,
+                    location: Location::Byte(at as u64),
+                });
+            }
+        }
+        if version == 101 {
+            c.u32("the cluster count")?;
+            let size_at = c.pos;
+            let size = c.u64("the cluster data size")?;
+            let size = usize::try_from(size)
+                .ok()
+                .filter(|&s| s <= end.saturating_sub(c.pos))
+                .ok_or_else(|| {
+                    c.err(
+                        size_at,
+                        format!("cluster data of {size} bytes does not fit in the frame"),
+                    )
+                })?;
+            c.take(size, "the cluster data")?;
+        }
+    }
+    if c.pos != end {
+        return Err(c.err(
+            c.pos,
+            format!(
+                "the frame's lists end at byte {} but the seek table says the frame ends at byte {end}",
+                c.pos
+            ),
+        ));
+    }
+    Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A version-`v` file with one frame of one FLOAT_XYZR/none list of `n` particles.
+    pub(crate) fn one_list(v: u16, timestamp: bool, n: u64, announced: u64) -> Vec<u8> {
+        let mut b = Vec::new();
+        b.extend_from_slice(MAGIC);
+        b.extend_from_slice(&v.to_le_bytes());
+        b.extend_from_slice(&1u32.to_le_bytes());
+        b.extend_from_slice(&[0u8; 48]);
+        let table_at = b.len();
+        b.extend_from_slice(&[0u8; 16]);
+        let start = b.len() as u64;
+        if timestamp {
+            b.extend_from_slice(&0f32.to_le_bytes());
+        }
+        b.extend_from_slice(&1i32.to_le_bytes());
+        b.extend_from_slice(&[2, 0]);
+        b.extend_from_slice(&[255, 0, 0, 255]);
+        b.extend_from_slice(&announced.to_le_bytes());
+        if v == 103 {
+            b.extend_from_slice(&[0u8; 24]);
+        }
+        for k in 0..n {
+            for x in [k as f32, 0.0, 0.0, 0.5] {
+                b.extend_from_slice(&x.to_le_bytes());
+            }
+        }
+        if v == 101 {
+            b.extend_from_slice(&2u32.to_le_bytes());
+            b.extend_from_slice(&4u64.to_le_bytes());
+            b.extend_from_slice(&[9u8; 4]);
+        }
+        let end = b.len() as u64;
+        b[table_at..table_at + 8].copy_from_slice(&start.to_le_bytes());
+        b[table_at + 8..table_at + 16].copy_from_slice(&end.to_le_bytes());
+        b
+    }
+
+    fn spec() -> IncludeSpec {
+        IncludeSpec::bare(Path::new("t.mmpld"))
+    }
+
+    #[test]
+    fn reads_a_synthetic_file() {
+        let l = load(&spec(), &one_list(102, true, 3, 3)).expect("ok");
+        assert_eq!(l.records.len(), 3);
+        assert_eq!(l.records[2].center.x, 2.0);
+        assert_eq!(l.records[2].radius, 0.5);
+        assert_eq!(l.records[0].color, Some(DVec3::new(1.0, 0.0, 0.0)));
+    }
+
+    #[test]
+    fn every_version() {
+        for (v, ts) in [(100, false), (101, false), (102, true), (103, true)] {
+            let l = load(&spec(), &one_list(v, ts, 2, 2)).expect("ok");
+            assert_eq!(l.records.len(), 2, "{v}");
+            assert_eq!(l.records[1].center.x, 1.0, "{v}");
+        }
+    }
+
+    #[test]
+    fn short_xyz_and_u8_rgb() {
+        // One list: SHORT_XYZ (3), UINT8_RGB (1), global radius 0.25, one particle (-2, 3, 7)
+        // coloured (255, 0, 0).
+        let mut b = Vec::new();
+        b.extend_from_slice(MAGIC);
+        b.extend_from_slice(&102u16.to_le_bytes());
+        b.extend_from_slice(&1u32.to_le_bytes());
+        b.extend_from_slice(&[0u8; 48]);
+        b.extend_from_slice(&76u64.to_le_bytes());
+        let end_at = b.len();
+        b.extend_from_slice(&0u64.to_le_bytes());
+        b.extend_from_slice(&0f32.to_le_bytes());
+        b.extend_from_slice(&1i32.to_le_bytes());
+        b.extend_from_slice(&[3, 1]);
+        b.extend_from_slice(&0.25f32.to_le_bytes());
+        b.extend_from_slice(&1u64.to_le_bytes());
+        for v in [-2i16, 3, 7] {
+            b.extend_from_slice(&v.to_le_bytes());
+        }
+        b.extend_from_slice(&[255, 0, 0]);
+        let end = b.len() as u64;
+        b[end_at..end_at + 8].copy_from_slice(&end.to_le_bytes());
+        let l = load(&spec(), &b).expect("ok");
+        assert_eq!(l.records[0].center, DVec3::new(-2.0, 3.0, 7.0));
+        assert_eq!(l.records[0].radius, 0.25);
+        assert_eq!(l.records[0].color, Some(DVec3::X));
+    }
+
+    #[test]
+    fn v103_without_timestamp_is_recovered() {
+        let l = load(&spec(), &one_list(103, false, 2, 2)).expect("ok");
+        assert_eq!(l.records.len(), 2);
+        assert!(l.warnings.iter().any(|w| w.contains("timestamp")));
+        let l = load(&spec(), &one_list(103, true, 2, 2)).expect("ok");
+        assert!(l.warnings.is_empty());
+    }
+
+    #[test]
+    fn lying_count_is_an_error_not_an_allocation() {
+        let e = load(&spec(), &one_list(102, true, 2, u64::MAX / 2))
+            .expect_err("lie")
+            .to_string();
+        assert!(
+            e.contains("t.mmpld (byte") && e.contains("particles"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn every_truncation_is_an_error() {
+        let full = one_list(102, true, 3, 3);
+        for n in 0..full.len() {
+            assert!(load(&spec(), &full[..n]).is_err(), "{n}");
+        }
+    }
+}

@@ -1,0 +1,180 @@
+//! PDB (wwPDB format 3.3, fixed columns): `ATOM`/`HETATM` records become spheres with van der
+//! Waals radii; `MODEL`/`ENDMDL` separate models. Everything else (`ANISOU`, `HEADER`, `CONECT`,
+//! …) is ignored.
+//!
+//! Columns read (1-based, inclusive): name 13–16, altLoc 17, resName 18–20, chainID 22,
+//! resSeq+iCode 23–27, x 31–38, y 39–46, z 47–54, occupancy 55–60 (1.0 if blank), element 77–78.
+//! Where the element columns are blank or hold something else (old files put an ID and a line
+//! number in 73–80, MD snapshots leave them empty), the element is inferred from the atom name
+//! ([`super::atoms::infer_element`]). pdbtbx was not used: pgt needs the file and line of every
+//! error and the lenient handling of those old files.
+
+use super::atoms::{infer_element, Atom};
+use super::elements::Element;
+use crate::error::{PgtError, Result};
+use glam::DVec3;
+use std::path::Path;
+
+/// Reads every atom of every model of a PDB file's text.
+pub fn read_atoms(path: &Path, bytes: &[u8]) -> Result<(Vec<Atom>, Vec<String>)> {
+    let mut atoms = Vec::new();
+    let warnings = Vec::new();
+    let mut model = 1i64;
+    for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
+        let line_no = i + 1;
+        let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
+        let record = field(raw, 1, 6);
+        match record.trim_end() {
+            "ATOM" | "HETATM" => atoms.push(atom(
+                path,
+                raw,
+                line_no,
+                model,
+                record.starts_with("HETATM"),
+            )?),
+            "MODEL" => {
+                let rest = String::from_utf8_lossy(raw.get(6..).unwrap_or_default())
+                    .trim()
+                    .to_string();
+                model = rest
+                    .split_whitespace()
+                    .next()
+                    .and_then(|s| s.parse().ok())
+                    .ok_or_else(|| {
+                        PgtError::at_line(
+                            path,
+                            line_no,
+                            format!("expected a model number after MODEL, found '{rest}'"),
+                        )
+                    })?;
+            }
+            _ => {}
+        }
+    }
+    Ok((atoms, warnings))
+}
+
+/// Columns `from..=to` (1-based) of a line, as text; short lines give what is there.
+fn field(line: &[u8], from: usize, to: usize) -> std::borrow::Cow<'_, str> {
+    let start = from.saturating_sub(1).min(line.len());
+    let end = to.min(line.len());
+    String::from_utf8_lossy(line.get(start..end).unwrap_or_default())
+}
+
+fn coordinate(
+    path: &Path,
+    line: &[u8],
+    line_no: usize,
+    axis: &str,
+    from: usize,
+    to: usize,
+) -> Result<f64> {
+    let text = field(line, from, to);
+    let v: f64 = text.trim().parse().map_err(|_| {
+        PgtError::at_line(
+            path,
+            line_no,
+            format!(
+                "expected the {axis} coordinate (a number) in columns {from}–{to}, found '{}'",
+                text.trim()
+            ),
+        )
+    })?;
+    if !v.is_finite() {
+        return Err(PgtError::at_line(
+            path,
+            line_no,
+            format!(
+                "the {axis} coordinate in columns {from}–{to} is not finite: '{}'",
+                text.trim()
+            ),
+        ));
+    }
+    Ok(v)
+}
+
+fn atom(path: &Path, raw: &[u8], line_no: usize, model: i64, hetatm: bool) -> Result<Atom> {
+    let x = coordinate(path, raw, line_no, "x", 31, 38)?;
+    let y = coordinate(path, raw, line_no, "y", 39, 46)?;
+    let z = coordinate(path, raw, line_no, "z", 47, 54)?;
+    let occ_text = field(raw, 55, 60);
+    let occupancy = if occ_text.trim().is_empty() {
+        1.0
+    } else {
+        match occ_text.trim().parse::<f64>() {
+            Ok(v) if v.is_finite() => v,
+            _ => {
+                return Err(PgtError::at_line(
+                    path,
+                    line_no,
+                    format!(
+                        "expected the occupancy (a number) in columns 55–60, found '{}'",
+                        occ_text.trim()
+                    ),
+                ))
+            }
+        }
+    };
+    let name_field = field(raw, 13, 16);
+    let element_field = field(raw, 77, 78);
+    let element = if element_field
+        .trim()
+        .chars()
+        .all(|c| c.is_ascii_alphabetic())
+        && !element_field.trim().is_empty()
+    {
+        Element::from_symbol(&element_field).or_else(|| infer_element(&name_field, hetatm))
+    } else {
+        infer_element(&name_field, hetatm)
+    };
+    let alt = field(raw, 17, 17);
+    let alt = alt.trim();
+    Ok(Atom {
+        position: DVec3::new(x, y, z),
+        element,
+        name: name_field.trim().to_string(),
+        alt_loc: (!alt.is_empty()).then(|| alt.to_string()),
+        occupancy,
+        residue_name: field(raw, 18, 20).trim().to_string(),
+        chain: field(raw, 22, 22).trim().to_string(),
+        residue: field(raw, 23, 27).into_owned(),
+        model,
+        line: line_no,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LINE: &str =
+        "ATOM      2  CA  ALA A   2      63.914 -67.078 -16.894  1.00 17.23           C  ";
+
+    #[test]
+    fn reads_columns() {
+        let (atoms, _) = read_atoms(Path::new("t.pdb"), LINE.as_bytes()).expect("parses");
+        let a = &atoms[0];
+        assert_eq!(a.position, DVec3::new(63.914, -67.078, -16.894));
+        assert_eq!(a.element.map(Element::symbol), Some("C"));
+        assert_eq!(a.chain, "A");
+        assert_eq!(a.name, "CA");
+    }
+
+    #[test]
+    fn short_line_is_an_error_with_line() {
+        let text = format!("HEADER\n{}\n", &LINE[..40]);
+        let e = read_atoms(Path::new("t.pdb"), text.as_bytes())
+            .expect_err("short")
+            .to_string();
+        assert!(e.contains("t.pdb:2") && e.contains("y coordinate"), "{e}");
+    }
+
+    #[test]
+    fn nan_is_an_error() {
+        let text = LINE.replace("63.914", "   NaN");
+        let e = read_atoms(Path::new("t.pdb"), text.as_bytes())
+            .expect_err("nan")
+            .to_string();
+        assert!(e.contains("t.pdb:1") && e.contains("not finite"), "{e}");
+    }
+}

@@ -1,0 +1,345 @@
+//! XYZ and CSV particle lists.
+//!
+//! **XYZ** (the chemistry format): a line with the atom count N, a comment line, then N lines
+//! `Element x y z` (further columns ignored). Elements give van der Waals radii and CPK colours
+//! ([`super::elements`]); an unknown symbol gets the fallback radius, with a warning. Several
+//! frames may follow one another; the first is read (`frame = k` picks frame k, 0-based).
+//!
+//! **CSV**: comma-separated, a header row naming the columns (case-insensitive, blanks trimmed,
+//! any order, unknown columns ignored with a warning): `x`, `y`, `z` (required); `radius` (or
+//! `r`); colour `red`, `green`, `blue` (or `r`, `g`, `b`: where `g` and `b` are present, an `r`
+//! is red, and a second `r`, or `radius`, is the radius), linear RGB ≥ 0; `opacity` (Θmax in
+//! [0, 1]). Without a radius column every particle has radius 1 (with a warning). Blank lines and
+//! lines starting with `#` are skipped.
+
+use super::elements::{element_color, element_radius, Element};
+use super::LoadedParticles;
+use crate::error::{Location, PgtError, Result};
+use crate::scene::ParticleRecord;
+use glam::DVec3;
+use std::path::Path;
+
+fn lines(bytes: &[u8]) -> impl Iterator<Item = (usize, String)> + '_ {
+    bytes.split(|&b| b == b'\n').enumerate().map(|(i, l)| {
+        let l = l.strip_suffix(b"\r").unwrap_or(l);
+        (i + 1, String::from_utf8_lossy(l).into_owned())
+    })
+}
+
+fn number(path: &Path, line: usize, what: &str, s: &str) -> Result<f64> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v.is_finite() => Ok(v),
+        Ok(_) => Err(PgtError::at_line(
+            path,
+            line,
+            format!("{what} is not finite: '{}'", s.trim()),
+        )),
+        Err(_) => Err(PgtError::at_line(
+            path,
+            line,
+            format!("expected a number for {what}, found '{}'", s.trim()),
+        )),
+    }
+}
+
+/// Loads frame `frame` (0-based) of an XYZ file.
+pub fn load_xyz(path: &Path, bytes: &[u8], frame: usize) -> Result<LoadedParticles> {
+    let mut it = lines(bytes).peekable();
+    let mut records = Vec::new();
+    let mut warnings = Vec::new();
+    let mut unknown = 0usize;
+    let mut current = 0usize;
+    loop {
+        // Skip blank lines between frames.
+        while it.peek().is_some_and(|(_, l)| l.trim().is_empty()) {
+            it.next();
+        }
+        let Some((line, count_text)) = it.next() else {
+            if current == 0 {
+                return Err(PgtError::in_file(
+                    path,
+                    "empty XYZ file: expected an atom count on the first line",
+                ));
+            }
+            return Err(PgtError::in_file(
+                path,
+                format!("frame {frame} requested but the file has {current} frame(s)"),
+            ));
+        };
+        let n: usize = count_text.trim().parse().map_err(|_| {
+            PgtError::at_line(
+                path,
+                line,
+                format!(
+                    "expected the atom count (an integer), found '{}'",
+                    count_text.trim()
+                ),
+            )
+        })?;
+        if n > bytes.len() / 4 {
+            return Err(PgtError::at_line(
+                path,
+                line,
+                format!(
+                    "the atom count {n} is larger than the file can hold ({} bytes)",
+                    bytes.len()
+                ),
+            ));
+        }
+        if it.next().is_none() {
+            return Err(PgtError::at_line(
+                path,
+                line,
+                "expected a comment line after the atom count",
+            ));
+        }
+        let keep = current == frame;
+        if keep {
+            records.reserve(n);
+        }
+        for k in 0..n {
+            let Some((l, text)) = it.next().filter(|(_, t)| !t.trim().is_empty()) else {
+                return Err(PgtError::at_line(
+                    path,
+                    line,
+                    format!("the frame announces {n} atoms but the file ends after {k}"),
+                ));
+            };
+            if !keep {
+                continue;
+            }
+            let f: Vec<&str> = text.split_whitespace().collect();
+            if f.len() < 4 {
+                return Err(PgtError::at_line(
+                    path,
+                    l,
+                    format!("expected 'Element x y z', found '{}'", text.trim()),
+                ));
+            }
+            let el = f.first().and_then(|s| Element::from_symbol(s));
+            if el.is_none() {
+                unknown += 1;
+            }
+            let c = |i: usize, w: &str| number(path, l, w, f.get(i).copied().unwrap_or_default());
+            records.push(ParticleRecord {
+                center: DVec3::new(c(1, "x")?, c(2, "y")?, c(3, "z")?),
+                radius: element_radius(el),
+                color: Some(element_color(el)),
+                opacity: None,
+                location: Location::Line(l),
+            });
+        }
+        if keep {
+            break;
+        }
+        current += 1;
+    }
+    if unknown > 0 {
+        warnings.push(format!(
+            "{}: {unknown} atoms have an unknown element symbol; they get radius {} Å",
+            path.display(),
+            super::elements::FALLBACK_RADIUS
+        ));
+    }
+    Ok(LoadedParticles { records, warnings })
+}
+
+/// The columns a CSV header names.
+#[derive(Debug, Default)]
+struct Columns {
+    xyz: [usize; 3],
+    radius: Option<usize>,
+    rgb: Option<[usize; 3]>,
+    opacity: Option<usize>,
+}
+
+fn columns(path: &Path, line: usize, header: &str, warnings: &mut Vec<String>) -> Result<Columns> {
+    let names: Vec<String> = header
+        .split(',')
+        .map(|s| s.trim().to_ascii_lowercase())
+        .collect();
+    let find = |n: &str| names.iter().position(|c| c == n);
+    let expected =
+        "expected a header row naming the columns: x,y,z[,radius][,red,green,blue][,opacity]";
+    let (Some(x), Some(y), Some(z)) = (find("x"), find("y"), find("z")) else {
+        return Err(PgtError::at_line(
+            path,
+            line,
+            format!("{expected}; found '{}'", header.trim()),
+        ));
+    };
+    let rs: Vec<usize> = names
+        .iter()
+        .enumerate()
+        .filter(|(_, c)| *c == "r")
+        .map(|(i, _)| i)
+        .collect();
+    let (g, b) = (find("g"), find("b"));
+    let mut cols = Columns {
+        xyz: [x, y, z],
+        ..Columns::default()
+    };
+    let mut used = vec![x, y, z];
+    if let (Some(r), Some(g), Some(b)) = (find("red"), find("green"), find("blue")) {
+        cols.rgb = Some([r, g, b]);
+        cols.radius = find("radius").or(rs.first().copied());
+    } else if let (Some(g), Some(b)) = (g, b) {
+        // r,g,b colour: the r nearest before g is red; another r (or `radius`) is the radius.
+        let red = rs
+            .iter()
+            .rev()
+            .find(|&&r| r < g)
+            .or(rs.last())
+            .copied()
+            .ok_or_else(|| {
+                PgtError::at_line(
+                    path,
+                    line,
+                    "the header has columns g and b but no r for red",
+                )
+            })?;
+        cols.rgb = Some([red, g, b]);
+        cols.radius = find("radius").or(rs.iter().copied().find(|&r| r != red));
+    } else {
+        cols.radius = find("radius").or(rs.first().copied());
+    }
+    cols.opacity = find("opacity");
+    used.extend(cols.radius);
+    used.extend(cols.rgb.iter().flatten());
+    used.extend(cols.opacity);
+    let unused: Vec<&String> = names
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| !used.contains(i))
+        .map(|(_, n)| n)
+        .collect();
+    if !unused.is_empty() {
+        warnings.push(format!(
+            "{}: ignored CSV columns {:?}",
+            path.display(),
+            unused
+        ));
+    }
+    if cols.radius.is_none() {
+        warnings.push(format!(
+            "{}: no radius column; every particle has radius 1",
+            path.display()
+        ));
+    }
+    Ok(cols)
+}
+
+/// Loads a CSV file with a header row.
+pub fn load_csv(path: &Path, bytes: &[u8]) -> Result<LoadedParticles> {
+    let mut warnings = Vec::new();
+    let mut cols: Option<Columns> = None;
+    let mut width = 0usize;
+    let mut records = Vec::new();
+    for (line, text) in lines(bytes) {
+        let t = text.trim();
+        if t.is_empty() || t.starts_with('#') {
+            continue;
+        }
+        let Some(c) = &cols else {
+            width = t.split(',').count();
+            cols = Some(columns(path, line, t, &mut warnings)?);
+            continue;
+        };
+        let f: Vec<&str> = t.split(',').collect();
+        if f.len() != width {
+            return Err(PgtError::at_line(
+                path,
+                line,
+                format!(
+                    "expected {width} comma-separated values (as in the header), found {}",
+                    f.len()
+                ),
+            ));
+        }
+        let get =
+            |i: usize, what: &str| number(path, line, what, f.get(i).copied().unwrap_or_default());
+        let [xi, yi, zi] = c.xyz;
+        records.push(ParticleRecord {
+            center: DVec3::new(get(xi, "x")?, get(yi, "y")?, get(zi, "z")?),
+            radius: c.radius.map_or(Ok(1.0), |i| get(i, "radius"))?,
+            color: c
+                .rgb
+                .map(|[r, g, b]| {
+                    Ok::<_, PgtError>(DVec3::new(
+                        get(r, "red")?,
+                        get(g, "green")?,
+                        get(b, "blue")?,
+                    ))
+                })
+                .transpose()?,
+            opacity: c.opacity.map(|i| get(i, "opacity")).transpose()?,
+            location: Location::Line(line),
+        });
+    }
+    if cols.is_none() {
+        warnings.push(format!(
+            "{}: empty CSV file (no header, no particles)",
+            path.display()
+        ));
+    }
+    Ok(LoadedParticles { records, warnings })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_with_r_g_b_and_radius() {
+        let text = "x, y, z, radius, r, g, b\n1,2,3,0.5,1,0,0\n\n# c\n4,5,6,1.5,0,1,0\n";
+        let l = load_csv(Path::new("t.csv"), text.as_bytes()).expect("ok");
+        assert_eq!(l.records.len(), 2);
+        assert_eq!(l.records[1].center, DVec3::new(4.0, 5.0, 6.0));
+        assert_eq!(l.records[1].radius, 1.5);
+        assert_eq!(l.records[1].color, Some(DVec3::new(0.0, 1.0, 0.0)));
+        assert_eq!(l.records[1].location, Location::Line(5));
+    }
+
+    #[test]
+    fn csv_double_r() {
+        let text = "x,y,z,r,r,g,b\n1,2,3,0.5,1,0.2,0.3\n";
+        let l = load_csv(Path::new("t.csv"), text.as_bytes()).expect("ok");
+        assert_eq!(l.records[0].radius, 0.5);
+        assert_eq!(l.records[0].color, Some(DVec3::new(1.0, 0.2, 0.3)));
+    }
+
+    #[test]
+    fn csv_errors() {
+        let e = load_csv(Path::new("t.csv"), b"1,2,3\n")
+            .expect_err("no header")
+            .to_string();
+        assert!(e.contains("t.csv:1") && e.contains("header"), "{e}");
+        let e = load_csv(Path::new("t.csv"), b"x,y,z\n1,2\n")
+            .expect_err("short")
+            .to_string();
+        assert!(e.contains("t.csv:2") && e.contains("expected 3"), "{e}");
+        let e = load_csv(Path::new("t.csv"), b"x,y,z\n1,nan,2\n")
+            .expect_err("nan")
+            .to_string();
+        assert!(e.contains("t.csv:2") && e.contains("not finite"), "{e}");
+    }
+
+    #[test]
+    fn xyz_frames() {
+        let text = "2\nwater\nO 0 0 0\nH 1 0 0\n1\nsecond\nC 5 5 5\n";
+        let l = load_xyz(Path::new("t.xyz"), text.as_bytes(), 0).expect("ok");
+        assert_eq!(l.records.len(), 2);
+        assert_eq!(l.records[0].radius, 1.52);
+        let l = load_xyz(Path::new("t.xyz"), text.as_bytes(), 1).expect("ok");
+        assert_eq!(l.records[0].center, DVec3::splat(5.0));
+        assert_eq!(l.records[0].location, Location::Line(7));
+        let e = load_xyz(Path::new("t.xyz"), text.as_bytes(), 2)
+            .expect_err("no frame 2")
+            .to_string();
+        assert!(e.contains("2 frame"), "{e}");
+        let e = load_xyz(Path::new("t.xyz"), b"3\nc\nO 0 0 0\n", 0)
+            .expect_err("short")
+            .to_string();
+        assert!(e.contains("t.xyz:1") && e.contains("ends after 1"), "{e}");
+    }
+}
