@@ -1,6 +1,7 @@
 //! The `pgt` command line (DESIGN.md §7): one file per subcommand. Every subcommand returns an
 //! [`Outcome`]; `main` maps it and errors to exit codes 0 / 1 / 2.
 
+pub mod approx;
 pub mod render;
 
 use clap::{Parser, Subcommand};
@@ -25,12 +26,15 @@ pub struct Cli {
 pub enum Command {
     /// Render the exact reference image of a scene (a scene TOML or a bare particle file).
     Render(render::RenderArgs),
+    /// Render a scene with a GPU approximation (a built-in method or a user's WGSL shader).
+    Approx(approx::ApproxArgs),
 }
 
 /// Runs the parsed command line.
 pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
     match cli.command {
         Command::Render(args) => render::run(args),
+        Command::Approx(args) => approx::run(args),
     }
 }
 
