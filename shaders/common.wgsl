@@ -339,12 +339,20 @@ fn any_hit(ray: Ray, t_min: f32, t_max: f32, skip: u32) -> bool {
 // The emission model along (t_min, t_max) of a ray with `background` behind t_max, one particle
 // at a time, back to front (DESIGN.md §4: overlaps ignored; exact where particles are disjoint).
 fn emission_along(ray: Ray, t_min: f32, t_max: f32, background: vec3<f32>) -> vec3<f32> {
+    return emission_along_skipping(ray, t_min, t_max, background, 0xffffffffu);
+}
+
+// emission_along with particle `skip` left out (a ray leaving that particle's surface).
+fn emission_along_skipping(ray: Ray, t_min: f32, t_max: f32, background: vec3<f32>, skip: u32) -> vec3<f32> {
     var list: HitList;
     collect_hits(ray, t_min, t_max, &list);
     var radiance = background;
     var k = list.count;
     while (k > 0u) {
         k = k - 1u;
+        if (list.index[k] == skip) {
+            continue;
+        }
         let p = particles[list.index[k]];
         let length = min(list.t_exit[k], t_max) - max(list.t_enter[k], t_min);
         radiance = composite_emission(p, length, radiance);
@@ -389,6 +397,34 @@ fn lit_source(x: vec3<f32>) -> vec3<f32> {
             continue;
         }
         q = q + emission_along(Ray(x, inc.toward), 0.0, inc.distance, inc.irradiance);
+    }
+    return frame.light_weight * q;
+}
+
+// What a particle with Θmax = 1 (σ = ∞) shows where the camera ray enters it at t0, under the
+// lit model: the limit σ → ∞ of ∫ σe^{−σs}·Q(x_s) ds. Light seen at depth z below the surface
+// has crossed z/μ_l of the particle's own gas, the view ray z/μ_v, so each light contributes
+// (L_rest·μ_l + C·μ_v)/(μ_l + μ_v), L_rest the emission model along the rest of the shadow ray
+// (other particles, the light behind), μ_v = cos(view, normal), μ_l = cos(light, normal);
+// a light behind the surface (μ_l ≤ 0), or an eye inside the particle, gives C.
+fn lit_opaque_surface(ray: Ray, index: u32, t0: f32, entering: bool) -> vec3<f32> {
+    let p = particles[index];
+    let x = ray_at(ray, t0);
+    let n = normalize(x - p.center);
+    let mu_v = max(dot(-ray.direction, n), 0.0);
+    var q = vec3<f32>(0.0);
+    for (var l = 0u; l < frame.light_count; l = l + 1u) {
+        let inc = light_incident(lights[l], x);
+        if (!inc.valid) {
+            continue;
+        }
+        let mu_l = dot(n, inc.toward);
+        if (!entering || mu_l <= 0.0 || mu_l + mu_v <= 0.0) {
+            q = q + p.color;
+            continue;
+        }
+        let rest = emission_along_skipping(Ray(x, inc.toward), 0.0, inc.distance, inc.irradiance, index);
+        q = q + (rest * mu_l + p.color * mu_v) / (mu_l + mu_v);
     }
     return frame.light_weight * q;
 }

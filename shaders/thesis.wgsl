@@ -7,11 +7,13 @@
 
 // One particle of chord [t0, t1] lit by the midpoint rule:
 // L = L_behind·e^{−σΔ} + Σ_k Q(x_k)·σ·e^{−σ(t_k − t0)}·Δt, t_k = t0 + (k + ½)Δt, Δt = Δ/samples
-// (the σ factor of DESIGN.md §8). Θmax = 1 (σ = ∞): the gas is opaque at its surface, so the
-// particle shows Q at its entry point, the limit of the integral.
-fn lit_particle(ray: Ray, p: Particle, t0: f32, t1: f32, behind: vec3<f32>) -> vec3<f32> {
+// (the σ factor of DESIGN.md §8). Θmax = 1 (σ = ∞) has no midpoint rule (every weight is ∞·0):
+// the particle gets the integral's limit at its surface, `lit_opaque_surface`.
+fn lit_particle(ray: Ray, index: u32, t_enter: f32, t1: f32, behind: vec3<f32>) -> vec3<f32> {
+    let p = particles[index];
+    let t0 = max(t_enter, 0.0);
     if (p.sigma < 0.0) {
-        return lit_source(ray_at(ray, t0));
+        return lit_opaque_surface(ray, index, t0, t_enter > 0.0);
     }
     let length = t1 - t0;
     let n = max(frame.samples, 1u);
@@ -32,14 +34,13 @@ fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {
     var k = list.count;
     while (k > 0u) {
         k = k - 1u;
-        let p = particles[list.index[k]];
         // A camera inside a particle sees only the part of its chord in front of it.
-        let t0 = max(list.t_enter[k], 0.0);
         let t1 = list.t_exit[k];
         if (frame.lit == 1u && k < frame.n_exact) {
-            radiance = lit_particle(ray, p, t0, t1, radiance);
+            radiance = lit_particle(ray, list.index[k], list.t_enter[k], t1, radiance);
         } else {
-            radiance = composite_emission(p, t1 - t0, radiance);
+            let t0 = max(list.t_enter[k], 0.0);
+            radiance = composite_emission(particles[list.index[k]], t1 - t0, radiance);
         }
     }
     return radiance;

@@ -45,15 +45,31 @@ fn thesis_timings_on_random_particles() {
         let mut rng = SplitMix(count as u64);
         let particles: Vec<_> = (0..count)
             .map(|_| {
-                let c = [(rng.next() - 0.5) * cube, (rng.next() - 0.5) * cube, (rng.next() - 0.5) * cube];
+                let c = [
+                    (rng.next() - 0.5) * cube,
+                    (rng.next() - 0.5) * cube,
+                    (rng.next() - 0.5) * cube,
+                ];
                 let r = 1.2 + 0.7 * rng.next();
                 gpu_common::particle(c, r, [rng.next(), rng.next(), rng.next()], 0.5)
             })
             .collect();
-        let mut s = gpu_common::scene(particles, pgt::scene::thesis_lights(), RenderMode::Volume, OpticalModel::Lit);
+        let mut s = gpu_common::scene(
+            particles,
+            pgt::scene::thesis_lights(),
+            RenderMode::Volume,
+            OpticalModel::Lit,
+        );
         // From −z, framing the cube (its bounding sphere) with fov_y 40°, like the default camera.
         let distance = 0.5 * cube * 3f64.sqrt() / (20f64.to_radians().sin());
-        s.camera = Camera::new(DVec3::new(0.0, 0.0, -distance), DVec3::ZERO, DVec3::Y, 40.0, side, side);
+        s.camera = Camera::new(
+            DVec3::new(0.0, 0.0, -distance),
+            DVec3::ZERO,
+            DVec3::Y,
+            40.0,
+            side,
+            side,
+        );
         for n_exact in [1, 5, N_EXACT_ALL] {
             let params = ApproxParams {
                 method: Some(Method::Thesis),
@@ -62,7 +78,11 @@ fn thesis_timings_on_random_particles() {
                 adapter: None,
             };
             let out = render_approx_with(ctx, &s, &params).unwrap();
-            let n = if n_exact == N_EXACT_ALL { "all".to_string() } else { n_exact.to_string() };
+            let n = if n_exact == N_EXACT_ALL {
+                "all".to_string()
+            } else {
+                n_exact.to_string()
+            };
             eprintln!(
                 "bench: {count} particles, {side}x{side}, samples {samples}, n_exact {n}: {:.3} s GPU ({}) on {}, {} overflow pixels",
                 out.gpu_seconds,

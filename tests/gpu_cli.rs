@@ -37,8 +37,9 @@ radius = 1.2
 color  = [1.0, 0.2, 0.2]
 opacity = 0.8
 
+# Above the first: it shadows it from the green light.
 [[particles]]
-center = [1.5, 0.5, 1.0]
+center = [-0.5, 2.5, 0.5]
 radius = 1.0
 color  = [0.2, 0.8, 0.2]
 opacity = 0.5
@@ -75,7 +76,10 @@ fn the_example_shaders_run_through_shader() {
     let dir = tempfile::tempdir().unwrap();
     let scene = scene_file(dir.path());
     let mut images = Vec::new();
-    for example in ["shaders/examples/centre_shadow.wgsl", "shaders/examples/no_shadows.wgsl"] {
+    for example in [
+        "shaders/examples/centre_shadow.wgsl",
+        "shaders/examples/no_shadows.wgsl",
+    ] {
         let out = dir.path().join("out.exr");
         let o = pgt(
             &[
@@ -90,13 +94,16 @@ fn the_example_shaders_run_through_shader() {
         );
         let err = stderr(&o);
         assert_eq!(o.status.code(), Some(0), "{example}: {err}");
-        assert!(err.contains("approximated") && err.contains(" s GPU"), "{err}");
+        assert!(
+            err.contains("approximated") && err.contains(" s GPU"),
+            "{err}"
+        );
         let image = pgt::image_io::read_image(&out).unwrap();
         assert_eq!((image.width, image.height), (32, 32));
         assert!(image.all_finite());
         images.push(image);
     }
-    // The two methods are different approximations: their images differ.
+    // The particles shadow each other, which only centre_shadow sees: the images differ.
     assert_ne!(images[0], images[1]);
 }
 
@@ -113,7 +120,14 @@ fn a_broken_user_shader_reports_its_own_line_and_exits_2() {
     .unwrap();
     let out = dir.path().join("out.png");
     let o = pgt(
-        &["approx", scene.to_str().unwrap(), "--shader", shader.to_str().unwrap(), "-o", out.to_str().unwrap()],
+        &[
+            "approx",
+            scene.to_str().unwrap(),
+            "--shader",
+            shader.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ],
         &[],
     );
     let err = stderr(&o);
@@ -130,7 +144,14 @@ fn a_shader_without_shade_is_refused_with_exit_2() {
     let shader = dir.path().join("empty.wgsl");
     std::fs::write(&shader, "fn helper() -> f32 { return 1.0; }\n").unwrap();
     let o = pgt(
-        &["approx", scene.to_str().unwrap(), "--shader", shader.to_str().unwrap(), "-o", "x.exr"],
+        &[
+            "approx",
+            scene.to_str().unwrap(),
+            "--shader",
+            shader.to_str().unwrap(),
+            "-o",
+            "x.exr",
+        ],
         &[],
     );
     let err = stderr(&o);
@@ -145,8 +166,16 @@ fn no_adapter_is_a_clear_error_with_exit_2() {
     let out = dir.path().join("out.exr");
     // Point the Vulkan loader at no driver at all: wgpu then finds no adapter.
     let o = pgt(
-        &["approx", scene.to_str().unwrap(), "-o", out.to_str().unwrap()],
-        &[("VK_ICD_FILENAMES", "/nonexistent/icd.json"), ("VK_DRIVER_FILES", "/nonexistent/icd.json")],
+        &[
+            "approx",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &[
+            ("VK_ICD_FILENAMES", "/nonexistent/icd.json"),
+            ("VK_DRIVER_FILES", "/nonexistent/icd.json"),
+        ],
     );
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{err}");
@@ -162,12 +191,22 @@ fn an_unknown_adapter_name_lists_the_adapters_and_exits_2() {
     let dir = tempfile::tempdir().unwrap();
     let scene = scene_file(dir.path());
     let o = pgt(
-        &["approx", scene.to_str().unwrap(), "--adapter", "no-such-adapter-xyz", "-o", "x.exr"],
+        &[
+            "approx",
+            scene.to_str().unwrap(),
+            "--adapter",
+            "no-such-adapter-xyz",
+            "-o",
+            "x.exr",
+        ],
         &[],
     );
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(err.contains("no GPU adapter matches --adapter 'no-such-adapter-xyz'"), "{err}");
+    assert!(
+        err.contains("no GPU adapter matches --adapter 'no-such-adapter-xyz'"),
+        "{err}"
+    );
 }
 
 #[test]

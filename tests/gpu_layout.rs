@@ -26,8 +26,14 @@ fn wgsl_layout(module: &naga::Module, name: &str) -> (Vec<(String, u32)>, u32) {
 /// sides only as far as the size says.
 fn check(module: &naga::Module, name: &str, rust_size: usize, rust: &[(&str, usize)]) {
     let (members, size) = wgsl_layout(module, name);
-    assert_eq!(size as usize, rust_size, "{name}: WGSL size {size}, Rust size {rust_size}");
-    let named: Vec<&(String, u32)> = members.iter().filter(|(n, _)| !n.starts_with('_')).collect();
+    assert_eq!(
+        size as usize, rust_size,
+        "{name}: WGSL size {size}, Rust size {rust_size}"
+    );
+    let named: Vec<&(String, u32)> = members
+        .iter()
+        .filter(|(n, _)| !n.starts_with('_'))
+        .collect();
     assert_eq!(
         named.len(),
         rust.len(),
@@ -35,7 +41,10 @@ fn check(module: &naga::Module, name: &str, rust_size: usize, rust: &[(&str, usi
     );
     for ((wn, wo), (rn, ro)) in named.iter().zip(rust) {
         assert_eq!(wn, rn, "{name}: member order differs");
-        assert_eq!(*wo as usize, *ro, "{name}.{wn}: WGSL offset {wo}, Rust offset {ro}");
+        assert_eq!(
+            *wo as usize, *ro,
+            "{name}.{wn}: WGSL offset {wo}, Rust offset {ro}"
+        );
     }
 }
 
@@ -54,7 +63,12 @@ fn particle_members() -> Vec<(&'static str, usize)> {
 #[test]
 fn rust_and_wgsl_struct_layouts_agree() {
     let module = naga::front::wgsl::parse_str(COMMON_WGSL).expect("common.wgsl parses");
-    check(&module, "Particle", size_of::<GpuParticle>(), &particle_members());
+    check(
+        &module,
+        "Particle",
+        size_of::<GpuParticle>(),
+        &particle_members(),
+    );
     check(
         &module,
         "BvhNode",
@@ -114,10 +128,23 @@ fn rust_and_wgsl_struct_layouts_agree() {
 fn the_check_catches_a_shifted_member() {
     // The subtle mismatch: padding moved in front of `shininess`. Same size, same member order,
     // only one offset differs (52 instead of 48); the check must still fail.
-    let wrong = COMMON_WGSL.replace("    shininess: f32,\n    _pad0: f32,", "    _pad0: f32,\n    shininess: f32,");
+    let wrong = COMMON_WGSL.replace(
+        "    shininess: f32,\n    _pad0: f32,",
+        "    _pad0: f32,\n    shininess: f32,",
+    );
     assert_ne!(wrong, COMMON_WGSL, "the replacement must apply");
     let module = naga::front::wgsl::parse_str(&wrong).expect("still valid WGSL");
-    assert_eq!(wgsl_layout(&module, "Particle").1 as usize, size_of::<GpuParticle>());
-    let result = std::panic::catch_unwind(|| check(&module, "Particle", size_of::<GpuParticle>(), &particle_members()));
+    assert_eq!(
+        wgsl_layout(&module, "Particle").1 as usize,
+        size_of::<GpuParticle>()
+    );
+    let result = std::panic::catch_unwind(|| {
+        check(
+            &module,
+            "Particle",
+            size_of::<GpuParticle>(),
+            &particle_members(),
+        )
+    });
     assert!(result.is_err());
 }

@@ -21,17 +21,28 @@ fn params(method: Method, samples: u32, n_exact: u32) -> ApproxParams {
 #[test]
 fn emission_matches_the_exact_answer_on_disjoint_particles() {
     let Some(ctx) = gpu() else { return };
-    let s = scene(disjoint_particles(), vec![], RenderMode::Volume, OpticalModel::Emission);
+    let s = scene(
+        disjoint_particles(),
+        vec![],
+        RenderMode::Volume,
+        OpticalModel::Emission,
+    );
     let bvh = s.build_bvh();
     let gpu = render_approx_with(ctx, &s, &params(Method::Emission, 1, 0)).unwrap();
     assert_eq!(gpu.hit_overflow_pixels, 0);
-    let oracle = cpu_image(&s.camera, |r| emission_per_particle(&s, &bvh, r, 0.0, f64::INFINITY, s.render.background));
+    let oracle = cpu_image(&s.camera, |r| {
+        emission_per_particle(&s, &bvh, r, 0.0, f64::INFINITY, s.render.background)
+    });
     let e = rmse(&gpu.image, &oracle);
     eprintln!("emission vs f64 per-particle oracle: RMSE {e:.3e}");
     assert!(e <= 1e-5, "RMSE {e}");
     // The scene is not trivial: many pixels differ from the background.
     let bg = s.render.background.as_vec3().to_array();
-    let covered = oracle.pixels.iter().filter(|p| (p[0] - bg[0]).abs() > 0.05).count();
+    let covered = oracle
+        .pixels
+        .iter()
+        .filter(|p| (p[0] - bg[0]).abs() > 0.05)
+        .count();
     assert!(covered > 300, "{covered}");
     // And against the reference renderer, where this build has volume mode.
     match reference::render(&s, &RenderOptions::default()) {
@@ -47,7 +58,12 @@ fn emission_matches_the_exact_answer_on_disjoint_particles() {
 #[test]
 fn thesis_on_an_emission_scene_is_the_emission_method() {
     let Some(ctx) = gpu() else { return };
-    let s = scene(disjoint_particles(), lights(), RenderMode::Volume, OpticalModel::Emission);
+    let s = scene(
+        disjoint_particles(),
+        lights(),
+        RenderMode::Volume,
+        OpticalModel::Emission,
+    );
     let a = render_approx_with(ctx, &s, &params(Method::Emission, 1, 0)).unwrap();
     let b = render_approx_with(ctx, &s, &params(Method::Thesis, 16, N_EXACT_ALL)).unwrap();
     assert_eq!(a.image, b.image);
@@ -67,7 +83,13 @@ fn opaque_matches_the_reference_except_on_silhouettes() {
     let mask = silhouette_mask(&s, &bvh);
     let mut worst = 0.0f64;
     let mut compared = 0;
-    for (i, (g, r)) in gpu.image.pixels.iter().zip(&reference.image.pixels).enumerate() {
+    for (i, (g, r)) in gpu
+        .image
+        .pixels
+        .iter()
+        .zip(&reference.image.pixels)
+        .enumerate()
+    {
         if mask[i] {
             continue;
         }
@@ -85,32 +107,57 @@ fn opaque_matches_the_reference_except_on_silhouettes() {
 #[test]
 fn thesis_converges_to_the_lit_model_on_disjoint_particles() {
     let Some(ctx) = gpu() else { return };
-    let s = scene(disjoint_particles(), lights(), RenderMode::Volume, OpticalModel::Lit);
+    let s = scene(
+        disjoint_particles(),
+        lights(),
+        RenderMode::Volume,
+        OpticalModel::Lit,
+    );
     let bvh = s.build_bvh();
     let oracle = cpu_image(&s.camera, |r| lit_oracle(&s, &bvh, r, 2048));
     let reference = reference::render(&s, &RenderOptions::default()).ok();
     let mut previous = f64::INFINITY;
     for samples in [4, 16, 64, 256] {
-        let gpu = render_approx_with(ctx, &s, &params(Method::Thesis, samples, N_EXACT_ALL)).unwrap();
+        let gpu =
+            render_approx_with(ctx, &s, &params(Method::Thesis, samples, N_EXACT_ALL)).unwrap();
         let e = rmse(&gpu.image, &oracle);
         let vs_ref = reference.as_ref().map(|r| rmse(&gpu.image, &r.image));
-        eprintln!("thesis samples {samples:>3}: RMSE vs f64 oracle {e:.3e}, vs reference {vs_ref:?}");
-        assert!(e < previous, "RMSE must fall with samples: {e} after {previous}");
+        eprintln!(
+            "thesis samples {samples:>3}: RMSE vs f64 oracle {e:.3e}, vs reference {vs_ref:?}"
+        );
+        // The midpoint rule converges at least like 1/samples here (shadow edges of the Θmax = 1
+        // particle make the source discontinuous along the chord): each 4× must at least halve it.
+        assert!(
+            e < 0.5 * previous,
+            "RMSE must fall with samples: {e} after {previous}"
+        );
         if let Some(v) = vs_ref {
             assert!(v.is_finite());
         }
         previous = e;
     }
-    assert!(previous < 2e-4, "RMSE at 256 samples {previous}");
+    assert!(previous < 1e-4, "RMSE at 256 samples {previous}");
 }
 
 #[test]
 fn thesis_with_fewer_exact_particles_is_further_from_the_lit_model() {
     let Some(ctx) = gpu() else { return };
-    let s = scene(disjoint_particles(), lights(), RenderMode::Volume, OpticalModel::Lit);
+    let s = scene(
+        disjoint_particles(),
+        lights(),
+        RenderMode::Volume,
+        OpticalModel::Lit,
+    );
     let bvh = s.build_bvh();
     let oracle = cpu_image(&s.camera, |r| lit_oracle(&s, &bvh, r, 1024));
-    let e = |n_exact| rmse(&render_approx_with(ctx, &s, &params(Method::Thesis, 64, n_exact)).unwrap().image, &oracle);
+    let e = |n_exact| {
+        rmse(
+            &render_approx_with(ctx, &s, &params(Method::Thesis, 64, n_exact))
+                .unwrap()
+                .image,
+            &oracle,
+        )
+    };
     let (e0, e1, eall) = (e(0), e(1), e(N_EXACT_ALL));
     eprintln!("thesis n_exact 0: {e0:.3e}, 1: {e1:.3e}, all: {eall:.3e}");
     assert!(e0 > e1 && e1 > eall, "{e0} {e1} {eall}");
@@ -128,7 +175,9 @@ fn thesis_ignores_overlaps_and_differs_from_exact_intervals() {
     let s = scene(ps, vec![], RenderMode::Volume, OpticalModel::Emission);
     let bvh = s.build_bvh();
     let exact = cpu_image(&s.camera, |r| emission_exact_intervals(&s, &bvh, r));
-    let per_particle = cpu_image(&s.camera, |r| emission_per_particle(&s, &bvh, r, 0.0, f64::INFINITY, s.render.background));
+    let per_particle = cpu_image(&s.camera, |r| {
+        emission_per_particle(&s, &bvh, r, 0.0, f64::INFINITY, s.render.background)
+    });
     let gpu = render_approx_with(ctx, &s, &params(Method::Thesis, 16, N_EXACT_ALL)).unwrap();
     let e_exact = rmse(&gpu.image, &exact);
     let e_model = rmse(&gpu.image, &per_particle);
@@ -158,10 +207,17 @@ fn an_empty_scene_renders_the_background() {
 #[test]
 fn a_crowded_ray_reports_hit_list_overflow() {
     let Some(ctx) = gpu() else { return };
-    // 200 small disjoint spheres in a row along the view axis: the centre rays cross all of
-    // them, more than MAX_HITS (128).
+    // 200 spheres in a row along the view axis (overlapping: this is about counting): the
+    // rays near the centre cross all of them, more than MAX_HITS (128).
     let ps: Vec<_> = (0..200)
-        .map(|i| particle([0.0, 0.0, -5.0 + 0.1 * i as f64], 0.04, [1.0, 1.0, 1.0], 0.01))
+        .map(|i| {
+            particle(
+                [0.0, 0.0, -5.0 + 0.1 * i as f64],
+                0.5,
+                [1.0, 1.0, 1.0],
+                0.01,
+            )
+        })
         .collect();
     let s = scene(ps, vec![], RenderMode::Volume, OpticalModel::Emission);
     let out = render_approx_with(ctx, &s, &params(Method::Emission, 1, 0)).unwrap();
@@ -179,10 +235,34 @@ fn a_point_light_inside_no_particle_lights_the_gas() {
         falloff: pgt::scene::Falloff::InverseSquare,
     };
     let ps = vec![particle([0.0, 0.0, 0.0], 1.5, [0.2, 0.2, 0.2], 0.6)];
-    let near = scene(ps.clone(), vec![light(0.0)], RenderMode::Volume, OpticalModel::Lit);
+    let near = scene(
+        ps.clone(),
+        vec![light(0.0)],
+        RenderMode::Volume,
+        OpticalModel::Lit,
+    );
     let far = scene(ps, vec![light(8.0)], RenderMode::Volume, OpticalModel::Lit);
     let a = render_approx_with(ctx, &near, &params(Method::Thesis, 16, N_EXACT_ALL)).unwrap();
     let b = render_approx_with(ctx, &far, &params(Method::Thesis, 16, N_EXACT_ALL)).unwrap();
     let centre = (SIDE / 2 * SIDE + SIDE / 2) as usize;
     assert!(a.image.pixels[centre][0] > b.image.pixels[centre][0] + 0.01);
+}
+
+#[test]
+fn the_opaque_gas_limit_agrees_with_nearly_opaque_gas() {
+    let Some(ctx) = gpu() else { return };
+    // The thesis method gives a Θmax = 1 particle the closed-form limit of the lit integral;
+    // the f64 oracle integrates the same particle with σ = 10⁴ /m (depth scale 0.1 mm on a
+    // 0.7 m sphere) without any limit formula. They must agree.
+    let ps = disjoint_particles();
+    let s_inf = scene(ps.clone(), lights(), RenderMode::Volume, OpticalModel::Lit);
+    assert!(s_inf.particles[2].sigma.is_infinite());
+    let mut s_big = s_inf.clone();
+    s_big.particles[2].sigma = 1e4;
+    let bvh = s_big.build_bvh();
+    let oracle = cpu_image(&s_big.camera, |r| lit_oracle(&s_big, &bvh, r, 2048));
+    let gpu = render_approx_with(ctx, &s_inf, &params(Method::Thesis, 256, N_EXACT_ALL)).unwrap();
+    let e = rmse(&gpu.image, &oracle);
+    eprintln!("Θmax = 1 limit vs σ = 1e4: RMSE {e:.3e}");
+    assert!(e < 1e-3, "{e}");
 }

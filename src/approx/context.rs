@@ -9,7 +9,8 @@ use crate::error::{PgtError, Result};
 use std::sync::{Arc, Mutex};
 
 /// The message DESIGN.md §4 asks for when no adapter exists.
-pub const NO_ADAPTER: &str = "no GPU adapter found: install mesa-vulkan-drivers (lavapipe) or a GPU driver";
+pub const NO_ADAPTER: &str =
+    "no GPU adapter found: install mesa-vulkan-drivers (lavapipe) or a GPU driver";
 
 /// One adapter as the user can name it with `--adapter`.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -84,7 +85,10 @@ impl GpuContext {
                     .iter()
                     .find(|a| a.get_info().name.to_lowercase().contains(&needle))
                     .ok_or_else(|| {
-                        let names: Vec<String> = adapters.iter().map(|a| describe(&a.get_info()).to_string()).collect();
+                        let names: Vec<String> = adapters
+                            .iter()
+                            .map(|a| describe(&a.get_info()).to_string())
+                            .collect();
                         PgtError::Gpu(format!(
                             "no GPU adapter matches --adapter '{filter}'; available: {}",
                             names.join("; ")
@@ -150,7 +154,10 @@ impl GpuContext {
 
     /// Reports an error that wgpu raised outside any scope.
     pub fn check_uncaptured(&self, what: &str) -> Result<()> {
-        let mut v = self.uncaptured.lock().map_err(|_| PgtError::Gpu(format!("{what}: GPU error handler poisoned")))?;
+        let mut v = self
+            .uncaptured
+            .lock()
+            .map_err(|_| PgtError::Gpu(format!("{what}: GPU error handler poisoned")))?;
         if v.is_empty() {
             return Ok(());
         }

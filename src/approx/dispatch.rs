@@ -35,7 +35,7 @@ pub struct DispatchOutput {
 /// that a scene that is too large is refused with a message, not a wgpu validation error.
 fn check_limits(ctx: &GpuContext, buffers: &[(&str, u64)]) -> Result<()> {
     let limits = ctx.device.limits();
-    let binding = limits.max_storage_buffer_binding_size as u64;
+    let binding = limits.max_storage_buffer_binding_size;
     let buffer = limits.max_buffer_size;
     for &(name, size) in buffers {
         let allowed = binding.min(buffer);
@@ -54,14 +54,19 @@ fn check_limits(ctx: &GpuContext, buffers: &[(&str, u64)]) -> Result<()> {
 
 /// A storage buffer from a slice; an empty slice still gets one zeroed element (wgpu forbids
 /// zero-sized bindings; the shaders read counts from `frame`, never the array length).
-fn storage<T: bytemuck::Pod + bytemuck::Zeroable>(ctx: &GpuContext, label: &str, data: &[T]) -> wgpu::Buffer {
+fn storage<T: bytemuck::Pod + bytemuck::Zeroable>(
+    ctx: &GpuContext,
+    label: &str,
+    data: &[T],
+) -> wgpu::Buffer {
     let zero = [T::zeroed()];
     let data = if data.is_empty() { &zero[..] } else { data };
-    ctx.device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some(label),
-        contents: bytemuck::cast_slice(data),
-        usage: wgpu::BufferUsages::STORAGE,
-    })
+    ctx.device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytemuck::cast_slice(data),
+            usage: wgpu::BufferUsages::STORAGE,
+        })
 }
 
 fn bytes<T>(n: usize) -> u64 {
@@ -89,16 +94,30 @@ fn read_back(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
 }
 
 /// Runs `program` (already validated with [`ShaderProgram::validate`]) over every pixel.
-pub fn run(ctx: &GpuContext, program: &ShaderProgram, scene: &SceneBuffers, frame: &GpuFrame) -> Result<DispatchOutput> {
+pub fn run(
+    ctx: &GpuContext,
+    program: &ShaderProgram,
+    scene: &SceneBuffers,
+    frame: &GpuFrame,
+) -> Result<DispatchOutput> {
     let pixels = frame.width as usize * frame.height as usize;
     let out_bytes = bytes::<[f32; 4]>(pixels);
     check_limits(
         ctx,
         &[
-            ("particle", bytes::<super::layout::GpuParticle>(scene.particles.len())),
-            ("BVH node", bytes::<super::layout::GpuBvhNode>(scene.nodes.len())),
+            (
+                "particle",
+                bytes::<super::layout::GpuParticle>(scene.particles.len()),
+            ),
+            (
+                "BVH node",
+                bytes::<super::layout::GpuBvhNode>(scene.nodes.len()),
+            ),
             ("BVH index", bytes::<u32>(scene.leaf_indices.len())),
-            ("light", bytes::<super::layout::GpuLight>(scene.lights.len())),
+            (
+                "light",
+                bytes::<super::layout::GpuLight>(scene.lights.len()),
+            ),
             ("output image", out_bytes),
         ],
     )?;
@@ -251,21 +270,27 @@ pub fn run(ctx: &GpuContext, program: &ShaderProgram, scene: &SceneBuffers, fram
     let (out_read, stats_read, ts_read) = ctx.checked("allocating read-back buffers", || {
         (
             readback("pgt output read-back", out_bytes),
-            readback("pgt stats read-back", std::mem::size_of::<GpuStats>() as u64),
+            readback(
+                "pgt stats read-back",
+                std::mem::size_of::<GpuStats>() as u64,
+            ),
             readback("pgt timestamps read-back", 16),
         )
     })?;
 
     let start = Instant::now();
     ctx.checked("running the compute pass", || {
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pgt") });
+        let mut encoder =
+            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pgt") });
         {
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("pgt method"),
-                timestamp_writes: timestamps.as_ref().map(|(set, _)| wgpu::ComputePassTimestampWrites {
-                    query_set: set,
-                    beginning_of_pass_write_index: Some(0),
-                    end_of_pass_write_index: Some(1),
+                timestamp_writes: timestamps.as_ref().map(|(set, _)| {
+                    wgpu::ComputePassTimestampWrites {
+                        query_set: set,
+                        beginning_of_pass_write_index: Some(0),
+                        end_of_pass_write_index: Some(1),
+                    }
                 }),
             });
             pass.set_pipeline(&pipeline);
@@ -277,14 +302,21 @@ pub fn run(ctx: &GpuContext, program: &ShaderProgram, scene: &SceneBuffers, fram
             encoder.copy_buffer_to_buffer(resolve, 0, &ts_read, 0, 16);
         }
         encoder.copy_buffer_to_buffer(&output, 0, &out_read, 0, out_bytes);
-        encoder.copy_buffer_to_buffer(&stats, 0, &stats_read, 0, std::mem::size_of::<GpuStats>() as u64);
+        encoder.copy_buffer_to_buffer(
+            &stats,
+            0,
+            &stats_read,
+            0,
+            std::mem::size_of::<GpuStats>() as u64,
+        );
         ctx.queue.submit([encoder.finish()]);
     })?;
     let out_data = read_back(ctx, &out_read)?;
     let wall = start.elapsed().as_secs_f64();
     ctx.check_uncaptured("running the compute pass")?;
     let stats_data = read_back(ctx, &stats_read)?;
-    let stats: GpuStats = bytemuck::pod_read_unaligned(&stats_data[..std::mem::size_of::<GpuStats>()]);
+    let stats: GpuStats =
+        bytemuck::pod_read_unaligned(&stats_data[..std::mem::size_of::<GpuStats>()]);
 
     let (gpu_seconds, timing) = match &timestamps {
         Some(_) => {

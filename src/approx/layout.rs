@@ -194,7 +194,10 @@ impl SceneBuffers {
             .lights
             .iter()
             .map(|l| match *l {
-                Light::Directional { direction, irradiance } => GpuLight {
+                Light::Directional {
+                    direction,
+                    irradiance,
+                } => GpuLight {
                     vector: direction.normalize().as_vec3().to_array(),
                     kind: LIGHT_DIRECTIONAL,
                     power: irradiance.as_vec3().to_array(),
@@ -231,7 +234,9 @@ pub fn bvh_depth(bvh: &Bvh) -> u32 {
     let mut stack = vec![(0usize, 1u32)];
     while let Some((n, d)) = stack.pop() {
         deepest = deepest.max(d);
-        let Some(node) = bvh.nodes.get(n) else { continue };
+        let Some(node) = bvh.nodes.get(n) else {
+            continue;
+        };
         if node.count == 0 && !bvh.is_empty() {
             stack.push((node.first as usize, d + 1));
             stack.push((node.first as usize + 1, d + 1));

@@ -53,14 +53,21 @@ pub fn render_approx(scene: &Scene, params: &ApproxParams) -> Result<ApproxOutpu
 
 /// Renders with an open context (a sweep opens one and renders many parameter sets).
 /// `params.adapter` is ignored here: the context has already chosen.
-pub fn render_approx_with(ctx: &GpuContext, scene: &Scene, params: &ApproxParams) -> Result<ApproxOutput> {
+pub fn render_approx_with(
+    ctx: &GpuContext,
+    scene: &Scene,
+    params: &ApproxParams,
+) -> Result<ApproxOutput> {
     let (method, program) = prepare(scene, params)?;
     run(ctx, scene, params, method, &program)
 }
 
 /// Resolves the method, checks it against the scene and the parameters, validates its WGSL.
 fn prepare(scene: &Scene, params: &ApproxParams) -> Result<(Method, shader::ShaderProgram)> {
-    let method = params.method.clone().unwrap_or_else(|| Method::default_for(scene));
+    let method = params
+        .method
+        .clone()
+        .unwrap_or_else(|| Method::default_for(scene));
     method.check_scene(scene)?;
     if params.samples == 0 {
         return Err(PgtError::Usage("--samples must be at least 1".into()));
@@ -70,7 +77,13 @@ fn prepare(scene: &Scene, params: &ApproxParams) -> Result<(Method, shader::Shad
     Ok((method, program))
 }
 
-fn run(ctx: &GpuContext, scene: &Scene, params: &ApproxParams, method: Method, program: &shader::ShaderProgram) -> Result<ApproxOutput> {
+fn run(
+    ctx: &GpuContext,
+    scene: &Scene,
+    params: &ApproxParams,
+    method: Method,
+    program: &shader::ShaderProgram,
+) -> Result<ApproxOutput> {
     let bvh = scene.build_bvh();
     let buffers = layout::SceneBuffers::new(scene, &bvh);
     if buffers.bvh_depth > STACK_DEPTH {

@@ -65,7 +65,11 @@ impl ShaderProgram {
                 source.push('\n');
             }
         }
-        ShaderProgram { parts, starts, source }
+        ShaderProgram {
+            parts,
+            starts,
+            source,
+        }
     }
 
     /// The concatenated WGSL.
@@ -82,7 +86,10 @@ impl ShaderProgram {
         let line = prefix.matches('\n').count() + 1;
         let line_start = prefix.rfind('\n').map_or(0, |p| p + 1);
         SourcePosition {
-            file: self.parts.get(k).map_or_else(String::new, |p| p.name.clone()),
+            file: self
+                .parts
+                .get(k)
+                .map_or_else(String::new, |p| p.name.clone()),
             line,
             column: prefix.len() - line_start + 1,
         }
@@ -122,7 +129,10 @@ impl ShaderProgram {
             }
             PgtError::Gpu(msg)
         })?;
-        let mut validator = naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::default());
+        let mut validator = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::default(),
+        );
         validator.validate(&module).map_err(|e| {
             let mut msg = String::new();
             let first = e.spans().next().and_then(|(span, _)| span.to_range());
@@ -161,11 +171,33 @@ mod tests {
 
     #[test]
     fn positions_are_relative_to_each_part() {
-        let p = ShaderProgram::from_parts(vec![part("a.wgsl", "x\ny\n"), part("b.wgsl", "one\ntwo")]);
+        let p =
+            ShaderProgram::from_parts(vec![part("a.wgsl", "x\ny\n"), part("b.wgsl", "one\ntwo")]);
         let at = |needle: &str| p.position(p.source().find(needle).unwrap());
-        assert_eq!(at("y"), SourcePosition { file: "a.wgsl".into(), line: 2, column: 1 });
-        assert_eq!(at("two"), SourcePosition { file: "b.wgsl".into(), line: 2, column: 1 });
-        assert_eq!(at("wo"), SourcePosition { file: "b.wgsl".into(), line: 2, column: 2 });
+        assert_eq!(
+            at("y"),
+            SourcePosition {
+                file: "a.wgsl".into(),
+                line: 2,
+                column: 1
+            }
+        );
+        assert_eq!(
+            at("two"),
+            SourcePosition {
+                file: "b.wgsl".into(),
+                line: 2,
+                column: 1
+            }
+        );
+        assert_eq!(
+            at("wo"),
+            SourcePosition {
+                file: "b.wgsl".into(),
+                line: 2,
+                column: 2
+            }
+        );
     }
 
     #[test]

@@ -48,7 +48,9 @@ mod tests {
 
     #[test]
     fn finds_shade_but_not_in_comments() {
-        assert!(defines_shade("fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {}"));
+        assert!(defines_shade(
+            "fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {}"
+        ));
         assert!(defines_shade("  fn   shade (ray: Ray"));
         assert!(!defines_shade("// fn shade(ray: Ray)"));
         assert!(!defines_shade("fn shader(ray: Ray)"));

@@ -10,7 +10,7 @@ use pgt::approx::GpuContext;
 use pgt::geometry::{Bvh, Camera, Hit, Ray};
 use pgt::image_io::RgbImage;
 use pgt::optics::extinction::sigma_from_opacity;
-use pgt::scene::{LightWeight, Light, OpticalModel, Particle, RenderMode, RenderSettings, Scene};
+use pgt::scene::{Light, LightWeight, OpticalModel, Particle, RenderMode, RenderSettings, Scene};
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
@@ -48,10 +48,22 @@ pub fn particle(center: [f64; 3], radius: f64, color: [f64; 3], opacity: f64) ->
     }
 }
 
-pub fn scene(particles: Vec<Particle>, lights: Vec<Light>, mode: RenderMode, model: OpticalModel) -> Scene {
+pub fn scene(
+    particles: Vec<Particle>,
+    lights: Vec<Light>,
+    mode: RenderMode,
+    model: OpticalModel,
+) -> Scene {
     Scene {
         source: "gpu-test".into(),
-        camera: Camera::new(DVec3::new(0.0, 0.0, -10.0), DVec3::ZERO, DVec3::Y, 40.0, SIDE, SIDE),
+        camera: Camera::new(
+            DVec3::new(0.0, 0.0, -10.0),
+            DVec3::ZERO,
+            DVec3::Y,
+            40.0,
+            SIDE,
+            SIDE,
+        ),
         render: RenderSettings {
             mode,
             model,
@@ -76,7 +88,10 @@ pub fn disjoint_particles() -> Vec<Particle> {
     ];
     for (i, a) in ps.iter().enumerate() {
         for b in &ps[i + 1..] {
-            assert!(a.center.distance(b.center) > a.radius + b.radius, "test scene overlaps");
+            assert!(
+                a.center.distance(b.center) > a.radius + b.radius,
+                "test scene overlaps"
+            );
         }
     }
     ps
@@ -120,7 +135,11 @@ pub fn cpu_image(camera: &Camera, f: impl Fn(&Ray) -> DVec3 + Sync) -> RgbImage 
         .into_par_iter()
         .map(|i| f(&camera.pixel_ray(i % w, i / w)).as_vec3().to_array())
         .collect();
-    RgbImage { width: w, height: h, pixels }
+    RgbImage {
+        width: w,
+        height: h,
+        pixels,
+    }
 }
 
 fn transmittance(sigma: f64, length: f64) -> f64 {
@@ -135,7 +154,14 @@ fn transmittance(sigma: f64, length: f64) -> f64 {
 
 /// Oracle, f64: the emission model along (t_min, t_max) composited particle by particle
 /// (exact when particles are disjoint: then the intervals are the particles' chords).
-pub fn emission_per_particle(scene: &Scene, bvh: &Bvh, ray: &Ray, t_min: f64, t_max: f64, background: DVec3) -> DVec3 {
+pub fn emission_per_particle(
+    scene: &Scene,
+    bvh: &Bvh,
+    ray: &Ray,
+    t_min: f64,
+    t_max: f64,
+    background: DVec3,
+) -> DVec3 {
     let mut hits: Vec<Hit> = Vec::new();
     bvh.all_hits(ray, t_min, t_max, &mut hits);
     let mut l = background;
@@ -190,7 +216,9 @@ pub fn lit_source(scene: &Scene, bvh: &Bvh, x: DVec3) -> DVec3 {
     };
     let mut q = DVec3::ZERO;
     for light in &scene.lights {
-        let Some(inc) = light.incident_at(x) else { continue };
+        let Some(inc) = light.incident_at(x) else {
+            continue;
+        };
         let ray = Ray {
             origin: x,
             direction: inc.toward,
@@ -200,9 +228,53 @@ pub fn lit_source(scene: &Scene, bvh: &Bvh, x: DVec3) -> DVec3 {
     w * q
 }
 
+/// Oracle, f64: what a Θmax = 1 particle shows at the entry point x of a camera ray under the
+/// lit model, the limit σ → ∞ of ∫σe^{−σs}Q ds: with depth z below the surface, the view path is
+/// z/μ_v and the light's path through the particle z/μ_l, so the integral is
+/// Σ_l (L_rest·μ_l + C·μ_v)/(μ_l + μ_v) (L_rest: light through the other particles), or C for a
+/// light behind the surface.
+fn lit_opaque_surface(scene: &Scene, bvh: &Bvh, ray: &Ray, index: u32, t0: f64) -> DVec3 {
+    let p = &scene.particles[index as usize];
+    let x = ray.at(t0);
+    let n = (x - p.center).normalize();
+    let mu_v = (-ray.direction).dot(n);
+    let w = match scene.render.light_weight {
+        LightWeight::Mean => 1.0 / scene.lights.len().max(1) as f64,
+        LightWeight::Sum => 1.0,
+    };
+    let mut q = DVec3::ZERO;
+    for light in &scene.lights {
+        let Some(inc) = light.incident_at(x) else {
+            continue;
+        };
+        let mu_l = n.dot(inc.toward);
+        if mu_l <= 0.0 {
+            q += p.color;
+            continue;
+        }
+        let shadow = Ray {
+            origin: x,
+            direction: inc.toward,
+        };
+        let mut hits: Vec<Hit> = Vec::new();
+        bvh.all_hits(&shadow, 0.0, inc.distance, &mut hits);
+        let mut rest = inc.irradiance;
+        for h in hits.iter().rev().filter(|h| h.index != index) {
+            let o = &scene.particles[h.index as usize];
+            let t = transmittance(
+                o.sigma,
+                h.chord.t_exit.min(inc.distance) - h.chord.t_enter.max(0.0),
+            );
+            rest = rest * t + o.color * (1.0 - t);
+        }
+        q += (rest * mu_l + p.color * mu_v) / (mu_l + mu_v);
+    }
+    w * q
+}
+
 /// Oracle, f64: the lit model on a scene of disjoint particles, each chord integrated as
 /// ∫ Q(t)·σe^{−σ(t−t0)} dt by the midpoint rule in u = 1 − e^{−σ(t−t0)} (the transmittance
-/// weight becomes du) with `n` panels; Θmax = 1 gives Q at the entry point.
+/// weight becomes du) with `n` panels; Θmax = 1 by its limit, [`lit_opaque_surface`].
 pub fn lit_oracle(scene: &Scene, bvh: &Bvh, ray: &Ray, n: usize) -> DVec3 {
     let mut hits: Vec<Hit> = Vec::new();
     bvh.all_hits(ray, 0.0, f64::INFINITY, &mut hits);
@@ -212,7 +284,7 @@ pub fn lit_oracle(scene: &Scene, bvh: &Bvh, ray: &Ray, n: usize) -> DVec3 {
         let t0 = h.chord.t_enter.max(0.0);
         let t1 = h.chord.t_exit;
         if p.sigma.is_infinite() {
-            l = lit_source(scene, bvh, ray.at(t0));
+            l = lit_opaque_surface(scene, bvh, ray, h.index, t0);
             continue;
         }
         let u_max = 1.0 - (-p.sigma * (t1 - t0)).exp();
@@ -235,8 +307,12 @@ pub fn silhouette_mask(scene: &Scene, bvh: &Bvh) -> Vec<bool> {
     let (w, h) = (cam.width as i64, cam.height as i64);
     let hit: Vec<bool> = (0..w * h)
         .map(|i| {
-            bvh.first_hit(&cam.pixel_ray((i % w) as u32, (i / w) as u32), 0.0, f64::INFINITY)
-                .is_some()
+            bvh.first_hit(
+                &cam.pixel_ray((i % w) as u32, (i / w) as u32),
+                0.0,
+                f64::INFINITY,
+            )
+            .is_some()
         })
         .collect();
     (0..w * h)
