@@ -16,7 +16,11 @@ pub enum Outcome {
 }
 
 #[derive(Debug, Parser)]
-#[command(name = "pgt", version, about = "Particle ground truth: exact renderings of sphere particle scenes, GPU approximations, and their difference")]
+#[command(
+    name = "pgt",
+    version,
+    about = "Particle ground truth: exact renderings of sphere particle scenes, GPU approximations, and their difference"
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
@@ -49,13 +53,7 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
             .map_err(|_| format!("expected WIDTHxHEIGHT with positive integers, got '{s}'"))
     };
     let (w, h) = (parse(w)?, parse(h)?);
-    if w == 0 || h == 0 || w > crate::scene::MAX_IMAGE_SIDE || h > crate::scene::MAX_IMAGE_SIDE {
-        return Err(format!(
-            "image size must be between 1 and {} on each side, got '{s}'",
-            crate::scene::MAX_IMAGE_SIDE
-        ));
-    }
-    Ok((w, h))
+    crate::scene::check_image_size(w as i64, h as i64)
 }
 
 /// Whether stderr is a terminal (progress bars only then).

@@ -70,7 +70,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
             if args.samples == 0 {
                 anyhow::bail!("--samples must be at least 1");
             }
-            Integrator::Riemann { samples: args.samples }
+            Integrator::Riemann {
+                samples: args.samples,
+            }
         }
     };
     let render_options = RenderOptions {
@@ -80,7 +82,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
         integrator,
     };
     let out = reference::render(&scene, &render_options)?;
-    let layers: Vec<(&str, &crate::image_io::RgbImage)> = out.error.iter().map(|e| ("err", e)).collect();
+    let layers: Vec<(&str, &crate::image_io::RgbImage)> =
+        out.error.iter().map(|e| ("err", e)).collect();
     write_image(&args.output, &out.image, &layers, args.exposure)?;
     let s = &out.stats;
     let rays = s.primary_rays + s.shadow_rays;

@@ -85,7 +85,11 @@ impl Bvh {
     pub fn build(centers: Vec<DVec3>, radii: Vec<f64>) -> Bvh {
         assert_eq!(centers.len(), radii.len());
         let n = centers.len();
-        let boxes: Vec<Aabb> = centers.iter().zip(&radii).map(|(&c, &r)| sphere_box(c, r)).collect();
+        let boxes: Vec<Aabb> = centers
+            .iter()
+            .zip(&radii)
+            .map(|(&c, &r)| sphere_box(c, r))
+            .collect();
         let mut indices: Vec<u32> = (0..n as u32).collect();
         let mut nodes = Vec::with_capacity(2 * n.max(1));
         nodes.push(BvhNode {
@@ -98,7 +102,12 @@ impl Bvh {
             // An empty box that no ray enters.
             nodes[0].min = DVec3::splat(f64::INFINITY);
             nodes[0].max = DVec3::splat(f64::NEG_INFINITY);
-            return Bvh { nodes, indices, centers, radii };
+            return Bvh {
+                nodes,
+                indices,
+                centers,
+                radii,
+            };
         }
         // Explicit work stack: (node, range start, range end); depth is bounded by the
         // fall-back median split, so no recursion limit is hit for millions of spheres.
@@ -165,7 +174,12 @@ impl Bvh {
             stack.push((left, start, mid));
         }
         nodes.shrink_to_fit();
-        Bvh { nodes, indices, centers, radii }
+        Bvh {
+            nodes,
+            indices,
+            centers,
+            radii,
+        }
     }
 
     /// Number of spheres.
@@ -230,7 +244,13 @@ impl Bvh {
 
     /// Visits every sphere whose chord overlaps (t_min, limit), nearer boxes first; `visit` may
     /// lower `limit` (nearest-hit search) and returns true to stop.
-    fn traverse(&self, ray: &Ray, t_min: f64, t_max: f64, mut visit: impl FnMut(u32, Chord, &mut f64) -> bool) {
+    fn traverse(
+        &self,
+        ray: &Ray,
+        t_min: f64,
+        t_max: f64,
+        mut visit: impl FnMut(u32, Chord, &mut f64) -> bool,
+    ) {
         if self.centers.is_empty() {
             return;
         }
@@ -247,8 +267,13 @@ impl Bvh {
             if node.count > 0 {
                 let first = node.first as usize;
                 for &i in &self.indices[first..first + node.count as usize] {
-                    if let Some(chord) = intersect_sphere(ray, self.centers[i as usize], self.radii[i as usize]) {
-                        if chord.t_exit > t_min && chord.t_enter < limit && visit(i, chord, &mut limit) {
+                    if let Some(chord) =
+                        intersect_sphere(ray, self.centers[i as usize], self.radii[i as usize])
+                    {
+                        if chord.t_exit > t_min
+                            && chord.t_enter < limit
+                            && visit(i, chord, &mut limit)
+                        {
                             return;
                         }
                     }
@@ -322,7 +347,9 @@ impl NodeStack {
 fn median_split(slice: &mut [u32], centers: &[DVec3], cbounds: &Aabb) {
     let axis = (cbounds.max - cbounds.min).max_position();
     let half = slice.len() / 2;
-    slice.select_nth_unstable_by(half, |&a, &b| centers[a as usize][axis].total_cmp(&centers[b as usize][axis]));
+    slice.select_nth_unstable_by(half, |&a, &b| {
+        centers[a as usize][axis].total_cmp(&centers[b as usize][axis])
+    });
 }
 
 /// Slab test of the segment (t_min, t_max) against a box. `f64::min`/`max` drop the NaN that
@@ -332,19 +359,34 @@ fn median_split(slice: &mut [u32], centers: &[DVec3], cbounds: &Aabb) {
 fn slab_test(o: DVec3, inv: DVec3, min: DVec3, max: DVec3, t_min: f64, t_max: f64) -> Option<f64> {
     let t0 = (min - o) * inv;
     let t1 = (max - o) * inv;
-    let near = t0.x.min(t1.x).max(t0.y.min(t1.y)).max(t0.z.min(t1.z)).max(t_min);
-    let far = t0.x.max(t1.x).min(t0.y.max(t1.y)).min(t0.z.max(t1.z)).min(t_max);
+    let near =
+        t0.x.min(t1.x)
+            .max(t0.y.min(t1.y))
+            .max(t0.z.min(t1.z))
+            .max(t_min);
+    let far =
+        t0.x.max(t1.x)
+            .min(t0.y.max(t1.y))
+            .min(t0.z.max(t1.z))
+            .min(t_max);
     (near <= far).then_some(near)
 }
 
 /// Binned SAH over centroids: the (axis, position) with the lowest cost, or `None` when no split
 /// beats a leaf.
-fn choose_split(indices: &[u32], boxes: &[Aabb], centers: &[DVec3], bounds: &Aabb, cbounds: &Aabb) -> Option<(usize, f64)> {
+fn choose_split(
+    indices: &[u32],
+    boxes: &[Aabb],
+    centers: &[DVec3],
+    bounds: &Aabb,
+    cbounds: &Aabb,
+) -> Option<(usize, f64)> {
     let mut best: Option<(f64, usize, f64)> = None;
+    #[allow(clippy::needless_range_loop)] // `axis` indexes DVec3 components, not a slice
     for axis in 0..3 {
         let lo = cbounds.min[axis];
         let hi = cbounds.max[axis];
-        if !(hi > lo) {
+        if hi.partial_cmp(&lo) != Some(std::cmp::Ordering::Greater) {
             continue;
         }
         let scale = BINS as f64 / (hi - lo);
@@ -400,15 +442,28 @@ mod tests {
             .iter()
             .zip(radii)
             .enumerate()
-            .filter_map(|(i, (&c, &r))| intersect_sphere(ray, c, r).map(|chord| Hit { index: i as u32, chord }))
+            .filter_map(|(i, (&c, &r))| {
+                intersect_sphere(ray, c, r).map(|chord| Hit {
+                    index: i as u32,
+                    chord,
+                })
+            })
             .filter(|h| h.chord.t_exit > t_min && h.chord.t_enter < t_max)
             .collect();
-        v.sort_unstable_by(|a, b| a.chord.t_enter.total_cmp(&b.chord.t_enter).then(a.index.cmp(&b.index)));
+        v.sort_unstable_by(|a, b| {
+            a.chord
+                .t_enter
+                .total_cmp(&b.chord.t_enter)
+                .then(a.index.cmp(&b.index))
+        });
         v
     }
 
     fn spheres() -> impl Strategy<Value = Vec<([f64; 3], f64)>> {
-        prop::collection::vec((prop::array::uniform3(-10.0f64..10.0), 0.05f64..2.0), 0..200)
+        prop::collection::vec(
+            (prop::array::uniform3(-10.0f64..10.0), 0.05f64..2.0),
+            0..200,
+        )
     }
 
     #[derive(Debug, Clone)]
@@ -422,9 +477,23 @@ mod tests {
 
     fn ray_kind() -> impl Strategy<Value = RayKind> {
         prop_oneof![
-            (prop::array::uniform3(-15.0f64..15.0), prop::array::uniform3(-1.0f64..1.0)).prop_map(|(o, d)| RayKind::Random(o, d)),
-            (0usize..1000, prop::array::uniform3(-1.0f64..1.0), -1.0f64..1.0).prop_map(|(k, d, s)| RayKind::Graze(k, d, s)),
-            (0usize..1000, prop::array::uniform3(-0.5f64..0.5), prop::array::uniform3(-1.0f64..1.0)).prop_map(|(k, o, d)| RayKind::Inside(k, o, d)),
+            (
+                prop::array::uniform3(-15.0f64..15.0),
+                prop::array::uniform3(-1.0f64..1.0)
+            )
+                .prop_map(|(o, d)| RayKind::Random(o, d)),
+            (
+                0usize..1000,
+                prop::array::uniform3(-1.0f64..1.0),
+                -1.0f64..1.0
+            )
+                .prop_map(|(k, d, s)| RayKind::Graze(k, d, s)),
+            (
+                0usize..1000,
+                prop::array::uniform3(-0.5f64..0.5),
+                prop::array::uniform3(-1.0f64..1.0)
+            )
+                .prop_map(|(k, o, d)| RayKind::Inside(k, o, d)),
         ]
     }
 
@@ -443,7 +512,10 @@ mod tests {
                 let d = d.normalize();
                 let b = radii[k] * (1.0 - 1e-12 * s);
                 let origin = centers[k] + d.any_orthonormal_vector() * b - 20.0 * d;
-                Some(Ray { origin, direction: d })
+                Some(Ray {
+                    origin,
+                    direction: d,
+                })
             }
             RayKind::Inside(k, o, d) => {
                 let d = DVec3::from(d);
@@ -489,7 +561,9 @@ mod tests {
         let mut centers = Vec::with_capacity(n);
         let mut state = 12345u64;
         let mut next = || {
-            state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
         for _ in 0..n {

@@ -21,7 +21,14 @@ pub struct Camera {
 impl Camera {
     /// Builds the frame. `forward` and `up` must be non-zero and not parallel (validated by the
     /// scene loader, which reports the file and line).
-    pub fn new(position: DVec3, look_at: DVec3, up: DVec3, fov_y_deg: f64, width: u32, height: u32) -> Self {
+    pub fn new(
+        position: DVec3,
+        look_at: DVec3,
+        up: DVec3,
+        fov_y_deg: f64,
+        width: u32,
+        height: u32,
+    ) -> Self {
         let forward = (look_at - position).normalize();
         let right = forward.cross(up).normalize();
         let up = right.cross(forward);
@@ -67,7 +74,14 @@ mod tests {
 
     #[test]
     fn centre_pixel_of_odd_image_looks_at_target() {
-        let cam = Camera::new(DVec3::new(0.0, 0.0, -10.0), DVec3::ZERO, DVec3::Y, 40.0, 5, 5);
+        let cam = Camera::new(
+            DVec3::new(0.0, 0.0, -10.0),
+            DVec3::ZERO,
+            DVec3::Y,
+            40.0,
+            5,
+            5,
+        );
         let r = cam.pixel_ray(2, 2);
         assert_relative_eq!(r.direction, DVec3::Z, epsilon = 1e-15);
     }
@@ -75,7 +89,14 @@ mod tests {
     #[test]
     fn right_handed_frame_and_row_zero_is_top() {
         // Looking down +z with +y up: right = f × up = z × y = −x.
-        let cam = Camera::new(DVec3::new(0.0, 0.0, -10.0), DVec3::ZERO, DVec3::Y, 90.0, 2, 2);
+        let cam = Camera::new(
+            DVec3::new(0.0, 0.0, -10.0),
+            DVec3::ZERO,
+            DVec3::Y,
+            90.0,
+            2,
+            2,
+        );
         assert_relative_eq!(cam.right, -DVec3::X, epsilon = 1e-15);
         let top_left = cam.pixel_ray(0, 0).direction;
         assert!(top_left.y > 0.0 && top_left.x > 0.0);

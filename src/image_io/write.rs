@@ -13,7 +13,12 @@ pub enum ImageFormat {
 impl ImageFormat {
     /// The format named by a path's extension (case-insensitive).
     pub fn from_path(path: &Path) -> Result<ImageFormat> {
-        match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+        match path
+            .extension()
+            .and_then(|e| e.to_str())
+            .map(str::to_ascii_lowercase)
+            .as_deref()
+        {
             Some("exr") => Ok(ImageFormat::Exr),
             Some("png") => Ok(ImageFormat::Png),
             _ => Err(PgtError::Usage(format!(
@@ -39,7 +44,12 @@ pub fn linear_to_srgb8(v: f32, exposure_scale: f32) -> u8 {
 
 /// Writes `image` (and, for EXR, the extra layers, each written as `NAME.R/G/B`) to `path`,
 /// atomically. PNG ignores the extra layers and applies `exposure` in stops.
-pub fn write_image(path: &Path, image: &RgbImage, layers: &[(&str, &RgbImage)], exposure: f32) -> Result<()> {
+pub fn write_image(
+    path: &Path,
+    image: &RgbImage,
+    layers: &[(&str, &RgbImage)],
+    exposure: f32,
+) -> Result<()> {
     let format = ImageFormat::from_path(path)?;
     let dir = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
@@ -50,10 +60,16 @@ pub fn write_image(path: &Path, image: &RgbImage, layers: &[(&str, &RgbImage)], 
         .tempfile_in(dir)
         .map_err(|e| PgtError::io(dir, e))?;
     match format {
-        ImageFormat::Png => write_png(tmp.as_file(), image, exposure).map_err(|e| PgtError::io(path, e))?,
-        ImageFormat::Exr => write_exr(tmp.as_file(), image, layers).map_err(|e| PgtError::io(path, e))?,
+        ImageFormat::Png => {
+            write_png(tmp.as_file(), image, exposure).map_err(|e| PgtError::io(path, e))?
+        }
+        ImageFormat::Exr => {
+            write_exr(tmp.as_file(), image, layers).map_err(|e| PgtError::io(path, e))?
+        }
     }
-    tmp.as_file().sync_all().map_err(|e| PgtError::io(path, e))?;
+    tmp.as_file()
+        .sync_all()
+        .map_err(|e| PgtError::io(path, e))?;
     tmp.persist(path).map_err(|e| PgtError::io(path, e.error))?;
     Ok(())
 }
@@ -67,14 +83,23 @@ fn write_png(file: &std::fs::File, image: &RgbImage, exposure: f32) -> std::io::
         .collect();
     let mut w = BufWriter::new(file);
     image::codecs::png::PngEncoder::new(&mut w)
-        .write_image(&bytes, image.width, image.height, image::ExtendedColorType::Rgb8)
+        .write_image(
+            &bytes,
+            image.width,
+            image.height,
+            image::ExtendedColorType::Rgb8,
+        )
         .map_err(std::io::Error::other)?;
     w.flush()
 }
 
 use image::ImageEncoder;
 
-fn write_exr(file: &std::fs::File, image: &RgbImage, layers: &[(&str, &RgbImage)]) -> std::io::Result<()> {
+fn write_exr(
+    file: &std::fs::File,
+    image: &RgbImage,
+    layers: &[(&str, &RgbImage)],
+) -> std::io::Result<()> {
     use exr::prelude::*;
     let size = (image.width as usize, image.height as usize);
     let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::new();
@@ -94,9 +119,16 @@ fn write_exr(file: &std::fs::File, image: &RgbImage, layers: &[(&str, &RgbImage)
         add(name, layer);
     }
     let channels = AnyChannels::sort(channels.into_iter().collect());
-    let layer = Layer::new(size, LayerAttributes::default(), Encoding::SMALL_LOSSLESS, channels);
+    let layer = Layer::new(
+        size,
+        LayerAttributes::default(),
+        Encoding::SMALL_LOSSLESS,
+        channels,
+    );
     let img = Image::from_layer(layer);
     let mut w = BufWriter::new(file);
-    img.write().to_buffered(&mut w).map_err(std::io::Error::other)?;
+    img.write()
+        .to_buffered(&mut w)
+        .map_err(std::io::Error::other)?;
     w.flush()
 }

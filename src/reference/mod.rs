@@ -87,8 +87,11 @@ pub struct RenderOutput {
 
 /// Renders the scene with the renderer its mode and model call for.
 pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
-    if options.spp == 0 {
-        return Err(PgtError::Usage("--spp must be at least 1".into()));
+    if !(1..=MAX_SPP).contains(&options.spp) {
+        return Err(PgtError::Usage(format!(
+            "--spp must be between 1 and {MAX_SPP}, got {}",
+            options.spp
+        )));
     }
     match scene.render.mode {
         RenderMode::Opaque => {
@@ -101,21 +104,32 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
     }
 }
 
+/// Largest k of k×k samples per pixel.
+pub const MAX_SPP: u32 = 64;
+
 /// Side of a square tile of pixels, the unit of parallel work.
 const TILE: u32 = 16;
 
 /// Runs `estimator` over every pixel of `camera`'s image.
-pub fn render_with(camera: &Camera, estimator: &dyn RadianceEstimator, options: &RenderOptions) -> Result<RenderOutput> {
+pub fn render_with(
+    camera: &Camera,
+    estimator: &dyn RadianceEstimator,
+    options: &RenderOptions,
+) -> Result<RenderOutput> {
     let start = Instant::now();
     let (w, h) = (camera.width, camera.height);
     let tiles_x = w.div_ceil(TILE);
     let tiles_y = h.div_ceil(TILE);
-    let tiles: Vec<(u32, u32)> = (0..tiles_y).flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty))).collect();
+    let tiles: Vec<(u32, u32)> = (0..tiles_y)
+        .flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty)))
+        .collect();
     let bar = if options.progress {
         let bar = indicatif::ProgressBar::new(tiles.len() as u64);
         bar.set_style(
-            indicatif::ProgressStyle::with_template("{elapsed_precise} [{bar:40}] {percent}% eta {eta}")
-                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+            indicatif::ProgressStyle::with_template(
+                "{elapsed_precise} [{bar:40}] {percent}% eta {eta}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
         );
         Some(bar)
     } else {

@@ -34,7 +34,8 @@ impl<'a> OpaqueRenderer<'a> {
             origin: x,
             direction: toward,
         };
-        let eps = SHADOW_EPSILON * (x.abs().max_element() + self.scene.particles[own as usize].radius);
+        let eps =
+            SHADOW_EPSILON * (x.abs().max_element() + self.scene.particles[own as usize].radius);
         self.bvh.any_hit(&ray, eps, distance, |i| i == own)
     }
 
@@ -43,11 +44,21 @@ impl<'a> OpaqueRenderer<'a> {
     /// Specular is normalised Blinn–Phong, ks·(s+8)/(8π)·max(0, n·h)^s·max(0, n·ω_l), h the half
     /// vector of ω_l and −view (DESIGN.md leaves the normalisation open; this one conserves
     /// energy for ks ≤ 1).
-    fn shade(&self, p: &Particle, own: u32, x: DVec3, n: DVec3, entering: bool, view: DVec3) -> (DVec3, u64) {
+    fn shade(
+        &self,
+        p: &Particle,
+        own: u32,
+        x: DVec3,
+        n: DVec3,
+        entering: bool,
+        view: DVec3,
+    ) -> (DVec3, u64) {
         let mut radiance = self.scene.render.ambient * p.color;
         let mut rays = 0;
         for light in &self.scene.lights {
-            let Some(inc) = light.incident_at(x) else { continue };
+            let Some(inc) = light.incident_at(x) else {
+                continue;
+            };
             let cos = n.dot(inc.toward);
             // Interior surfaces (the eye is inside the sphere): a ray towards the light from the
             // inside wall, on the side the wall faces, passes through the sphere itself.
@@ -62,7 +73,9 @@ impl<'a> OpaqueRenderer<'a> {
             if p.ks > 0.0 {
                 let h = (inc.toward - view).normalize_or_zero();
                 let nh = n.dot(h).max(0.0);
-                brdf_cos += DVec3::splat(p.ks * (p.shininess + 8.0) / (8.0 * PI) * nh.powf(p.shininess) * cos);
+                brdf_cos += DVec3::splat(
+                    p.ks * (p.shininess + 8.0) / (8.0 * PI) * nh.powf(p.shininess) * cos,
+                );
             }
             radiance += inc.irradiance * brdf_cos;
         }
@@ -114,7 +127,14 @@ mod tests {
     fn scene(particles: Vec<Particle>, lights: Vec<Light>) -> Scene {
         Scene {
             source: "test".into(),
-            camera: Camera::new(DVec3::new(0.0, 0.0, -10.0), DVec3::ZERO, DVec3::Y, 30.0, 9, 9),
+            camera: Camera::new(
+                DVec3::new(0.0, 0.0, -10.0),
+                DVec3::ZERO,
+                DVec3::Y,
+                30.0,
+                9,
+                9,
+            ),
             render: RenderSettings {
                 mode: RenderMode::Opaque,
                 ..RenderSettings::default()
@@ -127,7 +147,8 @@ mod tests {
 
     fn centre_radiance(s: &Scene) -> DVec3 {
         let r = OpaqueRenderer::new(s);
-        r.radiance(&Ray::new(DVec3::new(0.0, 0.0, -10.0), DVec3::Z)).radiance
+        r.radiance(&Ray::new(DVec3::new(0.0, 0.0, -10.0), DVec3::Z))
+            .radiance
     }
 
     #[test]
@@ -135,7 +156,10 @@ mod tests {
         let e = DVec3::new(2.0, 3.0, 5.0);
         let s = scene(
             vec![particle(DVec3::ZERO, 1.0)],
-            vec![Light::Directional { direction: DVec3::Z, irradiance: e }],
+            vec![Light::Directional {
+                direction: DVec3::Z,
+                irradiance: e,
+            }],
         );
         assert_relative_eq!(centre_radiance(&s), e / PI, max_relative = 1e-14);
     }
@@ -149,8 +173,15 @@ mod tests {
             intensity: i,
             falloff,
         };
-        let s = scene(vec![particle(DVec3::ZERO, 1.0)], vec![light(Falloff::InverseSquare)]);
-        assert_relative_eq!(centre_radiance(&s), i / 25.0 * 0.8 / PI, max_relative = 1e-14);
+        let s = scene(
+            vec![particle(DVec3::ZERO, 1.0)],
+            vec![light(Falloff::InverseSquare)],
+        );
+        assert_relative_eq!(
+            centre_radiance(&s),
+            i / 25.0 * 0.8 / PI,
+            max_relative = 1e-14
+        );
         let s = scene(vec![particle(DVec3::ZERO, 1.0)], vec![light(Falloff::None)]);
         assert_relative_eq!(centre_radiance(&s), i * 0.8 / PI, max_relative = 1e-14);
     }
@@ -180,8 +211,18 @@ mod tests {
             direction: DVec3::new(0.3, -0.2, 1.0).normalize(),
             irradiance: DVec3::ONE,
         };
-        let mut s = scene(vec![particle(DVec3::new(123.4, -56.7, 8.9), 3.0)], vec![light]);
-        s.camera = Camera::new(DVec3::new(123.4, -56.7, -20.0), DVec3::new(123.4, -56.7, 8.9), DVec3::Y, 20.0, 64, 64);
+        let mut s = scene(
+            vec![particle(DVec3::new(123.4, -56.7, 8.9), 3.0)],
+            vec![light],
+        );
+        s.camera = Camera::new(
+            DVec3::new(123.4, -56.7, -20.0),
+            DVec3::new(123.4, -56.7, 8.9),
+            DVec3::Y,
+            20.0,
+            64,
+            64,
+        );
         let r = OpaqueRenderer::new(&s);
         let mut lit_pixels = 0;
         for py in 0..64 {
@@ -192,7 +233,10 @@ mod tests {
                     let cos = n.dot(-light_dir(&s));
                     let got = r.radiance(&ray).radiance.x;
                     let expected = cos.max(0.0) / PI;
-                    assert!((got - expected).abs() < 1e-9, "pixel {px},{py}: {got} vs {expected}");
+                    assert!(
+                        (got - expected).abs() < 1e-9,
+                        "pixel {px},{py}: {got} vs {expected}"
+                    );
                     lit_pixels += (cos > 0.0) as u32;
                 }
             }
@@ -209,14 +253,20 @@ mod tests {
 
     #[test]
     fn blinn_phong_peaks_at_the_mirror_direction() {
-        // Eye on −z looking at the sphere's pole (0,0,−1) with normal −z. A light whose direction
-        // mirrors the view about the normal gives the largest highlight.
+        // An eye ray hitting the unit sphere off-centre: the highlight lobe (radiance over the
+        // cosine factor) is largest when the light sits in the mirror direction of the eye about
+        // the normal, where it is ks·(s+8)/(8π).
         let mut p = particle(DVec3::ZERO, 1.0);
         p.ks = 1.0;
         p.shininess = 64.0;
         p.color = DVec3::ZERO;
-        let spec_at = |angle: f64| {
-            let toward = DVec3::new(angle.sin(), 0.0, -angle.cos());
+        let eye = Ray::new(DVec3::new(0.5, 0.2, -10.0), DVec3::Z);
+        let x = eye.at(intersect_t(&eye));
+        let n = x.normalize();
+        let v = -eye.direction;
+        let mirror = 2.0 * n.dot(v) * n - v;
+        let axis = n.cross(v).normalize();
+        let spec_for = |toward: DVec3| {
             let s = scene(
                 vec![p],
                 vec![Light::Directional {
@@ -224,14 +274,21 @@ mod tests {
                     irradiance: DVec3::ONE,
                 }],
             );
-            centre_radiance(&s).x
+            OpaqueRenderer::new(&s).radiance(&eye).radiance.x / n.dot(toward)
         };
-        // View along +z at the pole: the mirror direction is the normal itself (angle 0).
-        let peak = spec_at(0.0);
-        assert_relative_eq!(peak, (64.0 + 8.0) / (8.0 * PI), max_relative = 1e-12);
-        for a in [0.05, 0.1, 0.3, -0.2] {
-            assert!(spec_at(a) < peak);
+        let peak = spec_for(mirror);
+        assert_relative_eq!(peak, (64.0 + 8.0) / (8.0 * PI), max_relative = 1e-9);
+        for angle in [-0.2, -0.05, -0.01, 0.01, 0.05, 0.2] {
+            let rotated = glam::DQuat::from_axis_angle(axis, angle) * mirror;
+            let off = spec_for(rotated);
+            assert!(off < peak, "angle {angle}: {off} ≥ {peak}");
         }
+    }
+
+    fn intersect_t(ray: &Ray) -> f64 {
+        crate::geometry::intersect_sphere(ray, DVec3::ZERO, 1.0)
+            .unwrap()
+            .t_enter
     }
 
     #[test]

@@ -45,26 +45,25 @@ pub(super) struct RenderTable {
     pub tol: Option<f64>,
 }
 
-#[derive(Debug, Deserialize)]
-#[serde(tag = "type", rename_all = "kebab-case")]
-pub(super) enum LightTable {
-    Directional(DirectionalTable),
-    Point(PointTable),
-}
-
+/// One `[[lights]]` table. A flat struct rather than a tagged enum: serde buffers tagged enums,
+/// which loses the line of a bad field; the per-type requirements are checked in validation.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
-pub(super) struct DirectionalTable {
-    pub direction: [f64; 3],
-    pub irradiance: [f64; 3],
-}
-
-#[derive(Debug, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub(super) struct PointTable {
-    pub position: [f64; 3],
-    pub intensity: [f64; 3],
+pub(super) struct LightTable {
+    #[serde(rename = "type")]
+    pub kind: LightKind,
+    pub direction: Option<[f64; 3]>,
+    pub irradiance: Option<[f64; 3]>,
+    pub position: Option<[f64; 3]>,
+    pub intensity: Option<[f64; 3]>,
     pub falloff: Option<Falloff>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub(super) enum LightKind {
+    Directional,
+    Point,
 }
 
 /// `[defaults]`: values for every particle that does not set its own.

@@ -17,7 +17,14 @@ pub fn default_camera(particles: &[Particle], width: u32, height: u32) -> Camera
     let (center, radius) = bounding_sphere(particles);
     let half = (DEFAULT_FOV_Y.to_radians() * 0.5).sin();
     let distance = (radius * FRAMING_MARGIN / half).max(1e-9);
-    Camera::new(center - DVec3::Z * distance, center, DVec3::Y, DEFAULT_FOV_Y, width, height)
+    Camera::new(
+        center - DVec3::Z * distance,
+        center,
+        DVec3::Y,
+        DEFAULT_FOV_Y,
+        width,
+        height,
+    )
 }
 
 /// The centre of the particles' bounding box and the radius of the sphere around it that holds

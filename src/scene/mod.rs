@@ -15,7 +15,9 @@ use glam::DVec3;
 use std::path::{Path, PathBuf};
 
 /// `mode` (DESIGN.md §1): opaque spheres or spheres of gas.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum RenderMode {
     Opaque,
@@ -23,7 +25,9 @@ pub enum RenderMode {
 }
 
 /// `model` (DESIGN.md §2): the source term Q of the volume renderer.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum)]
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum,
+)]
 #[serde(rename_all = "kebab-case")]
 pub enum OpticalModel {
     Emission,
@@ -79,7 +83,10 @@ impl Light {
     #[inline]
     pub fn incident_at(&self, x: DVec3) -> Option<Incident> {
         match *self {
-            Light::Directional { direction, irradiance } => Some(Incident {
+            Light::Directional {
+                direction,
+                irradiance,
+            } => Some(Incident {
                 toward: -direction,
                 distance: f64::INFINITY,
                 irradiance,
@@ -197,6 +204,25 @@ pub struct ParticleRecord {
 /// Largest image side pgt accepts; beyond it a typo (`--size 5120000x512`) would allocate
 /// gigabytes before anything useful happens.
 pub const MAX_IMAGE_SIDE: u32 = 32768;
+/// Largest pixel count (8192²): the reference keeps the image, its error layer and the tile
+/// results in memory, about 40 bytes a pixel.
+pub const MAX_PIXELS: u64 = 1 << 26;
+
+/// Checks an image size against [`MAX_IMAGE_SIDE`] and [`MAX_PIXELS`]; the error text says why.
+pub fn check_image_size(width: i64, height: i64) -> std::result::Result<(u32, u32), String> {
+    let max = MAX_IMAGE_SIDE as i64;
+    if width < 1
+        || height < 1
+        || width > max
+        || height > max
+        || (width * height) as u64 > MAX_PIXELS
+    {
+        return Err(format!(
+            "image size must be between 1 and {MAX_IMAGE_SIDE} pixels on each side and at most {MAX_PIXELS} pixels, got {width}x{height}"
+        ));
+    }
+    Ok((width as u32, height as u32))
+}
 
 impl Scene {
     /// Loads a scene: a TOML scene file (`.toml`), or a bare particle file that gets the default

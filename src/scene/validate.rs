@@ -1,11 +1,12 @@
 //! Scene validation: the raw TOML tables become a [`Scene`], or an error that names the file,
 //! the line and the field (DESIGN.md §6 "Bad input").
 
-use super::file::{CameraTable, LightTable, ParticleDefaults, ParticleTable, RenderTable, SceneFile};
+use super::file::{
+    CameraTable, LightKind, LightTable, ParticleDefaults, ParticleTable, RenderTable, SceneFile,
+};
 use super::framing::{default_camera, thesis_lights, DEFAULT_FOV_Y, DEFAULT_SIZE};
 use super::{
     Falloff, IncludeSpec, Light, Particle, ParticleRecord, RenderSettings, Scene, SceneLoadOptions,
-    MAX_IMAGE_SIDE,
 };
 use crate::error::{Location, PgtError, Result};
 use crate::geometry::Camera;
@@ -81,12 +82,28 @@ impl At<'_> {
 }
 
 /// Turns a TOML syntax or type error into one naming the file and line.
+/// The offending line's text is quoted, since serde's message alone ("invalid length 2") does
+/// not name the field.
 fn toml_error(path: &Path, text: &str, e: toml::de::Error) -> PgtError {
     let line = e.span().map(|s| line_of(text, s.start)).unwrap_or(1);
-    PgtError::at_line(path, line, e.message().trim().to_string())
+    let mut message = e.message().trim().to_string();
+    if let Some(source_line) = text
+        .lines()
+        .nth(line - 1)
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+    {
+        let quoted: String = source_line.chars().take(100).collect();
+        message = format!("{message} (in `{quoted}`)");
+    }
+    PgtError::at_line(path, line, message)
 }
 
-pub(super) fn scene_from_toml(text: &str, path: &Path, options: &SceneLoadOptions) -> Result<Scene> {
+pub(super) fn scene_from_toml(
+    text: &str,
+    path: &Path,
+    options: &SceneLoadOptions,
+) -> Result<Scene> {
     let file: SceneFile = toml::from_str(text).map_err(|e| toml_error(path, text, e))?;
     let at = |span: std::ops::Range<usize>| At {
         path,
@@ -119,19 +136,36 @@ pub(super) fn scene_from_toml(text: &str, path: &Path, options: &SceneLoadOption
 
     let mut particles = Vec::with_capacity(file.particles.len());
     for (i, p) in file.particles.iter().enumerate() {
-        particles.push(inline_particle(&at(p.span()), i, p.get_ref(), &resolved_defaults, render.lambda)?);
+        particles.push(inline_particle(
+            &at(p.span()),
+            i,
+            p.get_ref(),
+            &resolved_defaults,
+            render.lambda,
+        )?);
     }
     let mut warnings = Vec::new();
     let base = path.parent().unwrap_or(Path::new("."));
     for inc in &file.include {
         let spec_at = at(inc.span());
         let mut spec = inc.get_ref().clone();
-        spec_at.in_range("include.radius_scale", spec.radius_scale, f64::MIN_POSITIVE, f64::MAX, "> 0")?;
+        spec_at.in_range(
+            "include.radius_scale",
+            spec.radius_scale,
+            f64::MIN_POSITIVE,
+            f64::MAX,
+            "> 0",
+        )?;
         spec.path = base.join(&spec.path);
         let loaded = crate::formats::load_particles(&spec)?;
         warnings.extend(loaded.warnings);
         for rec in &loaded.records {
-            particles.push(record_particle(&spec.path, rec, &resolved_defaults, render.lambda)?);
+            particles.push(record_particle(
+                &spec.path,
+                rec,
+                &resolved_defaults,
+                render.lambda,
+            )?);
         }
     }
 
@@ -144,7 +178,10 @@ pub(super) fn scene_from_toml(text: &str, path: &Path, options: &SceneLoadOption
 
     let camera = camera(&file.camera, &at, &whole, options, &particles)?;
     if particles.is_empty() {
-        warnings.push(format!("{}: the scene has no particles; it renders the background", path.display()));
+        warnings.push(format!(
+            "{}: the scene has no particles; it renders the background",
+            path.display()
+        ));
     }
     Ok(Scene {
         source: path.to_path_buf(),
@@ -172,7 +209,10 @@ pub(super) fn bare_particle_file(path: &Path, options: &SceneLoadOptions) -> Res
         .collect::<Result<Vec<_>>>()?;
     let mut warnings = loaded.warnings;
     if particles.is_empty() {
-        warnings.push(format!("{}: the file has no particles; it renders the background", path.display()));
+        warnings.push(format!(
+            "{}: the file has no particles; it renders the background",
+            path.display()
+        ));
     }
     let (w, h) = options.size.unwrap_or(DEFAULT_SIZE);
     check_size(&whole, w as i64, h as i64)?;
@@ -191,7 +231,9 @@ fn render_settings(at: &At, t: &RenderTable) -> Result<RenderSettings> {
     Ok(RenderSettings {
         mode: t.mode.unwrap_or(d.mode),
         model: t.model.unwrap_or(d.model),
-        background: t.background.map_or(Ok(d.background), |v| at.non_negative3("render.background", v))?,
+        background: t.background.map_or(Ok(d.background), |v| {
+            at.non_negative3("render.background", v)
+        })?,
         lambda: t.lambda.map_or(Ok(d.lambda), |v| {
             let v = at.finite("render.lambda", v)?;
             if v > 0.0 && v <= 1.0 {
@@ -220,7 +262,11 @@ fn check_tol(at: &At, v: f64) -> Result<f64> {
     }
 }
 
-fn apply_overrides(mut r: RenderSettings, o: &SceneLoadOptions, whole: &At) -> Result<RenderSettings> {
+fn apply_overrides(
+    mut r: RenderSettings,
+    o: &SceneLoadOptions,
+    whole: &At,
+) -> Result<RenderSettings> {
     if let Some(m) = o.mode {
         r.mode = m;
     }
@@ -229,7 +275,9 @@ fn apply_overrides(mut r: RenderSettings, o: &SceneLoadOptions, whole: &At) -> R
     }
     if let Some(t) = o.tol {
         if !(t.is_finite() && t > 0.0) {
-            return Err(PgtError::Usage(format!("--tol must be a finite number > 0, got {t}")));
+            return Err(PgtError::Usage(format!(
+                "--tol must be a finite number > 0, got {t}"
+            )));
         }
         r.tol = t;
     }
@@ -258,7 +306,9 @@ impl ResolvedDefaults {
             return Err(at.err("defaults: set opacity or kappa, not both"));
         }
         Ok(ResolvedDefaults {
-            color: d.color.map_or(Ok(DVec3::ONE), |c| at.non_negative3("defaults.color", c))?,
+            color: d
+                .color
+                .map_or(Ok(DVec3::ONE), |c| at.non_negative3("defaults.color", c))?,
             opacity: d
                 .opacity
                 .map(|o| at.in_range("defaults.opacity", o, 0.0, 1.0, "in [0, 1]"))
@@ -267,8 +317,13 @@ impl ResolvedDefaults {
                 .kappa
                 .map(|k| at.in_range("defaults.kappa", k, 0.0, f64::MAX, "≥ 0"))
                 .transpose()?,
-            albedo: d.albedo.map(|a| at.non_negative3("defaults.albedo", a)).transpose()?,
-            ks: d.ks.map_or(Ok(0.0), |v| at.in_range("defaults.ks", v, 0.0, f64::MAX, "≥ 0"))?,
+            albedo: d
+                .albedo
+                .map(|a| at.non_negative3("defaults.albedo", a))
+                .transpose()?,
+            ks: d.ks.map_or(Ok(0.0), |v| {
+                at.in_range("defaults.ks", v, 0.0, f64::MAX, "≥ 0")
+            })?,
             shininess: d.shininess.map_or(Ok(DEFAULT_SHININESS), |v| {
                 at.in_range("defaults.shininess", v, 0.0, f64::MAX, "≥ 0")
             })?,
@@ -289,7 +344,13 @@ impl ResolvedDefaults {
     }
 }
 
-fn inline_particle(at: &At, i: usize, p: &ParticleTable, d: &ResolvedDefaults, lambda: f64) -> Result<Particle> {
+fn inline_particle(
+    at: &At,
+    i: usize,
+    p: &ParticleTable,
+    d: &ResolvedDefaults,
+    lambda: f64,
+) -> Result<Particle> {
     let name = |f: &str| format!("particles[{i}].{f}");
     let center = at.vec3(&name("center"), p.center)?;
     let radius = at.finite(&name("radius"), p.radius)?;
@@ -307,36 +368,45 @@ fn inline_particle(at: &At, i: usize, p: &ParticleTable, d: &ResolvedDefaults, l
         .kappa
         .map(|k| at.in_range(&name("kappa"), k, 0.0, f64::MAX, "≥ 0"))
         .transpose()?;
-    let color = p.color.map_or(Ok(d.color), |c| at.non_negative3(&name("color"), c))?;
+    let color = p
+        .color
+        .map_or(Ok(d.color), |c| at.non_negative3(&name("color"), c))?;
     Ok(Particle {
         center,
         radius,
         color,
         sigma: d.sigma(opacity, kappa, radius, lambda),
-        albedo: p
-            .albedo
-            .map_or(Ok(d.albedo.unwrap_or(color)), |a| at.non_negative3(&name("albedo"), a))?,
-        ks: p.ks.map_or(Ok(d.ks), |v| at.in_range(&name("ks"), v, 0.0, f64::MAX, "≥ 0"))?,
-        shininess: p
-            .shininess
-            .map_or(Ok(d.shininess), |v| at.in_range(&name("shininess"), v, 0.0, f64::MAX, "≥ 0"))?,
+        albedo: p.albedo.map_or(Ok(d.albedo.unwrap_or(color)), |a| {
+            at.non_negative3(&name("albedo"), a)
+        })?,
+        ks: p.ks.map_or(Ok(d.ks), |v| {
+            at.in_range(&name("ks"), v, 0.0, f64::MAX, "≥ 0")
+        })?,
+        shininess: p.shininess.map_or(Ok(d.shininess), |v| {
+            at.in_range(&name("shininess"), v, 0.0, f64::MAX, "≥ 0")
+        })?,
     })
 }
 
 /// A particle from a file format, checked with the location the format recorded.
-fn record_particle(path: &Path, rec: &ParticleRecord, d: &ResolvedDefaults, lambda: f64) -> Result<Particle> {
+fn record_particle(
+    path: &Path,
+    rec: &ParticleRecord,
+    d: &ResolvedDefaults,
+    lambda: f64,
+) -> Result<Particle> {
     let at = At {
         path,
         location: rec.location.clone(),
     };
-    let center = DVec3::from(at.vec3("particle position", rec.center.to_array())?);
+    let center = at.vec3("particle position", rec.center.to_array())?;
     let radius = at.finite("particle radius", rec.radius)?;
     if radius <= 0.0 {
         return Err(at.err(format!("particle radius must be > 0, got {radius}")));
     }
-    let color = rec
-        .color
-        .map_or(Ok(d.color), |c| at.non_negative3("particle colour", c.to_array()))?;
+    let color = rec.color.map_or(Ok(d.color), |c| {
+        at.non_negative3("particle colour", c.to_array())
+    })?;
     let opacity = rec
         .opacity
         .map(|o| at.in_range("particle opacity", o, 0.0, 1.0, "in [0, 1]"))
@@ -353,27 +423,47 @@ fn record_particle(path: &Path, rec: &ParticleRecord, d: &ResolvedDefaults, lamb
 }
 
 fn light(at: &At, i: usize, l: &LightTable) -> Result<Light> {
-    match l {
-        LightTable::Directional(t) => Ok(Light::Directional {
-            direction: at.direction(&format!("lights[{i}].direction"), t.direction)?,
-            irradiance: at.non_negative3(&format!("lights[{i}].irradiance"), t.irradiance)?,
-        }),
-        LightTable::Point(t) => Ok(Light::Point {
-            position: at.vec3(&format!("lights[{i}].position"), t.position)?,
-            intensity: at.non_negative3(&format!("lights[{i}].intensity"), t.intensity)?,
-            falloff: t.falloff.unwrap_or(Falloff::InverseSquare),
-        }),
+    let field = |f: &str| format!("lights[{i}].{f}");
+    let required = |f: &str, v: Option<[f64; 3]>| {
+        v.ok_or_else(|| {
+            at.err(format!("{} is required for a {:?} light", field(f), l.kind).to_lowercase())
+        })
+    };
+    let forbidden = |f: &str, present: bool| {
+        if present {
+            Err(at
+                .err(format!("{} does not apply to a {:?} light", field(f), l.kind).to_lowercase()))
+        } else {
+            Ok(())
+        }
+    };
+    match l.kind {
+        LightKind::Directional => {
+            forbidden("position", l.position.is_some())?;
+            forbidden("intensity", l.intensity.is_some())?;
+            forbidden("falloff", l.falloff.is_some())?;
+            Ok(Light::Directional {
+                direction: at
+                    .direction(&field("direction"), required("direction", l.direction)?)?,
+                irradiance: at
+                    .non_negative3(&field("irradiance"), required("irradiance", l.irradiance)?)?,
+            })
+        }
+        LightKind::Point => {
+            forbidden("direction", l.direction.is_some())?;
+            forbidden("irradiance", l.irradiance.is_some())?;
+            Ok(Light::Point {
+                position: at.vec3(&field("position"), required("position", l.position)?)?,
+                intensity: at
+                    .non_negative3(&field("intensity"), required("intensity", l.intensity)?)?,
+                falloff: l.falloff.unwrap_or(Falloff::InverseSquare),
+            })
+        }
     }
 }
 
 fn check_size(at: &At, w: i64, h: i64) -> Result<(u32, u32)> {
-    let max = MAX_IMAGE_SIDE as i64;
-    if w < 1 || h < 1 || w > max || h > max {
-        return Err(at.err(format!(
-            "image size must be between 1 and {MAX_IMAGE_SIDE} pixels on each side, got {w}x{h}"
-        )));
-    }
-    Ok((w as u32, h as u32))
+    super::check_image_size(w, h).map_err(|e| at.err(e))
 }
 
 fn camera<'a>(
@@ -417,12 +507,18 @@ fn camera<'a>(
         (None, None) => DEFAULT_FOV_Y,
     };
     let (position, look_at) = match (t.position, t.look_at) {
-        (Some(p), Some(l)) => (at.vec3("camera.position", p)?, at.vec3("camera.look_at", l)?),
+        (Some(p), Some(l)) => (
+            at.vec3("camera.position", p)?,
+            at.vec3("camera.look_at", l)?,
+        ),
         (None, None) => {
             let framed = default_camera(particles, w, h);
             (framed.position, framed.position + framed.forward)
         }
-        _ => return Err(at.err("camera: set both position and look_at, or neither (to frame the particles)")),
+        _ => {
+            return Err(at
+                .err("camera: set both position and look_at, or neither (to frame the particles)"))
+        }
     };
     let up = at.direction("camera.up", t.up.unwrap_or([0.0, 1.0, 0.0]))?;
     let forward = look_at - position;
@@ -518,8 +614,12 @@ opacity = 0.8
         assert!(e.starts_with("s.toml:2:") && e.contains("modle"), "{e}");
         let e = err_text("[render]\nmodel = \"glow\"\n");
         assert!(e.starts_with("s.toml:2:") && e.contains("glow"), "{e}");
-        let e = err_text("[[lights]]\ntype=\"directional\"\ndirection=[0,0,0]\nirradiance=[1,1,1]\n");
-        assert!(e.contains("lights[0].direction must be a non-zero vector"), "{e}");
+        let e =
+            err_text("[[lights]]\ntype=\"directional\"\ndirection=[0,0,0]\nirradiance=[1,1,1]\n");
+        assert!(
+            e.contains("lights[0].direction must be a non-zero vector"),
+            "{e}"
+        );
         let e = err_text("[camera]\nwidth = 0\n");
         assert!(e.contains("image size"), "{e}");
         let e = err_text("[[particles]]\ncenter=[0,0,0]\nradius=1.0\nopacity=1.5\n");
@@ -543,7 +643,8 @@ opacity = 0.8
             model: None,
             tol: Some(1e-3),
         };
-        let s = Scene::from_toml_str("[camera]\nwidth=100\nheight=100\n", Path::new("s.toml"), &o).unwrap();
+        let s = Scene::from_toml_str("[camera]\nwidth=100\nheight=100\n", Path::new("s.toml"), &o)
+            .unwrap();
         assert_eq!((s.camera.width, s.camera.height), (7, 3));
         assert_eq!(s.render.mode, super::super::RenderMode::Opaque);
         assert_eq!(s.render.tol, 1e-3);
