@@ -1,4 +1,9 @@
-//! Optics: extinction from the particle description (DESIGN.md §1) and, with the volume
-//! renderer, the interval cutting, closed forms and source terms of DESIGN.md §2.
+//! Optics: extinction from the particle description (DESIGN.md §1), the cutting of rays into
+//! intervals, the emission model's closed form, the source terms Q of DESIGN.md §2 and the
+//! places where shadow rays graze spheres (breakpoints of the quadrature).
 
+pub mod emission;
 pub mod extinction;
+pub mod intervals;
+pub mod kinks;
+pub mod source;

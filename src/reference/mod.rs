@@ -2,6 +2,9 @@
 //! rayon, bit-identical for any thread count (each pixel is a pure function of the scene).
 
 pub mod opaque;
+pub mod quadrature;
+pub mod riemann;
+pub mod volume;
 
 use crate::error::{PgtError, Result};
 use crate::geometry::{Camera, Ray};
@@ -98,9 +101,13 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
             let renderer = opaque::OpaqueRenderer::new(scene);
             render_with(&scene.camera, &renderer, options)
         }
-        RenderMode::Volume => Err(PgtError::Usage(
-            "volume mode is not available in this build yet; use --mode opaque".into(),
-        )),
+        RenderMode::Volume => {
+            if let Integrator::Riemann { samples: 0 } = options.integrator {
+                return Err(PgtError::Usage("Riemann sums need at least 1 sample per interval".into()));
+            }
+            let renderer = volume::VolumeRenderer::new(scene, options.integrator);
+            render_with(&scene.camera, &renderer, options)
+        }
     }
 }
 

@@ -1,0 +1,325 @@
+//! Cutting a ray into intervals with a constant set of particles (DESIGN.md §3 "intervals").
+//!
+//! Every sphere entry and exit on the ray is a cut. Inside one interval the set of particles is
+//! fixed, so σ = Σσᵢ and the emission colour E = Σσᵢ·Cᵢ / Σσᵢ (DESIGN.md §2, emission model) and
+//! the σ-weighted albedo α = Σσᵢ·αᵢ / Σσᵢ (single-scatter) are constants.
+//!
+//! **Order independence.** Floating-point sums depend on their order, and the renderer promises
+//! that shuffling the particle list changes no pixel. The sums therefore run over the active set
+//! sorted by a *canonical rank*: the position of the particle in a total order of its content
+//! (σ, radius, centre, colour, albedo), which does not depend on where it sits in the input.
+//! Particles with equal content are interchangeable, so ties cannot change a sum either.
+//!
+//! **Θmax = 0 and Θmax = 1.** Particles with σ = 0 are invisible and skipped. Where a particle
+//! with σ = +∞ is active the interval has σ = +∞; its colour and albedo are the plain mean over
+//! the infinite particles present (the limit of equal, growing σ), never ∞/∞.
+
+// `!(a > b)` is deliberate throughout: unlike `a <= b` it is also true when a value is NaN, so
+// degenerate input takes the safe branch.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use crate::geometry::Hit;
+use crate::scene::Particle;
+use glam::DVec3;
+use std::cmp::Ordering;
+
+/// A piece [t0, t1] of a ray with a fixed set of particles: what the models of DESIGN.md §2 need.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Interval {
+    /// Ray parameter where the interval starts (m).
+    pub t0: f64,
+    /// Ray parameter where the interval ends (m), > t0.
+    pub t1: f64,
+    /// Extinction σ = Σσᵢ (1/m), > 0; +∞ where a Θmax = 1 particle is active.
+    pub sigma: f64,
+    /// Emission colour E = Σσᵢ·Cᵢ / Σσᵢ (linear RGB).
+    pub emission: DVec3,
+    /// Single-scatter albedo α = Σσᵢ·αᵢ / Σσᵢ.
+    pub albedo: DVec3,
+}
+
+impl Interval {
+    /// Length Δ = t1 − t0 (m).
+    #[inline]
+    pub fn length(&self) -> f64 {
+        self.t1 - self.t0
+    }
+}
+
+/// The canonical rank of every particle (index → rank): the position of the particle in a total
+/// order of its content, so that sums over a set of particles can run in an order that the input
+/// order does not influence.
+pub fn canonical_ranks(particles: &[Particle]) -> Vec<u32> {
+    let key = |p: &Particle| {
+        [
+            p.sigma, p.radius, p.center.x, p.center.y, p.center.z, p.color.x, p.color.y, p.color.z,
+            p.albedo.x, p.albedo.y, p.albedo.z,
+        ]
+    };
+    let mut order: Vec<u32> = (0..particles.len() as u32).collect();
+    order.sort_by(|&a, &b| {
+        let (ka, kb) = (key(&particles[a as usize]), key(&particles[b as usize]));
+        ka.iter()
+            .zip(&kb)
+            .map(|(x, y)| x.total_cmp(y))
+            .find(|o| *o != Ordering::Equal)
+            .unwrap_or(Ordering::Equal)
+    });
+    let mut rank = vec![0u32; particles.len()];
+    for (r, &i) in order.iter().enumerate() {
+        rank[i as usize] = r as u32;
+    }
+    rank
+}
+
+/// A chord end on the ray: where particle `index` (of canonical rank `rank`) enters or leaves.
+#[derive(Debug, Clone, Copy)]
+struct Event {
+    t: f64,
+    rank: u32,
+    index: u32,
+    enter: bool,
+}
+
+/// Reusable buffers of [`IntervalCutter::cut`], so that shadow rays do not allocate.
+#[derive(Debug, Default, Clone)]
+pub struct IntervalScratch {
+    events: Vec<Event>,
+    /// Active particles as (rank, index), kept sorted by rank.
+    active: Vec<(u32, u32)>,
+}
+
+/// The particles of a scene with their canonical ranks: cuts rays into intervals.
+#[derive(Debug, Clone)]
+pub struct IntervalCutter<'a> {
+    particles: &'a [Particle],
+    ranks: Vec<u32>,
+}
+
+impl<'a> IntervalCutter<'a> {
+    pub fn new(particles: &'a [Particle]) -> Self {
+        IntervalCutter {
+            particles,
+            ranks: canonical_ranks(particles),
+        }
+    }
+
+    /// The particles, in input order.
+    pub fn particles(&self) -> &'a [Particle] {
+        self.particles
+    }
+
+    /// Cuts the part (t_min, t_max) of a ray into intervals (DESIGN.md §3), given every sphere
+    /// the ray crosses (`hits`, in any order). Particles with σ = 0 and those for which `skip`
+    /// returns true are left out. `out` is cleared first and receives the intervals in ray
+    /// order; gaps without particles produce no interval.
+    pub fn cut(
+        &self,
+        hits: &[Hit],
+        t_min: f64,
+        t_max: f64,
+        skip: impl Fn(u32) -> bool,
+        scratch: &mut IntervalScratch,
+        out: &mut Vec<Interval>,
+    ) {
+        cut_into_intervals(
+            hits,
+            (t_min, t_max),
+            self.particles,
+            &self.ranks,
+            skip,
+            scratch,
+            out,
+        )
+    }
+}
+
+fn cut_into_intervals(
+    hits: &[Hit],
+    (t_min, t_max): (f64, f64),
+    particles: &[Particle],
+    ranks: &[u32],
+    skip: impl Fn(u32) -> bool,
+    scratch: &mut IntervalScratch,
+    out: &mut Vec<Interval>,
+) {
+    out.clear();
+    let events = &mut scratch.events;
+    events.clear();
+    for h in hits {
+        let p = &particles[h.index as usize];
+        if !(p.sigma > 0.0) || skip(h.index) {
+            continue;
+        }
+        let t0 = h.chord.t_enter.max(t_min);
+        let t1 = h.chord.t_exit.min(t_max);
+        if t1 > t0 {
+            let rank = ranks[h.index as usize];
+            events.push(Event {
+                t: t0,
+                rank,
+                index: h.index,
+                enter: true,
+            });
+            events.push(Event {
+                t: t1,
+                rank,
+                index: h.index,
+                enter: false,
+            });
+        }
+    }
+    // Only t matters for the order: all events at one t are applied before the next interval.
+    events.sort_unstable_by(|a, b| a.t.total_cmp(&b.t));
+    let active = &mut scratch.active;
+    active.clear();
+    let mut i = 0;
+    while i < events.len() {
+        let t = events[i].t;
+        while i < events.len() && events[i].t == t {
+            let e = events[i];
+            let key = (e.rank, e.index);
+            match active.binary_search(&key) {
+                Ok(pos) if !e.enter => {
+                    active.remove(pos);
+                }
+                Err(pos) if e.enter => active.insert(pos, key),
+                // An exit without entry (or a double entry) cannot happen for chords with
+                // t_enter < t_exit; ignoring it keeps the sweep total rather than panicking.
+                _ => {}
+            }
+            i += 1;
+        }
+        if active.is_empty() || i >= events.len() {
+            continue;
+        }
+        let t_next = events[i].t;
+        out.push(medium_of(active, particles, t, t_next));
+    }
+}
+
+/// σ, E and α of a fixed set of particles (sorted by canonical rank, so the sums are
+/// order-independent).
+fn medium_of(active: &[(u32, u32)], particles: &[Particle], t0: f64, t1: f64) -> Interval {
+    let mut sigma = 0.0;
+    let mut weighted_color = DVec3::ZERO;
+    let mut weighted_albedo = DVec3::ZERO;
+    let mut n_inf = 0u32;
+    let mut inf_color = DVec3::ZERO;
+    let mut inf_albedo = DVec3::ZERO;
+    for &(_, index) in active {
+        let p = &particles[index as usize];
+        if p.sigma.is_infinite() {
+            n_inf += 1;
+            inf_color += p.color;
+            inf_albedo += p.albedo;
+        } else {
+            sigma += p.sigma;
+            weighted_color += p.sigma * p.color;
+            weighted_albedo += p.sigma * p.albedo;
+        }
+    }
+    if n_inf > 0 {
+        let n = n_inf as f64;
+        Interval {
+            t0,
+            t1,
+            sigma: f64::INFINITY,
+            emission: inf_color / n,
+            albedo: inf_albedo / n,
+        }
+    } else if sigma.is_finite() {
+        Interval {
+            t0,
+            t1,
+            sigma,
+            emission: weighted_color / sigma,
+            albedo: weighted_albedo / sigma,
+        }
+    } else {
+        // Σσᵢ overflowed (σ near f64::MAX from a huge κ): weigh by σᵢ/σ_max instead, so the
+        // colour stays a convex combination rather than ∞/∞.
+        let scale = active
+            .iter()
+            .map(|&(_, i)| particles[i as usize].sigma)
+            .fold(0.0, f64::max);
+        let (mut w, mut c, mut a) = (0.0, DVec3::ZERO, DVec3::ZERO);
+        for &(_, index) in active {
+            let p = &particles[index as usize];
+            let s = p.sigma / scale;
+            w += s;
+            c += s * p.color;
+            a += s * p.albedo;
+        }
+        Interval {
+            t0,
+            t1,
+            sigma,
+            emission: c / w,
+            albedo: a / w,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::Chord;
+
+    fn particle(sigma: f64, color: DVec3) -> Particle {
+        Particle {
+            center: DVec3::ZERO,
+            radius: 1.0,
+            color,
+            sigma,
+            albedo: color,
+            ks: 0.0,
+            shininess: 0.0,
+        }
+    }
+
+    fn hit(index: u32, t_enter: f64, t_exit: f64) -> Hit {
+        Hit {
+            index,
+            chord: Chord { t_enter, t_exit },
+        }
+    }
+
+    #[test]
+    fn overlapping_chords_give_three_intervals_with_summed_sigma() {
+        let ps = vec![particle(1.0, DVec3::X), particle(3.0, DVec3::Y)];
+        let cutter = IntervalCutter::new(&ps);
+        let mut out = Vec::new();
+        let mut s = IntervalScratch::default();
+        let hits = [hit(0, 1.0, 3.0), hit(1, 2.0, 5.0)];
+        cutter.cut(&hits, 0.0, f64::INFINITY, |_| false, &mut s, &mut out);
+        assert_eq!(out.len(), 3);
+        assert_eq!((out[0].t0, out[0].t1, out[0].sigma), (1.0, 2.0, 1.0));
+        assert_eq!((out[1].t0, out[1].t1, out[1].sigma), (2.0, 3.0, 4.0));
+        assert_eq!(out[1].emission, DVec3::new(0.25, 0.75, 0.0));
+        assert_eq!((out[2].t0, out[2].t1, out[2].sigma), (3.0, 5.0, 3.0));
+    }
+
+    #[test]
+    fn clipping_skipping_and_infinite_sigma() {
+        let ps = vec![
+            particle(f64::INFINITY, DVec3::X),
+            particle(0.0, DVec3::Y),
+            particle(2.0, DVec3::Z),
+        ];
+        let cutter = IntervalCutter::new(&ps);
+        let mut out = Vec::new();
+        let mut s = IntervalScratch::default();
+        let hits = [hit(0, -1.0, 1.0), hit(1, 0.0, 4.0), hit(2, 0.5, 2.0)];
+        cutter.cut(&hits, 0.0, 1.5, |_| false, &mut s, &mut out);
+        assert_eq!(out.len(), 3);
+        assert_eq!((out[0].t0, out[0].t1), (0.0, 0.5));
+        assert!(out[0].sigma.is_infinite());
+        assert_eq!(out[0].emission, DVec3::X);
+        assert!(out[1].sigma.is_infinite());
+        assert_eq!((out[2].t0, out[2].t1, out[2].sigma), (1.0, 1.5, 2.0));
+        cutter.cut(&hits, 0.0, 1.5, |i| i == 0, &mut s, &mut out);
+        assert_eq!(out.len(), 1);
+        assert_eq!((out[0].t0, out[0].t1, out[0].sigma), (0.5, 1.5, 2.0));
+    }
+}

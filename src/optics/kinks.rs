@@ -1,0 +1,306 @@
+//! Where a shadow ray grazes a sphere: the kinks of the lit and single-scatter integrands
+//! (DESIGN.md §3, "kinks ... computed in closed form and used as breakpoints").
+//!
+//! Along a camera ray x(t) = o + t·d the source Q(x(t)) is smooth except where the shadow ray
+//! from x(t) towards a light becomes tangent to a sphere j: there the shadow chord through j
+//! grows like √(t − t*) and Q has a square-root kink. (Where x(t) crosses a sphere's surface the
+//! camera ray is cut into intervals anyway.) The tangencies have closed forms:
+//!
+//! * directional light, unit vector ω towards it: the shadow ray is tangent to sphere (c, r) iff
+//!   x(t) lies on the cylinder of radius r about the line c + s·ω, with the tangent point ahead
+//!   of x ((c − x)·ω > 0): a ray–cylinder intersection, a quadratic in t;
+//! * point light at p outside the sphere (D = |c − p| > r): iff x(t) lies on the cone with apex p,
+//!   axis towards c and half-angle asin(r/D), on the sphere's nappe, and at least as far from p
+//!   as the tangent point (√(D² − r²)), so that the tangent point lies on the shadow segment:
+//!   a ray–cone intersection, again a quadratic. A light inside a sphere has no tangencies.
+//!
+//! The candidate spheres are those that a shadow ray from some point of the camera segment can
+//! reach: the segment swept towards the light (a parallelogram for a directional light, a
+//! triangle for a point light). The BVH is traversed with a separating-axis test of that
+//! polygon against the node boxes. The roots are only breakpoints for the quadrature: an
+//! inexact root costs refinement, never correctness.
+
+// `!(a > b)` is deliberate throughout: unlike `a <= b` it is also true when a value is NaN, so
+// degenerate input takes the safe branch.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
+use crate::geometry::{Bvh, Ray};
+use crate::scene::{Light, Particle};
+use glam::DVec3;
+
+/// Appends to `out` the ray parameters t in (t_lo, t_hi) where the shadow ray from `ray.at(t)`
+/// towards `light` is tangent to a particle with σ > 0, then sorts `out` (which may hold the
+/// kinks of other lights already). `bvh` indexes `particles`.
+pub fn shadow_tangencies(
+    ray: &Ray,
+    (t_lo, t_hi): (f64, f64),
+    light: &Light,
+    bvh: &Bvh,
+    particles: &[Particle],
+    out: &mut Vec<f64>,
+) {
+    if bvh.is_empty() || !(t_hi > t_lo) || !t_lo.is_finite() || !t_hi.is_finite() {
+        return;
+    }
+    let (y0, y1) = (ray.at(t_lo), ray.at(t_hi));
+    let mut poly = [DVec3::ZERO; 4];
+    let n_vertices = match *light {
+        Light::Directional { direction, .. } => {
+            let root = &bvh.nodes[0];
+            let centre = 0.5 * (root.min + root.max);
+            // Far enough along the light's direction to leave the root box from any point of
+            // the segment.
+            let reach =
+                (root.max - root.min).length() + (y0 - centre).length() + (y1 - centre).length();
+            poly = [y0, y1, y1 - direction * reach, y0 - direction * reach];
+            4
+        }
+        Light::Point { position, .. } => {
+            poly[..3].copy_from_slice(&[y0, y1, position]);
+            3
+        }
+    };
+    let poly = &poly[..n_vertices];
+    let mut stack = vec![0u32];
+    while let Some(n) = stack.pop() {
+        let node = &bvh.nodes[n as usize];
+        if !polygon_overlaps_box(poly, node.min, node.max) {
+            continue;
+        }
+        if node.count == 0 {
+            stack.push(node.first);
+            stack.push(node.first + 1);
+            continue;
+        }
+        let first = node.first as usize;
+        for &i in &bvh.indices[first..first + node.count as usize] {
+            let p = &particles[i as usize];
+            if !(p.sigma > 0.0) {
+                continue;
+            }
+            let roots = match *light {
+                Light::Directional { direction, .. } => {
+                    cylinder_roots(ray, -direction, p.center, p.radius)
+                }
+                Light::Point { position, .. } => cone_roots(ray, position, p.center, p.radius),
+            };
+            out.extend(
+                roots
+                    .into_iter()
+                    .flatten()
+                    .filter(|&t| t > t_lo && t < t_hi),
+            );
+        }
+    }
+    out.sort_unstable_by(f64::total_cmp);
+    out.dedup();
+}
+
+/// Roots of the ray against the cylinder of radius r about c + s·ω (ω unit, towards the light),
+/// kept where the tangent point lies ahead of x(t) towards the light.
+fn cylinder_roots(ray: &Ray, omega: DVec3, c: DVec3, r: f64) -> [Option<f64>; 2] {
+    let q0 = ray.origin - c;
+    let d_perp = ray.direction - ray.direction.dot(omega) * omega;
+    let q_perp = q0 - q0.dot(omega) * omega;
+    let a = d_perp.length_squared();
+    if !(a > 1e-24) {
+        // The camera ray runs along the light: its distance to the axis never changes.
+        return [None, None];
+    }
+    // Same stable form as the sphere intersection: closest approach, then the half-chord.
+    let t_c = -q_perp.dot(d_perp) / a;
+    let dist = (q_perp + t_c * d_perp).length();
+    if dist >= r {
+        return [None, None];
+    }
+    let half = ((r - dist) * (r + dist) / a).sqrt();
+    let ahead = |t: f64| (c - ray.at(t)).dot(omega) > 0.0;
+    [t_c - half, t_c + half].map(|t| ahead(t).then_some(t))
+}
+
+/// Roots of the ray against the cone with apex p (the point light) tangent to sphere (c, r),
+/// kept on the sphere's nappe and beyond the tangent point as seen from the light.
+fn cone_roots(ray: &Ray, p: DVec3, c: DVec3, r: f64) -> [Option<f64>; 2] {
+    let axis = c - p;
+    let dd = axis.length();
+    if !(dd > r) {
+        return [None, None];
+    }
+    let w = axis / dd;
+    let k = (1.0 - r / dd) * (1.0 + r / dd); // cos² of the half-angle
+    let tangent_distance = dd * k.sqrt();
+    let v0 = ray.origin - p;
+    let dw = ray.direction.dot(w);
+    let v0w = v0.dot(w);
+    let qa = dw * dw - k;
+    let qb = 2.0 * (v0w * dw - k * v0.dot(ray.direction));
+    let qc = v0w * v0w - k * v0.length_squared();
+    let roots = solve_quadratic(qa, qb, qc);
+    let valid = |t: f64| {
+        let v = v0 + t * ray.direction;
+        v.dot(w) > 0.0 && v.length() >= tangent_distance
+    };
+    roots.map(|t| t.filter(|&t| valid(t)))
+}
+
+/// Real roots of a·t² + b·t + c = 0 without cancellation (the q = −(b + sign(b)·√disc)/2 form).
+fn solve_quadratic(a: f64, b: f64, c: f64) -> [Option<f64>; 2] {
+    if a == 0.0 {
+        return [(b != 0.0).then(|| -c / b), None];
+    }
+    let disc = b * b - 4.0 * a * c;
+    if !(disc >= 0.0) {
+        return [None, None];
+    }
+    let q = -0.5 * (b + b.signum() * disc.sqrt());
+    let t1 = q / a;
+    let t2 = if q != 0.0 { c / q } else { t1 };
+    [
+        Some(t1).filter(|t| t.is_finite()),
+        Some(t2).filter(|t| t.is_finite()),
+    ]
+}
+
+/// Separating-axis test of a planar convex polygon against an axis-aligned box (the box faces,
+/// the polygon's plane, and the cross products of its edges with the box axes). Conservative:
+/// a relative slack keeps round-off from separating what touches.
+fn polygon_overlaps_box(poly: &[DVec3], min: DVec3, max: DVec3) -> bool {
+    let centre = 0.5 * (min + max);
+    let half = 0.5 * (max - min);
+    if !(half.min_element() >= 0.0) {
+        return false;
+    }
+    let separated = |axis: DVec3| {
+        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+        for v in poly {
+            let s = (*v - centre).dot(axis);
+            lo = lo.min(s);
+            hi = hi.max(s);
+        }
+        let extent = half.dot(axis.abs());
+        let slack = 1e-9 * (extent + lo.abs().max(hi.abs()));
+        lo > extent + slack || hi < -extent - slack
+    };
+    for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
+        if separated(axis) {
+            return false;
+        }
+    }
+    let e0 = poly[1] - poly[0];
+    let e1 = poly[2] - poly[1];
+    if separated(e0.cross(e1)) {
+        return false;
+    }
+    for i in 0..poly.len() {
+        let edge = poly[(i + 1) % poly.len()] - poly[i];
+        for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
+            if separated(edge.cross(axis)) {
+                return false;
+            }
+        }
+    }
+    true
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::intersect_sphere;
+    use crate::scene::Falloff;
+
+    fn sphere(c: DVec3, r: f64) -> Particle {
+        Particle {
+            center: c,
+            radius: r,
+            color: DVec3::ONE,
+            sigma: 1.0,
+            albedo: DVec3::ONE,
+            ks: 0.0,
+            shininess: 0.0,
+        }
+    }
+
+    /// Checks each reported root against the definition: the shadow ray from x(t*) is tangent
+    /// to the sphere (its distance to the centre equals r, to 1e-9 relative).
+    fn is_tangent(ray: &Ray, t: f64, light: &Light, p: &Particle) -> bool {
+        let x = ray.at(t);
+        let inc = light.incident_at(x).unwrap();
+        let f = x - p.center;
+        let t_c = -f.dot(inc.toward);
+        let dist = (f + t_c * inc.toward).length();
+        t_c > 0.0
+            && t_c <= inc.distance * (1.0 + 1e-9)
+            && (dist - p.radius).abs() < 1e-9 * p.radius.max(1.0)
+    }
+
+    #[test]
+    fn tangencies_are_tangent_and_every_change_of_hit_is_found() {
+        let particles = vec![
+            sphere(DVec3::new(0.3, 2.0, 0.1), 0.7),
+            sphere(DVec3::new(-1.0, 3.0, 0.5), 0.4),
+            sphere(DVec3::new(0.5, -2.5, -0.2), 0.9),
+        ];
+        let bvh = Bvh::build(
+            particles.iter().map(|p| p.center).collect(),
+            particles.iter().map(|p| p.radius).collect(),
+        );
+        let lights = [
+            Light::Directional {
+                direction: DVec3::new(0.1, -1.0, 0.05).normalize(),
+                irradiance: DVec3::ONE,
+            },
+            Light::Point {
+                position: DVec3::new(0.2, 6.0, 0.3),
+                intensity: DVec3::ONE,
+                falloff: Falloff::InverseSquare,
+            },
+        ];
+        let ray = Ray::new(DVec3::new(-4.0, 0.2, 0.0), DVec3::new(1.0, 0.05, 0.02));
+        for light in &lights {
+            let mut kinks = Vec::new();
+            shadow_tangencies(&ray, (0.0, 8.0), light, &bvh, &particles, &mut kinks);
+            assert!(!kinks.is_empty());
+            for &t in &kinks {
+                let ok = particles.iter().any(|p| is_tangent(&ray, t, light, p));
+                assert!(ok, "t = {t} is tangent to no sphere");
+            }
+            // Brute force: the set of spheres the shadow ray hits changes only at a kink.
+            let hits_at = |t: f64| -> Vec<bool> {
+                let x = ray.at(t);
+                let inc = light.incident_at(x).unwrap();
+                let sray = Ray {
+                    origin: x,
+                    direction: inc.toward,
+                };
+                particles
+                    .iter()
+                    .map(|p| {
+                        intersect_sphere(&sray, p.center, p.radius).is_some_and(|c| c.t_exit > 0.0)
+                    })
+                    .collect()
+            };
+            let inside_at = |t: f64| -> Vec<bool> {
+                let x = ray.at(t);
+                particles
+                    .iter()
+                    .map(|p| (x - p.center).length() < p.radius)
+                    .collect()
+            };
+            let n = 4000;
+            let mut changes = 0;
+            for i in 0..n {
+                let (a, b) = (8.0 * i as f64 / n as f64, 8.0 * (i + 1) as f64 / n as f64);
+                // Crossing a sphere's surface also changes what the shadow ray hits; that is an
+                // interval boundary of the renderer, not a tangency.
+                if hits_at(a) != hits_at(b) && inside_at(a) == inside_at(b) {
+                    changes += 1;
+                    assert!(
+                        kinks.iter().any(|&k| k >= a - 1e-9 && k <= b + 1e-9),
+                        "no kink in [{a}, {b}]"
+                    );
+                }
+            }
+            assert!(changes > 0);
+        }
+    }
+}
