@@ -103,7 +103,9 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
         }
         RenderMode::Volume => {
             if let Integrator::Riemann { samples: 0 } = options.integrator {
-                return Err(PgtError::Usage("Riemann sums need at least 1 sample per interval".into()));
+                return Err(PgtError::Usage(
+                    "Riemann sums need at least 1 sample per interval".into(),
+                ));
             }
             let renderer = volume::VolumeRenderer::new(scene, options.integrator);
             render_with(&scene.camera, &renderer, options)
