@@ -64,17 +64,17 @@ struct Frame {
     light_weight: f32,
     ambient: f32,
     lit: u32,
-    _pad0: u32,
-    _pad1: u32,
+    pair_begin: u32,
+    pair_end: u32,
     camera_position: vec3<f32>,
     _pad2: u32,
 }
 
 struct Stats {
     hit_overflows: atomic<u32>,
-    shadow_rays: atomic<u32>,
-    _pad0: u32,
-    _pad1: u32,
+    loop_limited: atomic<u32>,
+    more_work: atomic<u32>,
+    max_loop_iterations: atomic<u32>,
 }
 
 @group(0) @binding(0) var<uniform> frame: Frame;
@@ -87,6 +87,30 @@ struct Stats {
 
 // Set when any hit list of this invocation overflowed; the entry point counts the pixel.
 var<private> pixel_overflowed: bool = false;
+
+// lavapipe (llvmpipe) ends all loops of an invocation after 65535 iterations *in total*
+// (LP_MAX_TGSI_LOOP_ITERATIONS, shared by every loop of a shader) and carries on with wrong
+// values. pgt's loops count their iterations here; the entry point reports pixels that reached
+// the limit, and the thesis method splits its work into passes to stay below it.
+const LOOP_LIMIT: u32 = 65535u;
+// Pixels that counted this many are reported: lavapipe counts every loop (users' too) for a group
+// of 8 SIMD lanes together, each loop as long as its slowest lane, so its count runs ahead of
+// ours (measured: its limit struck when ours read 43,000); half the limit leaves that margin.
+const LOOP_LIMIT_REPORT: u32 = 32768u;
+var<private> loop_iterations: u32 = 0u;
+// Set by a method when this pixel has work beyond the pass's [pair_begin, pair_end).
+var<private> pixel_more_work: bool = false;
+
+fn count_iteration() {
+    loop_iterations = loop_iterations + 1u;
+}
+
+// Working memory of one invocation lives at module scope (`private`), not in function-local
+// `var`s: lavapipe (Mesa 22.3) silently stops producing results when large function-local
+// arrays are declared in functions called many times per invocation (the thesis method calls
+// the shadow-ray code `samples × lights` times per particle; results went dark beyond ~180
+// calls). One traversal stack is enough: traversals never nest.
+var<private> traversal_stack: array<u32, STACK_SIZE>;
 
 struct Ray {
     origin: vec3<f32>,
@@ -173,6 +197,9 @@ fn ray_box(origin: vec3<f32>, inv_dir: vec3<f32>, bmin: vec3<f32>, bmax: vec3<f3
 
 // The particles a ray crosses, sorted by entry (ties by index, as the CPU BVH sorts them).
 // Parallel arrays keep the struct free of padding.
+// Hit lists are `private` (see traversal_stack): `camera_hits` for the camera ray,
+// `shadow_hits` for emission_along (shadow rays); user code may declare its own
+// `var<private> name: HitList;`.
 struct HitList {
     count: u32,
     overflowed: bool,
@@ -181,12 +208,15 @@ struct HitList {
     index: array<u32, MAX_HITS>,
 }
 
+var<private> camera_hits: HitList;
+var<private> shadow_hits: HitList;
+
 fn hit_before(t_a: f32, i_a: u32, t_b: f32, i_b: u32) -> bool {
     return t_a < t_b || (t_a == t_b && i_a < i_b);
 }
 
 // Inserts by insertion sort; a full list keeps its nearest MAX_HITS entries.
-fn hit_list_insert(list: ptr<function, HitList>, index: u32, chord: Chord) {
+fn hit_list_insert(list: ptr<private, HitList>, index: u32, chord: Chord) {
     var slot = (*list).count;
     if (slot >= MAX_HITS) {
         (*list).overflowed = true;
@@ -200,6 +230,7 @@ fn hit_list_insert(list: ptr<function, HitList>, index: u32, chord: Chord) {
         (*list).count = slot + 1u;
     }
     loop {
+        count_iteration();
         if (slot == 0u) {
             break;
         }
@@ -219,24 +250,25 @@ fn hit_list_insert(list: ptr<function, HitList>, index: u32, chord: Chord) {
 
 // Every particle whose chord overlaps (t_min, t_max), sorted by entry, into `list` (BVH
 // traversal with an explicit stack). Chords are not clipped: callers clip to their interval.
-fn collect_hits(ray: Ray, t_min: f32, t_max: f32, list: ptr<function, HitList>) {
+fn collect_hits(ray: Ray, t_min: f32, t_max: f32, list: ptr<private, HitList>) {
     (*list).count = 0u;
     (*list).overflowed = false;
     if (frame.particle_count == 0u) {
         return;
     }
     let inv = safe_inverse(ray.direction);
-    var stack: array<u32, STACK_SIZE>;
-    stack[0] = 0u;
+    traversal_stack[0] = 0u;
     var sp = 1u;
     while (sp > 0u) {
+        count_iteration();
         sp = sp - 1u;
-        let node = nodes[stack[sp]];
+        let node = nodes[traversal_stack[sp]];
         if (!ray_box(ray.origin, inv, node.min, node.max, t_min, t_max)) {
             continue;
         }
         if (node.count > 0u) {
             for (var k = 0u; k < node.count; k = k + 1u) {
+                count_iteration();
                 let i = leaf_indices[node.first + k];
                 let p = particles[i];
                 let c = intersect_sphere(ray, p.center, p.radius);
@@ -245,8 +277,8 @@ fn collect_hits(ray: Ray, t_min: f32, t_max: f32, list: ptr<function, HitList>) 
                 }
             }
         } else if (sp + 2u <= STACK_SIZE) {
-            stack[sp] = node.first;
-            stack[sp + 1u] = node.first + 1u;
+            traversal_stack[sp] = node.first;
+            traversal_stack[sp + 1u] = node.first + 1u;
             sp = sp + 2u;
         }
     }
@@ -267,17 +299,18 @@ fn first_hit(ray: Ray, t_min: f32, t_max: f32) -> SurfaceHit {
         return best;
     }
     let inv = safe_inverse(ray.direction);
-    var stack: array<u32, STACK_SIZE>;
-    stack[0] = 0u;
+    traversal_stack[0] = 0u;
     var sp = 1u;
     while (sp > 0u) {
+        count_iteration();
         sp = sp - 1u;
-        let node = nodes[stack[sp]];
+        let node = nodes[traversal_stack[sp]];
         if (!ray_box(ray.origin, inv, node.min, node.max, t_min, best.t)) {
             continue;
         }
         if (node.count > 0u) {
             for (var k = 0u; k < node.count; k = k + 1u) {
+                count_iteration();
                 let i = leaf_indices[node.first + k];
                 let p = particles[i];
                 let c = intersect_sphere(ray, p.center, p.radius);
@@ -291,8 +324,8 @@ fn first_hit(ray: Ray, t_min: f32, t_max: f32) -> SurfaceHit {
                 }
             }
         } else if (sp + 2u <= STACK_SIZE) {
-            stack[sp] = node.first;
-            stack[sp + 1u] = node.first + 1u;
+            traversal_stack[sp] = node.first;
+            traversal_stack[sp + 1u] = node.first + 1u;
             sp = sp + 2u;
         }
     }
@@ -306,17 +339,18 @@ fn any_hit(ray: Ray, t_min: f32, t_max: f32, skip: u32) -> bool {
         return false;
     }
     let inv = safe_inverse(ray.direction);
-    var stack: array<u32, STACK_SIZE>;
-    stack[0] = 0u;
+    traversal_stack[0] = 0u;
     var sp = 1u;
     while (sp > 0u) {
+        count_iteration();
         sp = sp - 1u;
-        let node = nodes[stack[sp]];
+        let node = nodes[traversal_stack[sp]];
         if (!ray_box(ray.origin, inv, node.min, node.max, t_min, t_max)) {
             continue;
         }
         if (node.count > 0u) {
             for (var k = 0u; k < node.count; k = k + 1u) {
+                count_iteration();
                 let i = leaf_indices[node.first + k];
                 if (i == skip) {
                     continue;
@@ -328,8 +362,8 @@ fn any_hit(ray: Ray, t_min: f32, t_max: f32, skip: u32) -> bool {
                 }
             }
         } else if (sp + 2u <= STACK_SIZE) {
-            stack[sp] = node.first;
-            stack[sp + 1u] = node.first + 1u;
+            traversal_stack[sp] = node.first;
+            traversal_stack[sp + 1u] = node.first + 1u;
             sp = sp + 2u;
         }
     }
@@ -344,17 +378,17 @@ fn emission_along(ray: Ray, t_min: f32, t_max: f32, background: vec3<f32>) -> ve
 
 // emission_along with particle `skip` left out (a ray leaving that particle's surface).
 fn emission_along_skipping(ray: Ray, t_min: f32, t_max: f32, background: vec3<f32>, skip: u32) -> vec3<f32> {
-    var list: HitList;
-    collect_hits(ray, t_min, t_max, &list);
+    collect_hits(ray, t_min, t_max, &shadow_hits);
     var radiance = background;
-    var k = list.count;
+    var k = shadow_hits.count;
     while (k > 0u) {
+        count_iteration();
         k = k - 1u;
-        if (list.index[k] == skip) {
+        if (shadow_hits.index[k] == skip) {
             continue;
         }
-        let p = particles[list.index[k]];
-        let length = min(list.t_exit[k], t_max) - max(list.t_enter[k], t_min);
+        let p = particles[shadow_hits.index[k]];
+        let length = min(shadow_hits.t_exit[k], t_max) - max(shadow_hits.t_enter[k], t_min);
         radiance = composite_emission(p, length, radiance);
     }
     return radiance;
@@ -392,6 +426,7 @@ fn light_incident(light: Light, x: vec3<f32>) -> Incident {
 fn lit_source(x: vec3<f32>) -> vec3<f32> {
     var q = vec3<f32>(0.0);
     for (var l = 0u; l < frame.light_count; l = l + 1u) {
+        count_iteration();
         let inc = light_incident(lights[l], x);
         if (!inc.valid) {
             continue;
@@ -414,6 +449,7 @@ fn lit_opaque_surface(ray: Ray, index: u32, t0: f32, entering: bool) -> vec3<f32
     let mu_v = max(dot(-ray.direction, n), 0.0);
     var q = vec3<f32>(0.0);
     for (var l = 0u; l < frame.light_count; l = l + 1u) {
+        count_iteration();
         let inc = light_incident(lights[l], x);
         if (!inc.valid) {
             continue;

@@ -110,6 +110,8 @@ fn rust_and_wgsl_struct_layouts_agree() {
             ("light_weight", offset_of!(GpuFrame, light_weight)),
             ("ambient", offset_of!(GpuFrame, ambient)),
             ("lit", offset_of!(GpuFrame, lit)),
+            ("pair_begin", offset_of!(GpuFrame, pair_begin)),
+            ("pair_end", offset_of!(GpuFrame, pair_end)),
             ("camera_position", offset_of!(GpuFrame, camera_position)),
         ],
     );
@@ -119,7 +121,12 @@ fn rust_and_wgsl_struct_layouts_agree() {
         size_of::<GpuStats>(),
         &[
             ("hit_overflows", offset_of!(GpuStats, hit_overflows)),
-            ("shadow_rays", offset_of!(GpuStats, shadow_rays)),
+            ("loop_limited", offset_of!(GpuStats, loop_limited)),
+            ("more_work", offset_of!(GpuStats, more_work)),
+            (
+                "max_loop_iterations",
+                offset_of!(GpuStats, max_loop_iterations),
+            ),
         ],
     );
 }

@@ -4,14 +4,13 @@
 // composited back to front with the emission model's closed form using that colour:
 // L = L_behind·T + Q(centre)·(1 − T). Cheap, and wrong where light varies across a particle.
 fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {
-    var list: HitList;
-    collect_hits(ray, 0.0, T_FAR, &list);
+    collect_hits(ray, 0.0, T_FAR, &camera_hits);
     var radiance = frame.background;
-    var k = list.count;
+    var k = camera_hits.count;
     while (k > 0u) {
         k = k - 1u;
-        let p = particles[list.index[k]];
-        let length = list.t_exit[k] - max(list.t_enter[k], 0.0);
+        let p = particles[camera_hits.index[k]];
+        let length = camera_hits.t_exit[k] - max(camera_hits.t_enter[k], 0.0);
         let t = particle_transmittance(p.sigma, length);
         let q = lit_source(p.center);
         radiance = radiance * t + q * (1.0 - t);

@@ -4,13 +4,12 @@
 // only (one radius, in closed form), Q = w·Σ_l [E_l·T_r + C·(1 − T_r)], T_r = e^{−σr}.
 // Composited back to front with the emission model's closed form.
 fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {
-    var list: HitList;
-    collect_hits(ray, 0.0, T_FAR, &list);
+    collect_hits(ray, 0.0, T_FAR, &camera_hits);
     var radiance = frame.background;
-    var k = list.count;
+    var k = camera_hits.count;
     while (k > 0u) {
         k = k - 1u;
-        let p = particles[list.index[k]];
+        let p = particles[camera_hits.index[k]];
         var q = vec3<f32>(0.0);
         let t_own = particle_transmittance(p.sigma, p.radius);
         for (var l = 0u; l < frame.light_count; l = l + 1u) {
@@ -20,7 +19,7 @@ fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {
             }
         }
         q = frame.light_weight * q;
-        let length = list.t_exit[k] - max(list.t_enter[k], 0.0);
+        let length = camera_hits.t_exit[k] - max(camera_hits.t_enter[k], 0.0);
         let t = particle_transmittance(p.sigma, length);
         radiance = radiance * t + q * (1.0 - t);
     }

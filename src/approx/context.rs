@@ -18,6 +18,8 @@ pub struct AdapterDescription {
     pub name: String,
     pub backend: String,
     pub device_type: String,
+    /// A CPU implementation (lavapipe): its loop limit shapes how pgt splits work.
+    pub is_cpu: bool,
 }
 
 impl std::fmt::Display for AdapterDescription {
@@ -51,6 +53,7 @@ fn describe(info: &wgpu::AdapterInfo) -> AdapterDescription {
         name: info.name.clone(),
         backend: format!("{:?}", info.backend),
         device_type: format!("{:?}", info.device_type),
+        is_cpu: info.device_type == wgpu::DeviceType::Cpu,
     }
 }
 

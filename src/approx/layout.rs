@@ -100,7 +100,13 @@ pub struct GpuFrame {
     /// 1 when the scene's model is `lit` (the `thesis` method lights the first `n_exact`
     /// particles only then), 0 otherwise.
     pub lit: u32,
-    pub _pad: [u32; 2],
+    /// `thesis`: this pass computes the (particle, sample) pairs with index in
+    /// [pair_begin, pair_end), pair = k·samples + j for the k-th particle from the eye and its
+    /// j-th sample. Work is split into passes because lavapipe ends every loop of an invocation
+    /// after 65535 iterations in total (see `dispatch`). Pass 0 also adds everything that is not
+    /// a lit sample; later passes add to the image.
+    pub pair_begin: u32,
+    pub pair_end: u32,
     /// World position of the camera (f32; for user shaders that need world coordinates:
     /// world = camera-relative + camera_position).
     pub camera_position: [f32; 3],
@@ -113,9 +119,14 @@ pub struct GpuFrame {
 pub struct GpuStats {
     /// Hit lists that were full: the farthest hits were dropped (see `MAX_HITS`).
     pub hit_overflows: u32,
-    /// Shadow rays traced.
-    pub shadow_rays: u32,
-    pub _pad: [u32; 2],
+    /// Pixels whose shader ran at least `LOOP_LIMIT_REPORT` (32768) loop iterations (counted in
+    /// the prelude's and pgt's loops): on lavapipe, which ends all loops of a group of 8 pixels
+    /// after 65535 iterations, such a pixel may have been cut short.
+    pub loop_limited: u32,
+    /// Pixels that have (particle, sample) pairs beyond this pass's range: another pass follows.
+    pub more_work: u32,
+    /// The most loop iterations any pixel counted in this pass.
+    pub max_loop_iterations: u32,
 }
 
 /// The scene converted for upload.
@@ -268,7 +279,8 @@ impl GpuFrame {
             },
             ambient: scene.render.ambient as f32,
             lit: (scene.render.model == crate::scene::OpticalModel::Lit) as u32,
-            _pad: [0; 2],
+            pair_begin: 0,
+            pair_end: u32::MAX,
             camera_position: cam.position.as_vec3().to_array(),
             _pad2: 0,
         }

@@ -41,6 +41,11 @@ pub struct ApproxOutput {
     /// Pixels where a ray crossed more than `MAX_HITS` (128) particles: the farthest were
     /// dropped for that ray. Non-zero means the image is not what the method would give.
     pub hit_overflow_pixels: u32,
+    /// Pixels whose loops reached 65535 iterations: lavapipe cuts them short there, so on a Cpu
+    /// adapter these pixels are wrong (pgt splits the thesis method into passes to avoid it).
+    pub loop_limited_pixels: u32,
+    /// Dispatches the method took (the thesis method on lavapipe takes several).
+    pub passes: u32,
 }
 
 /// Opens a GPU context ([`GpuContext::new`] with `params.adapter`) and renders the scene.
@@ -101,6 +106,12 @@ fn run(
         adapter_name: ctx.adapter.name.clone(),
         method,
         hit_overflow_pixels: out.hit_overflows,
+        loop_limited_pixels: if ctx.adapter.is_cpu {
+            out.loop_limited
+        } else {
+            0
+        },
+        passes: out.passes,
     })
 }
 

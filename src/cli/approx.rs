@@ -98,6 +98,12 @@ pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
             approx::MAX_HITS
         );
     }
+    if out.loop_limited_pixels > 0 {
+        eprintln!(
+            "warning: {} pixels reached lavapipe's limit of 65535 loop iterations per pixel; lavapipe cuts such loops short, so these pixels are wrong (use fewer samples or a real GPU)",
+            out.loop_limited_pixels
+        );
+    }
     let n_exact = if args.n_exact == N_EXACT_ALL {
         "all".to_string()
     } else {
@@ -105,7 +111,7 @@ pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
     };
     let pixels = scene.camera.width as f64 * scene.camera.height as f64;
     eprintln!(
-        "approximated {} ({}x{}, {} spheres, {} lights) with {} (samples {}, n_exact {}) on {}: {:.3} s GPU ({}), {:.3} Mpixels/s",
+        "approximated {} ({}x{}, {} spheres, {} lights) with {} (samples {}, n_exact {}) on {}: {:.3} s GPU ({}, {} passes), {:.3} Mpixels/s",
         args.output.display(),
         scene.camera.width,
         scene.camera.height,
@@ -120,6 +126,7 @@ pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
             Timing::Timestamps => "timestamp queries",
             Timing::Wall => "wall time",
         },
+        out.passes,
         pixels / out.gpu_seconds.max(1e-9) / 1e6
     );
     Ok(Outcome::Success)
