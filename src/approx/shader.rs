@@ -135,7 +135,8 @@ impl ShaderProgram {
         );
         validator.validate(&module).map_err(|e| {
             let mut msg = String::new();
-            let first = e.spans().next().and_then(|(span, _)| span.to_range());
+            // The last span is the most specific (the expression, after the function that holds it).
+            let first = e.spans().last().and_then(|(span, _)| span.to_range());
             if let Some(range) = first {
                 let p = self.position(range.start);
                 msg += &format!("{}:{}:{}: ", p.file, p.line, p.column);
