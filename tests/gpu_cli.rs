@@ -236,3 +236,39 @@ fn the_thesis_method_runs_from_the_command_line_and_names_the_adapter() {
     assert!(err.contains("samples 8, n_exact 1"), "{err}");
     assert!(out.exists());
 }
+
+#[test]
+fn an_image_beyond_the_storage_buffer_limit_is_refused_with_exit_2() {
+    let Some(ctx) = gpu_common::gpu() else { return };
+    // 8192² pixels of 16 bytes: 1 GiB in one storage buffer (lavapipe allows 128 MiB).
+    let limits = ctx.device.limits();
+    if limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size)
+        >= 1 << 30
+    {
+        eprintln!("skipping: {} binds 1 GiB storage buffers", ctx.adapter);
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    let scene = scene_file(dir.path());
+    let out = dir.path().join("out.exr");
+    let o = pgt(
+        &[
+            "approx",
+            scene.to_str().unwrap(),
+            "--size",
+            "8192x8192",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &[],
+    );
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("the output image buffer needs 1024.0 MiB"),
+        "{err}"
+    );
+    assert!(!out.exists());
+}

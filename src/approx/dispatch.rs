@@ -55,7 +55,7 @@ fn check_limits(ctx: &GpuContext, buffers: &[(&str, u64)]) -> Result<()> {
         let allowed = binding.min(buffer);
         if size > allowed {
             return Err(PgtError::Gpu(format!(
-                "scene too large for {}: the {name} buffer needs {:.1} MiB, the adapter allows {:.1} MiB per storage buffer \
+                "too large for {}: the {name} buffer needs {:.1} MiB, the adapter allows {:.1} MiB per storage buffer \
                  (max_storage_buffer_binding_size); render a smaller part of the scene or a smaller image, or use an adapter with larger limits",
                 ctx.adapter.name,
                 size as f64 / 1048576.0,
