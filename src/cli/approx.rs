@@ -109,24 +109,33 @@ pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
     } else {
         args.n_exact.to_string()
     };
+    // Only the thesis method (and user shaders, which may read them) use the parameters.
+    let parameters = match out.method {
+        Method::Thesis | Method::User(_) => {
+            format!(" (samples {}, n_exact {n_exact})", args.samples)
+        }
+        Method::Emission | Method::Opaque => String::new(),
+    };
+    let passes = if out.passes == 1 {
+        "1 pass".to_string()
+    } else {
+        format!("{} passes", out.passes)
+    };
     let pixels = scene.camera.width as f64 * scene.camera.height as f64;
     eprintln!(
-        "approximated {} ({}x{}, {} spheres, {} lights) with {} (samples {}, n_exact {}) on {}: {:.3} s GPU ({}, {} passes), {:.3} Mpixels/s",
+        "approximated {} ({}x{}, {} spheres, {} lights) with {}{parameters} on {}: {:.3} s GPU ({}, {passes}), {:.3} Mpixels/s",
         args.output.display(),
         scene.camera.width,
         scene.camera.height,
         scene.particles.len(),
         scene.lights.len(),
         out.method.name(),
-        args.samples,
-        n_exact,
         out.adapter_name,
         out.gpu_seconds,
         match out.timing {
             Timing::Timestamps => "timestamp queries",
             Timing::Wall => "wall time",
         },
-        out.passes,
         pixels / out.gpu_seconds.max(1e-9) / 1e6
     );
     Ok(Outcome::Success)
