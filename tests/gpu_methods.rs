@@ -384,3 +384,28 @@ fn thesis_stays_right_on_a_crowded_random_scene() {
     assert_eq!(out.loop_limited_pixels, 0);
     assert!(e < 5e-4, "{e}");
 }
+
+#[test]
+fn the_example_user_methods_are_measurably_worse_than_the_thesis_method() {
+    let Some(ctx) = gpu() else { return };
+    // What pgt is for: measure a user's shortcut against the exact reference.
+    let s = scene(
+        disjoint_particles(),
+        lights(),
+        RenderMode::Volume,
+        OpticalModel::Lit,
+    );
+    let reference = reference::render(&s, &RenderOptions::default()).unwrap();
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    let thesis = render_approx_with(ctx, &s, &params(Method::Thesis, 64, N_EXACT_ALL)).unwrap();
+    let e_thesis = rmse(&thesis.image, &reference.image);
+    for example in ["centre_shadow", "no_shadows"] {
+        let shader = root.join(format!("shaders/examples/{example}.wgsl"));
+        let out =
+            render_approx_with(ctx, &s, &params(Method::User(shader), 64, N_EXACT_ALL)).unwrap();
+        let e = rmse(&out.image, &reference.image);
+        eprintln!("{example}: RMSE vs lit reference {e:.3e} (thesis, 64 samples: {e_thesis:.3e})");
+        assert!(out.image.all_finite());
+        assert!(e > 10.0 * e_thesis, "{example}: {e} vs thesis {e_thesis}");
+    }
+}
