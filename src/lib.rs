@@ -10,8 +10,10 @@ pub mod error;
 pub mod formats;
 pub mod geometry;
 pub mod image_io;
+pub mod metrics;
 pub mod optics;
 pub mod reference;
+pub mod report;
 pub mod scene;
 
 pub use error::{PgtError, Result};

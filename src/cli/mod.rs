@@ -2,7 +2,9 @@
 //! [`Outcome`]; `main` maps it and errors to exit codes 0 / 1 / 2.
 
 pub mod approx;
+pub mod compare;
 pub mod render;
+pub mod sweep;
 
 use clap::{Parser, Subcommand};
 
@@ -32,6 +34,10 @@ pub enum Command {
     Render(render::RenderArgs),
     /// Render a scene with a GPU approximation (a built-in method or a user's WGSL shader).
     Approx(approx::ApproxArgs),
+    /// Compare an approximation with the reference: metrics, maps, report, gates.
+    Compare(compare::CompareArgs),
+    /// Render the reference once and an approximation per parameter set; report with plots.
+    Sweep(sweep::SweepArgs),
 }
 
 /// Runs the parsed command line.
@@ -39,6 +45,8 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
     match cli.command {
         Command::Render(args) => render::run(args),
         Command::Approx(args) => approx::run(args),
+        Command::Compare(args) => compare::run(args),
+        Command::Sweep(args) => sweep::run(args),
     }
 }
 

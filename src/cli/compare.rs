@@ -1,0 +1,260 @@
+//! `pgt compare REF APPROX`: metrics, maps, report and gates (DESIGN.md §5, §7).
+//!
+//! Prints a one-line verdict on stdout; `--json F` writes the summary (`-` = stdout, then the
+//! verdict goes to stderr); `--report DIR` writes the HTML page and maps. Exit 0 when every gate
+//! passes (or none is set), 1 when one fails (named in the verdict), 2 on any error.
+
+use super::Outcome;
+use crate::image_io::{read_image_layer, ReadImage, RgbImage};
+use crate::metrics::gate::Gate;
+use crate::metrics::{compare, CompareOptions, DataRangeSource};
+use crate::report::{self, ReportInputs, ReportOptions, Summary};
+use anyhow::Context;
+use clap::Args;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+#[derive(Debug, Args)]
+pub struct CompareArgs {
+    /// The reference image (.exr or .png), or a scene (.toml) rendered on the fly.
+    pub reference: PathBuf,
+    /// The approximation (.exr or .png).
+    pub approximation: PathBuf,
+    /// EXR layer to compare (channels LAYER.R/G/B) in both files, e.g. `err`.
+    #[arg(long)]
+    pub layer: Option<String>,
+    /// Data range R of SSIM and PSNR (default: 1 for LDR inputs, derived from the reference for HDR).
+    #[arg(long)]
+    pub data_range: Option<f64>,
+    /// Write the JSON summary to this file (`-` for stdout).
+    #[arg(long)]
+    pub json: Option<PathBuf>,
+    /// Write the HTML report, heatmaps and maps (EXR) into this folder.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// Fixed top of the absolute-error heatmap scale (default: the map's maximum).
+    #[arg(long)]
+    pub error_scale: Option<f64>,
+    /// Fixed top of the relative-error heatmap scale (default: the map's maximum).
+    #[arg(long)]
+    pub rel_scale: Option<f64>,
+    /// Gate file (TOML; see `metrics::gate`). Command-line thresholds override it.
+    #[arg(long)]
+    pub gate: Option<PathBuf>,
+    /// Fail unless the mean SSIM is at least this.
+    #[arg(long)]
+    pub min_ssim: Option<f64>,
+    /// Fail unless the mean RMSE is at most this.
+    #[arg(long)]
+    pub max_rmse: Option<f64>,
+    /// Fail unless the mean LDR-FLIP is at most this.
+    #[arg(long)]
+    pub max_flip: Option<f64>,
+    /// Skip FLIP.
+    #[arg(long)]
+    pub no_flip: bool,
+    /// HDR-FLIP exposure range START,STOP in stops (default: chosen from the reference).
+    #[arg(long, value_parser = parse_exposures, allow_hyphen_values = true)]
+    pub flip_exposures: Option<(f32, f32)>,
+    /// FLIP's viewing condition in pixels per degree.
+    #[arg(long, default_value_t = crate::metrics::flip::DEFAULT_PIXELS_PER_DEGREE)]
+    pub ppd: f32,
+}
+
+pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
+    let start = Instant::now();
+    for (name, v) in [
+        ("--error-scale", args.error_scale),
+        ("--rel-scale", args.rel_scale),
+    ] {
+        if v.is_some_and(|v| !(v.is_finite() && v > 0.0)) {
+            anyhow::bail!("{name} must be a finite number > 0");
+        }
+    }
+    if !(args.ppd.is_finite() && args.ppd > 0.0) {
+        anyhow::bail!("--ppd must be a finite number > 0");
+    }
+    let mut gate = match &args.gate {
+        Some(path) => Gate::load(path)?,
+        None => Gate::default(),
+    };
+    gate.min_ssim = args.min_ssim.or(gate.min_ssim);
+    gate.max_rmse = args.max_rmse.or(gate.max_rmse);
+    gate.max_flip = args.max_flip.or(gate.max_flip);
+    gate.validate().map_err(anyhow::Error::msg)?;
+
+    let (reference, approximation) =
+        load_pair(&args.reference, &args.approximation, args.layer.as_deref())?;
+    let options = CompareOptions {
+        data_range: args.data_range,
+        flip: !args.no_flip,
+        pixels_per_degree: args.ppd,
+        flip_exposures: args.flip_exposures,
+    };
+    let cmp = compare(&reference, &approximation, &options).with_context(|| {
+        format!(
+            "comparing {} with {}",
+            args.reference.display(),
+            args.approximation.display()
+        )
+    })?;
+    if cmp.data_range_source == DataRangeSource::Derived {
+        eprintln!(
+            "note: HDR input (values above 1); data range for SSIM/PSNR derived from the reference: {} (pass --data-range to fix it)",
+            cmp.data_range
+        );
+    }
+    let checks = gate.evaluate(&cmp, &reference, &approximation)?;
+    let mut summary = Summary::new(
+        &args.reference.display().to_string(),
+        &args.approximation.display().to_string(),
+        &cmp,
+        checks,
+        start.elapsed().as_secs_f64(),
+    );
+    summary.reference_uncertainty = reference_estimate(&args.reference, args.layer.as_deref())
+        .filter(|e| (e.width, e.height) == (reference.width, reference.height))
+        .map(|e| crate::metrics::errors::reference_uncertainty(&reference, &approximation, &e));
+    if let Some(u) = &summary.reference_uncertainty {
+        eprintln!(
+            "reference error estimate: max {:.3e}, mean {:.3e}; the difference exceeds it at {:.3}% of pixel-channels",
+            u.max_estimate,
+            u.mean_estimate,
+            100.0 * u.exceeding_fraction
+        );
+    }
+    if let Some(dir) = &args.report {
+        let inputs = ReportInputs {
+            reference: &reference,
+            approximation: &approximation,
+            comparison: &cmp,
+            summary: &summary,
+            options: ReportOptions {
+                error_scale: args.error_scale,
+                rel_scale: args.rel_scale,
+            },
+        };
+        let page = report::write_report(dir, &inputs)?;
+        eprintln!("report: {}", page.display());
+    }
+    let verdict = summary.verdict();
+    match &args.json {
+        Some(path) if path.as_os_str() == "-" => {
+            println!("{}", serde_json::to_string_pretty(&summary)?);
+            eprintln!("{verdict}");
+        }
+        Some(path) => {
+            report::html::write_text(path, &(serde_json::to_string_pretty(&summary)? + "\n"))?;
+            println!("{verdict}");
+        }
+        None => println!("{verdict}"),
+    }
+    Ok(match summary.passed {
+        Some(false) => Outcome::GateFailed,
+        _ => Outcome::Success,
+    })
+}
+
+/// The reference's per-pixel error estimate: the `err` layer of a reference EXR (DESIGN.md §3,
+/// §7), when the whole image is compared (no `--layer`) and the file has one.
+fn reference_estimate(reference: &Path, layer: Option<&str>) -> Option<RgbImage> {
+    let is_exr = reference
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if !is_exr || layer.is_some_and(|l| !l.is_empty()) {
+        return None;
+    }
+    crate::image_io::read_exr_layer(reference, "err").ok()
+}
+
+/// Parses `START,STOP` (stops, finite, START <= STOP).
+fn parse_exposures(s: &str) -> Result<(f32, f32), String> {
+    let err = || format!("expected START,STOP in stops with START <= STOP, got '{s}'");
+    let (a, b) = s.split_once(',').ok_or_else(err)?;
+    let a: f32 = a.trim().parse().map_err(|_| err())?;
+    let b: f32 = b.trim().parse().map_err(|_| err())?;
+    if a.is_finite() && b.is_finite() && a <= b {
+        Ok((a, b))
+    } else {
+        Err(err())
+    }
+}
+
+/// An image file, or a scene file (`.toml`) rendered on the fly by the exact reference with its
+/// default options (DESIGN.md §5 "Inputs: … or scenes rendered on the fly").
+fn read_or_render(path: &Path, layer: Option<&str>) -> anyhow::Result<ReadImage> {
+    let is_scene = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+    if !is_scene {
+        return Ok(read_image_layer(path, layer)?);
+    }
+    if layer.is_some_and(|l| !l.is_empty()) {
+        anyhow::bail!(
+            "{}: --layer applies to EXR files, not to a scene",
+            path.display()
+        );
+    }
+    let scene = crate::scene::Scene::load(path, &crate::scene::SceneLoadOptions::default())?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    let options = crate::reference::RenderOptions {
+        progress: super::stderr_is_terminal(),
+        ..Default::default()
+    };
+    let out = crate::reference::render(&scene, &options)?;
+    eprintln!(
+        "rendered the reference of {} in {:.2} s",
+        path.display(),
+        out.stats.seconds
+    );
+    Ok(ReadImage {
+        image: out.image,
+        channels: 3,
+    })
+}
+
+/// Reads both images (or renders scenes) and checks they can be compared: same size and channel count (an error
+/// naming both files otherwise).
+pub fn load_pair(
+    reference: &Path,
+    approximation: &Path,
+    layer: Option<&str>,
+) -> anyhow::Result<(RgbImage, RgbImage)> {
+    let r = read_or_render(reference, layer)?;
+    let a = read_or_render(approximation, layer)?;
+    if (r.image.width, r.image.height) != (a.image.width, a.image.height) {
+        anyhow::bail!(
+            "images differ in size: {} is {}x{}, {} is {}x{}",
+            reference.display(),
+            r.image.width,
+            r.image.height,
+            approximation.display(),
+            a.image.width,
+            a.image.height
+        );
+    }
+    if r.channels != a.channels {
+        anyhow::bail!(
+            "images differ in channel count: {} has {}, {} has {}",
+            reference.display(),
+            r.channels,
+            approximation.display(),
+            a.channels
+        );
+    }
+    for (path, img) in [(reference, &r.image), (approximation, &a.image)] {
+        if let Some((x, y, c)) = crate::metrics::first_non_finite(img) {
+            anyhow::bail!(
+                "{}: non-finite value ({}) at pixel ({x}, {y}), channel {}; NaN and infinity cannot be compared",
+                path.display(),
+                img.get(x, y)[c],
+                crate::metrics::CHANNELS[c]
+            );
+        }
+    }
+    Ok((r.image, a.image))
+}

@@ -1,0 +1,15 @@
+//! Reports of a comparison (DESIGN.md §5): colour maps and heatmaps with colour bars, the
+//! self-contained HTML page, and SVG plots of swept parameters.
+
+pub mod colormap;
+mod colormap_data;
+pub mod heatmap;
+
+pub use colormap::{ColorMap, Scale};
+pub use heatmap::{heatmap, Srgb8Image};
+pub mod html;
+pub mod summary;
+
+pub use html::{write_report, ReportInputs, ReportOptions};
+pub use summary::Summary;
+pub mod plot;
