@@ -2,7 +2,8 @@
 //! radius 1.2–1.9 (Å, used as the length unit), uniform in a cube at about protein atom density (0.05 Å⁻³), the thesis's
 //! two directional lights, Θmax 0.5. Ignored by default (minutes on lavapipe):
 //!
-//!     PGT_BENCH_SIDE=64 PGT_BENCH_COUNTS=2758,73642 cargo test --test gpu_bench -- --ignored --nocapture
+//!     PGT_BENCH_SIDE=64 PGT_BENCH_COUNTS=2758,73642 PGT_BENCH_N_EXACT=1,5,all \
+//!         cargo test --test gpu_bench -- --ignored --nocapture
 //!
 //! Prints one line per (count, n_exact): GPU seconds and the timing source.
 
@@ -39,6 +40,13 @@ fn thesis_timings_on_random_particles() {
     let counts: Vec<usize> = env_or("PGT_BENCH_COUNTS", "2758,73642")
         .split(',')
         .map(|c| c.trim().parse().unwrap())
+        .collect();
+    let n_exacts: Vec<u32> = env_or("PGT_BENCH_N_EXACT", "1,5,all")
+        .split(',')
+        .map(|n| match n.trim() {
+            "all" => N_EXACT_ALL,
+            n => n.parse().unwrap(),
+        })
         .collect();
     for count in counts {
         let cube = (count as f64 / 0.05).cbrt();
@@ -78,7 +86,7 @@ fn thesis_timings_on_random_particles() {
             adapter: None,
         };
         render_approx_with(ctx, &s, &warm).unwrap();
-        for n_exact in [1, 5, N_EXACT_ALL] {
+        for n_exact in n_exacts.iter().copied() {
             let params = ApproxParams {
                 method: Some(Method::Thesis),
                 samples,
