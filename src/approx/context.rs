@@ -15,6 +15,7 @@ pub const NO_ADAPTER: &str =
 /// One adapter as the user can name it with `--adapter`.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct AdapterDescription {
+    /// The driver's name, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)".
     pub name: String,
     pub backend: String,
     pub device_type: String,
@@ -30,7 +31,9 @@ impl std::fmt::Display for AdapterDescription {
 
 /// An open device on a chosen adapter.
 pub struct GpuContext {
+    /// The adapter that runs everything (named in every summary).
     pub adapter: AdapterDescription,
+    /// The device, opened with every limit the adapter offers.
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     /// Whether compute passes can carry timestamp queries (`TIMESTAMP_QUERY`).

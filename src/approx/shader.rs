@@ -207,6 +207,14 @@ mod tests {
             ("emission", crate::approx::methods::EMISSION_WGSL),
             ("opaque", crate::approx::methods::OPAQUE_WGSL),
             ("thesis", crate::approx::methods::THESIS_WGSL),
+            (
+                "examples/centre_shadow",
+                include_str!("../../shaders/examples/centre_shadow.wgsl"),
+            ),
+            (
+                "examples/no_shadows",
+                include_str!("../../shaders/examples/no_shadows.wgsl"),
+            ),
         ] {
             let prog = ShaderProgram::with_method(part(name, text));
             if let Err(e) = prog.validate() {

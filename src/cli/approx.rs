@@ -8,6 +8,7 @@ use crate::scene::{OpticalModel, RenderMode, Scene, SceneLoadOptions};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 
+/// The built-in methods by name (`--method`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum MethodName {
     /// Per-particle compositing with the emission model's closed form.
@@ -18,6 +19,7 @@ pub enum MethodName {
     Thesis,
 }
 
+/// `pgt approx` (DESIGN.md §7).
 #[derive(Debug, Args)]
 pub struct ApproxArgs {
     /// Scene file (.toml) or a bare particle file.
@@ -61,6 +63,8 @@ fn parse_n_exact(s: &str) -> Result<u32, String> {
         .map_err(|_| format!("expected a non-negative integer or 'all', got '{s}'"))
 }
 
+/// Loads the scene, runs the approximation (DESIGN.md §4), writes the image and prints the
+/// one-line summary with the adapter and the GPU time (DESIGN.md §7).
 pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
     crate::image_io::ImageFormat::from_path(&args.output)?;
     if !args.exposure.is_finite() {
