@@ -105,11 +105,9 @@ fn count_iteration() {
     loop_iterations = loop_iterations + 1u;
 }
 
-// Working memory of one invocation lives at module scope (`private`), not in function-local
-// `var`s: lavapipe (Mesa 22.3) silently stops producing results when large function-local
-// arrays are declared in functions called many times per invocation (the thesis method calls
-// the shadow-ray code `samples × lights` times per particle; results went dark beyond ~180
-// calls). One traversal stack is enough: traversals never nest.
+// Working memory of one invocation lives at module scope (`private`): one copy per invocation
+// however often the functions run, and the prelude's functions and a method can share hit lists
+// by name. One traversal stack is enough: traversals never nest.
 var<private> traversal_stack: array<u32, STACK_SIZE>;
 
 struct Ray {
