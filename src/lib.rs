@@ -4,6 +4,7 @@
 //! metrics → report, with the command line on top. This file holds only module lines and
 //! re-exports.
 
+pub mod approx;
 pub mod cli;
 pub mod error;
 pub mod formats;

@@ -1,6 +1,7 @@
 //! The `pgt` command line (DESIGN.md §7): one file per subcommand. Every subcommand returns an
 //! [`Outcome`]; `main` maps it and errors to exit codes 0 / 1 / 2.
 
+pub mod approx;
 pub mod compare;
 pub mod gen;
 pub mod info;
@@ -33,6 +34,8 @@ pub struct Cli {
 pub enum Command {
     /// Render the exact reference image of a scene (a scene TOML or a bare particle file).
     Render(render::RenderArgs),
+    /// Render a scene with a GPU approximation (a built-in method or a user's WGSL shader).
+    Approx(approx::ApproxArgs),
     /// Compare an approximation with the reference: metrics, maps, report, gates.
     Compare(compare::CompareArgs),
     /// Render the reference once and an approximation per parameter set; report with plots.
@@ -47,6 +50,7 @@ pub enum Command {
 pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
     match cli.command {
         Command::Render(args) => render::run(args),
+        Command::Approx(args) => approx::run(args),
         Command::Compare(args) => compare::run(args),
         Command::Sweep(args) => sweep::run(args),
         Command::Info(args) => info::run(args),

@@ -1,0 +1,464 @@
+// pgt prelude (DESIGN.md §4): the scene buffers, the camera of DESIGN.md §1, ray–sphere
+// intersection, BVH traversal (all hits, first hit, any hit) and per-particle emission
+// compositing. Every method file, pgt's own and users' (docs/user-shaders.md), is appended to
+// this prelude and defines
+//     fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32>
+// Coordinates are camera-relative (world − camera position): the camera is at the origin.
+// The struct layouts are mirrored in src/approx/layout.rs; tests/gpu_layout.rs compares them.
+
+// Most particles one hit list holds. A ray that crosses more keeps the nearest MAX_HITS and the
+// pixel is counted in `stats.hit_overflows` (pgt reports it), never dropped silently.
+const MAX_HITS: u32 = 128u;
+// BVH traversal stack; pgt refuses a tree deeper than this (src/approx/mod.rs checks).
+const STACK_SIZE: u32 = 64u;
+// "No upper bound" for t. A finite stand-in for +∞ (WGSL may assume no infinities).
+const T_FAR: f32 = 3.0e38;
+// σ of a particle with Θmax = 1 (σ = +∞), see particle_transmittance.
+const SIGMA_INFINITE: f32 = -1.0;
+const PI: f32 = 3.14159265358979;
+const LIGHT_DIRECTIONAL: u32 = 0u;
+const LIGHT_POINT: u32 = 1u;
+const FALLOFF_INVERSE_SQUARE: u32 = 0u;
+
+struct Particle {
+    center: vec3<f32>,
+    radius: f32,
+    color: vec3<f32>,
+    sigma: f32,
+    albedo: vec3<f32>,
+    ks: f32,
+    shininess: f32,
+    _pad0: f32,
+    _pad1: f32,
+    _pad2: f32,
+}
+
+struct BvhNode {
+    min: vec3<f32>,
+    first: u32,
+    max: vec3<f32>,
+    count: u32,
+}
+
+struct Light {
+    // Directional: unit direction of travel. Point: camera-relative position.
+    vector: vec3<f32>,
+    kind: u32,
+    // Directional: irradiance E. Point: intensity I.
+    power: vec3<f32>,
+    falloff: u32,
+}
+
+struct Frame {
+    forward: vec3<f32>,
+    tan_half_fov: f32,
+    right: vec3<f32>,
+    width: u32,
+    up: vec3<f32>,
+    height: u32,
+    background: vec3<f32>,
+    light_count: u32,
+    particle_count: u32,
+    samples: u32,
+    n_exact: u32,
+    light_weight: f32,
+    ambient: f32,
+    lit: u32,
+    pair_begin: u32,
+    pair_end: u32,
+    camera_position: vec3<f32>,
+    _pad2: u32,
+}
+
+struct Stats {
+    hit_overflows: atomic<u32>,
+    loop_limited: atomic<u32>,
+    more_work: atomic<u32>,
+    max_loop_iterations: atomic<u32>,
+}
+
+@group(0) @binding(0) var<uniform> frame: Frame;
+@group(0) @binding(1) var<storage, read> particles: array<Particle>;
+@group(0) @binding(2) var<storage, read> nodes: array<BvhNode>;
+@group(0) @binding(3) var<storage, read> leaf_indices: array<u32>;
+@group(0) @binding(4) var<storage, read> lights: array<Light>;
+@group(0) @binding(5) var<storage, read_write> output: array<vec4<f32>>;
+@group(0) @binding(6) var<storage, read_write> stats: Stats;
+
+// Set when any hit list of this invocation overflowed; the entry point counts the pixel.
+var<private> pixel_overflowed: bool = false;
+
+// lavapipe (llvmpipe) ends all loops of an invocation after 65535 iterations *in total*
+// (LP_MAX_TGSI_LOOP_ITERATIONS, shared by every loop of a shader) and carries on with wrong
+// values. pgt's loops count their iterations here; the entry point reports pixels that reached
+// the limit, and the thesis method splits its work into passes to stay below it.
+const LOOP_LIMIT: u32 = 65535u;
+// Pixels that counted this many are reported: lavapipe counts every loop (users' too) for a group
+// of 8 SIMD lanes together, each loop as long as its slowest lane, so its count runs ahead of
+// ours (measured: its limit struck when ours read 43,000); half the limit leaves that margin.
+const LOOP_LIMIT_REPORT: u32 = 32768u;
+var<private> loop_iterations: u32 = 0u;
+// Set by a method when this pixel has work beyond the pass's [pair_begin, pair_end).
+var<private> pixel_more_work: bool = false;
+
+fn count_iteration() {
+    loop_iterations = loop_iterations + 1u;
+}
+
+// Working memory of one invocation lives at module scope (`private`): one copy per invocation
+// however often the functions run, and the prelude's functions and a method can share hit lists
+// by name. One traversal stack is enough: traversals never nest.
+var<private> traversal_stack: array<u32, STACK_SIZE>;
+
+struct Ray {
+    origin: vec3<f32>,
+    // Unit length, so t is a distance.
+    direction: vec3<f32>,
+}
+
+fn ray_at(ray: Ray, t: f32) -> vec3<f32> {
+    return ray.origin + t * ray.direction;
+}
+
+// DESIGN.md §1: pixel (px, py), py down, through its centre:
+// a = (2(px+0.5)/W − 1)·(W/H)·tan(fov_y/2), b = (1 − 2(py+0.5)/H)·tan(fov_y/2).
+fn camera_ray(pixel: vec2<u32>) -> Ray {
+    let w = f32(frame.width);
+    let h = f32(frame.height);
+    let a = (2.0 * (f32(pixel.x) + 0.5) / w - 1.0) * (w / h) * frame.tan_half_fov;
+    let b = (1.0 - 2.0 * (f32(pixel.y) + 0.5) / h) * frame.tan_half_fov;
+    return Ray(vec3<f32>(0.0), normalize(frame.forward + a * frame.right + b * frame.up));
+}
+
+// Where a ray's line crosses a sphere; `hit` is false when it misses or only touches it.
+struct Chord {
+    t_enter: f32,
+    t_exit: f32,
+    hit: bool,
+}
+
+// The stable intersection of src/geometry/sphere.rs: project the centre on the ray and take the
+// half-chord from h² = (r − |l|)(r + |l|), never the textbook b² − 4ac (which cancels when the
+// origin is far from the sphere). The chord goes to 0 continuously at the silhouette.
+fn intersect_sphere(ray: Ray, center: vec3<f32>, radius: f32) -> Chord {
+    let f = ray.origin - center;
+    let t_c = -dot(f, ray.direction);
+    let l = f + t_c * ray.direction;
+    let dist = length(l);
+    var chord = Chord(0.0, 0.0, false);
+    if (dist >= radius) {
+        return chord;
+    }
+    let half = sqrt((radius - dist) * (radius + dist));
+    if (half <= 0.0) {
+        return chord;
+    }
+    chord.t_enter = t_c - half;
+    chord.t_exit = t_c + half;
+    chord.hit = true;
+    return chord;
+}
+
+// Transmittance through a length of one particle's gas, exp(−σ·length); σ = +∞ (Θmax = 1)
+// gives 0 for any positive length.
+fn particle_transmittance(sigma: f32, length: f32) -> f32 {
+    if (sigma < 0.0) {
+        return select(1.0, 0.0, length > 0.0);
+    }
+    return exp(-sigma * max(length, 0.0));
+}
+
+// DESIGN.md §2, emission model for one particle alone: L = L_behind·T + C·(1 − T).
+fn composite_emission(p: Particle, length: f32, behind: vec3<f32>) -> vec3<f32> {
+    let t = particle_transmittance(p.sigma, length);
+    return behind * t + p.color * (1.0 - t);
+}
+
+// 1/d with d's zero components replaced by a tiny value of the same sign: the slab test then
+// needs no infinities (0·∞ would be NaN).
+fn safe_inverse(d: vec3<f32>) -> vec3<f32> {
+    let tiny = vec3<f32>(1e-30);
+    let s = select(vec3<f32>(1.0), vec3<f32>(-1.0), d < vec3<f32>(0.0));
+    let m = max(abs(d), tiny);
+    return s / m;
+}
+
+fn ray_box(origin: vec3<f32>, inv_dir: vec3<f32>, bmin: vec3<f32>, bmax: vec3<f32>, t_min: f32, t_max: f32) -> bool {
+    let t0 = (bmin - origin) * inv_dir;
+    let t1 = (bmax - origin) * inv_dir;
+    let lo = min(t0, t1);
+    let hi = max(t0, t1);
+    let t_near = max(max(lo.x, lo.y), max(lo.z, t_min));
+    let t_far = min(min(hi.x, hi.y), min(hi.z, t_max));
+    return t_near <= t_far;
+}
+
+// The particles a ray crosses, sorted by entry (ties by index, as the CPU BVH sorts them).
+// Parallel arrays keep the struct free of padding.
+// Hit lists are `private` (see traversal_stack): `camera_hits` for the camera ray,
+// `shadow_hits` for emission_along (shadow rays); user code may declare its own
+// `var<private> name: HitList;`.
+struct HitList {
+    count: u32,
+    overflowed: bool,
+    t_enter: array<f32, MAX_HITS>,
+    t_exit: array<f32, MAX_HITS>,
+    index: array<u32, MAX_HITS>,
+}
+
+var<private> camera_hits: HitList;
+var<private> shadow_hits: HitList;
+
+fn hit_before(t_a: f32, i_a: u32, t_b: f32, i_b: u32) -> bool {
+    return t_a < t_b || (t_a == t_b && i_a < i_b);
+}
+
+// Inserts by insertion sort; a full list keeps its nearest MAX_HITS entries.
+fn hit_list_insert(list: ptr<private, HitList>, index: u32, chord: Chord) {
+    var slot = (*list).count;
+    if (slot >= MAX_HITS) {
+        (*list).overflowed = true;
+        pixel_overflowed = true;
+        let last = MAX_HITS - 1u;
+        if (!hit_before(chord.t_enter, index, (*list).t_enter[last], (*list).index[last])) {
+            return;
+        }
+        slot = last;
+    } else {
+        (*list).count = slot + 1u;
+    }
+    loop {
+        count_iteration();
+        if (slot == 0u) {
+            break;
+        }
+        let prev = slot - 1u;
+        if (!hit_before(chord.t_enter, index, (*list).t_enter[prev], (*list).index[prev])) {
+            break;
+        }
+        (*list).t_enter[slot] = (*list).t_enter[prev];
+        (*list).t_exit[slot] = (*list).t_exit[prev];
+        (*list).index[slot] = (*list).index[prev];
+        slot = prev;
+    }
+    (*list).t_enter[slot] = chord.t_enter;
+    (*list).t_exit[slot] = chord.t_exit;
+    (*list).index[slot] = index;
+}
+
+// Every particle whose chord overlaps (t_min, t_max), sorted by entry, into `list` (BVH
+// traversal with an explicit stack). Chords are not clipped: callers clip to their interval.
+fn collect_hits(ray: Ray, t_min: f32, t_max: f32, list: ptr<private, HitList>) {
+    (*list).count = 0u;
+    (*list).overflowed = false;
+    if (frame.particle_count == 0u) {
+        return;
+    }
+    let inv = safe_inverse(ray.direction);
+    traversal_stack[0] = 0u;
+    var sp = 1u;
+    while (sp > 0u) {
+        count_iteration();
+        sp = sp - 1u;
+        let node = nodes[traversal_stack[sp]];
+        if (!ray_box(ray.origin, inv, node.min, node.max, t_min, t_max)) {
+            continue;
+        }
+        if (node.count > 0u) {
+            for (var k = 0u; k < node.count; k = k + 1u) {
+                count_iteration();
+                let i = leaf_indices[node.first + k];
+                let p = particles[i];
+                let c = intersect_sphere(ray, p.center, p.radius);
+                if (c.hit && c.t_exit > t_min && c.t_enter < t_max) {
+                    hit_list_insert(list, i, c);
+                }
+            }
+        } else if (sp + 2u <= STACK_SIZE) {
+            traversal_stack[sp] = node.first;
+            traversal_stack[sp + 1u] = node.first + 1u;
+            sp = sp + 2u;
+        }
+    }
+}
+
+// The nearest surface crossing with t in (t_min, t_max): which particle, where, and whether the
+// ray enters it there (false: it leaves it, the origin being inside). Ties: lower index.
+struct SurfaceHit {
+    index: u32,
+    t: f32,
+    entering: bool,
+    hit: bool,
+}
+
+fn first_hit(ray: Ray, t_min: f32, t_max: f32) -> SurfaceHit {
+    var best = SurfaceHit(0u, t_max, false, false);
+    if (frame.particle_count == 0u) {
+        return best;
+    }
+    let inv = safe_inverse(ray.direction);
+    traversal_stack[0] = 0u;
+    var sp = 1u;
+    while (sp > 0u) {
+        count_iteration();
+        sp = sp - 1u;
+        let node = nodes[traversal_stack[sp]];
+        if (!ray_box(ray.origin, inv, node.min, node.max, t_min, best.t)) {
+            continue;
+        }
+        if (node.count > 0u) {
+            for (var k = 0u; k < node.count; k = k + 1u) {
+                count_iteration();
+                let i = leaf_indices[node.first + k];
+                let p = particles[i];
+                let c = intersect_sphere(ray, p.center, p.radius);
+                if (!c.hit || c.t_exit <= t_min) {
+                    continue;
+                }
+                let entering = c.t_enter > t_min;
+                let t = select(c.t_exit, c.t_enter, entering);
+                if (t < best.t || (t == best.t && best.hit && i < best.index)) {
+                    best = SurfaceHit(i, t, entering, true);
+                }
+            }
+        } else if (sp + 2u <= STACK_SIZE) {
+            traversal_stack[sp] = node.first;
+            traversal_stack[sp + 1u] = node.first + 1u;
+            sp = sp + 2u;
+        }
+    }
+    return best;
+}
+
+// Whether any particle other than `skip` has a chord overlapping (t_min, t_max) (hard shadows).
+// Pass skip = 0xffffffffu to skip none.
+fn any_hit(ray: Ray, t_min: f32, t_max: f32, skip: u32) -> bool {
+    if (frame.particle_count == 0u) {
+        return false;
+    }
+    let inv = safe_inverse(ray.direction);
+    traversal_stack[0] = 0u;
+    var sp = 1u;
+    while (sp > 0u) {
+        count_iteration();
+        sp = sp - 1u;
+        let node = nodes[traversal_stack[sp]];
+        if (!ray_box(ray.origin, inv, node.min, node.max, t_min, t_max)) {
+            continue;
+        }
+        if (node.count > 0u) {
+            for (var k = 0u; k < node.count; k = k + 1u) {
+                count_iteration();
+                let i = leaf_indices[node.first + k];
+                if (i == skip) {
+                    continue;
+                }
+                let p = particles[i];
+                let c = intersect_sphere(ray, p.center, p.radius);
+                if (c.hit && c.t_exit > t_min && c.t_enter < t_max) {
+                    return true;
+                }
+            }
+        } else if (sp + 2u <= STACK_SIZE) {
+            traversal_stack[sp] = node.first;
+            traversal_stack[sp + 1u] = node.first + 1u;
+            sp = sp + 2u;
+        }
+    }
+    return false;
+}
+
+// The emission model along (t_min, t_max) of a ray with `background` behind t_max, one particle
+// at a time, back to front (DESIGN.md §4: overlaps ignored; exact where particles are disjoint).
+fn emission_along(ray: Ray, t_min: f32, t_max: f32, background: vec3<f32>) -> vec3<f32> {
+    return emission_along_skipping(ray, t_min, t_max, background, 0xffffffffu);
+}
+
+// emission_along with particle `skip` left out (a ray leaving that particle's surface).
+fn emission_along_skipping(ray: Ray, t_min: f32, t_max: f32, background: vec3<f32>, skip: u32) -> vec3<f32> {
+    collect_hits(ray, t_min, t_max, &shadow_hits);
+    var radiance = background;
+    var k = shadow_hits.count;
+    while (k > 0u) {
+        count_iteration();
+        k = k - 1u;
+        if (shadow_hits.index[k] == skip) {
+            continue;
+        }
+        let p = particles[shadow_hits.index[k]];
+        let length = min(shadow_hits.t_exit[k], t_max) - max(shadow_hits.t_enter[k], t_min);
+        radiance = composite_emission(p, length, radiance);
+    }
+    return radiance;
+}
+
+// What arrives at x from one light before any occlusion (DESIGN.md §1): the unit vector towards
+// the light, the distance to it (T_FAR for directional lights) and E, or I/d² (I with
+// falloff = "none"). `valid` is false at a point light's own position.
+struct Incident {
+    toward: vec3<f32>,
+    distance: f32,
+    irradiance: vec3<f32>,
+    valid: bool,
+}
+
+fn light_incident(light: Light, x: vec3<f32>) -> Incident {
+    if (light.kind == LIGHT_DIRECTIONAL) {
+        return Incident(-light.vector, T_FAR, light.power, true);
+    }
+    let v = light.vector - x;
+    let d = length(v);
+    if (!(d > 0.0)) {
+        return Incident(vec3<f32>(0.0, 0.0, 1.0), 0.0, vec3<f32>(0.0), false);
+    }
+    var e = light.power;
+    if (light.falloff == FALLOFF_INVERSE_SQUARE) {
+        e = light.power / (d * d);
+    }
+    return Incident(v / d, d, e, true);
+}
+
+// DESIGN.md §2 "lit": Q(x) = w·Σ_l L_l(x), L_l the emission model along the shadow ray from x
+// towards light l with the light's E (or I/d²) as background; it includes the particle that
+// contains x. One shadow ray per light.
+fn lit_source(x: vec3<f32>) -> vec3<f32> {
+    var q = vec3<f32>(0.0);
+    for (var l = 0u; l < frame.light_count; l = l + 1u) {
+        count_iteration();
+        let inc = light_incident(lights[l], x);
+        if (!inc.valid) {
+            continue;
+        }
+        q = q + emission_along(Ray(x, inc.toward), 0.0, inc.distance, inc.irradiance);
+    }
+    return frame.light_weight * q;
+}
+
+// What a particle with Θmax = 1 (σ = ∞) shows where the camera ray enters it at t0, under the
+// lit model: the limit σ → ∞ of ∫ σe^{−σs}·Q(x_s) ds. Light seen at depth z below the surface
+// has crossed z/μ_l of the particle's own gas, the view ray z/μ_v, so each light contributes
+// (L_rest·μ_l + C·μ_v)/(μ_l + μ_v), L_rest the emission model along the rest of the shadow ray
+// (other particles, the light behind), μ_v = cos(view, normal), μ_l = cos(light, normal);
+// a light behind the surface (μ_l ≤ 0), or an eye inside the particle, gives C.
+fn lit_opaque_surface(ray: Ray, index: u32, t0: f32, entering: bool) -> vec3<f32> {
+    let p = particles[index];
+    let x = ray_at(ray, t0);
+    let n = normalize(x - p.center);
+    let mu_v = max(dot(-ray.direction, n), 0.0);
+    var q = vec3<f32>(0.0);
+    for (var l = 0u; l < frame.light_count; l = l + 1u) {
+        count_iteration();
+        let inc = light_incident(lights[l], x);
+        if (!inc.valid) {
+            continue;
+        }
+        let mu_l = dot(n, inc.toward);
+        if (!entering || mu_l <= 0.0 || mu_l + mu_v <= 0.0) {
+            q = q + p.color;
+            continue;
+        }
+        let rest = emission_along_skipping(Ray(x, inc.toward), 0.0, inc.distance, inc.irradiance, index);
+        q = q + (rest * mu_l + p.color * mu_v) / (mu_l + mu_v);
+    }
+    return frame.light_weight * q;
+}

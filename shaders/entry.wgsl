@@ -1,0 +1,27 @@
+// pgt entry point, appended after the method file: one invocation per pixel, one ray through
+// the pixel centre (DESIGN.md §1), the method's `shade`, the result into `output` (pass 0
+// writes, later passes of a multi-pass method add), and the counters of `stats`.
+@compute @workgroup_size(8, 8, 1)
+fn pgt_main(@builtin(global_invocation_id) gid: vec3<u32>) {
+    if (gid.x >= frame.width || gid.y >= frame.height) {
+        return;
+    }
+    let pixel = gid.xy;
+    let radiance = shade(camera_ray(pixel), pixel);
+    let i = gid.y * frame.width + gid.x;
+    if (frame.pair_begin == 0u) {
+        output[i] = vec4<f32>(radiance, 1.0);
+    } else {
+        output[i] = output[i] + vec4<f32>(radiance, 0.0);
+    }
+    if (pixel_overflowed) {
+        atomicAdd(&stats.hit_overflows, 1u);
+    }
+    if (loop_iterations >= LOOP_LIMIT_REPORT) {
+        atomicAdd(&stats.loop_limited, 1u);
+    }
+    atomicMax(&stats.max_loop_iterations, loop_iterations);
+    if (pixel_more_work) {
+        atomicAdd(&stats.more_work, 1u);
+    }
+}

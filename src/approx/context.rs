@@ -1,0 +1,173 @@
+//! The GPU context (DESIGN.md §4): adapter selection, device and queue, and wgpu's errors turned
+//! into `PgtError::Gpu` instead of panics.
+//!
+//! wgpu's default handler for errors outside an error scope panics; pgt installs its own, which
+//! records the message, and wraps every fallible step in an error scope that is popped and
+//! reported. No adapter at all is a clear message and exit code 2 (DESIGN.md §4).
+
+use crate::error::{PgtError, Result};
+use std::sync::{Arc, Mutex};
+
+/// The message DESIGN.md §4 asks for when no adapter exists.
+pub const NO_ADAPTER: &str =
+    "no GPU adapter found: install mesa-vulkan-drivers (lavapipe) or a GPU driver";
+
+/// One adapter as the user can name it with `--adapter`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct AdapterDescription {
+    /// The driver's name, e.g. "llvmpipe (LLVM 15.0.6, 256 bits)".
+    pub name: String,
+    pub backend: String,
+    pub device_type: String,
+    /// A CPU implementation (lavapipe): its loop limit shapes how pgt splits work.
+    pub is_cpu: bool,
+}
+
+impl std::fmt::Display for AdapterDescription {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "{} ({}, {})", self.name, self.backend, self.device_type)
+    }
+}
+
+/// An open device on a chosen adapter.
+pub struct GpuContext {
+    /// The adapter that runs everything (named in every summary).
+    pub adapter: AdapterDescription,
+    /// The device, opened with every limit the adapter offers.
+    pub device: wgpu::Device,
+    pub queue: wgpu::Queue,
+    /// Whether compute passes can carry timestamp queries (`TIMESTAMP_QUERY`).
+    pub timestamps: bool,
+    /// Errors that reached the uncaptured-error handler, oldest first.
+    uncaptured: Arc<Mutex<Vec<String>>>,
+}
+
+impl std::fmt::Debug for GpuContext {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("GpuContext")
+            .field("adapter", &self.adapter)
+            .field("timestamps", &self.timestamps)
+            .finish_non_exhaustive()
+    }
+}
+
+fn describe(info: &wgpu::AdapterInfo) -> AdapterDescription {
+    AdapterDescription {
+        name: info.name.clone(),
+        backend: format!("{:?}", info.backend),
+        device_type: format!("{:?}", info.device_type),
+        is_cpu: info.device_type == wgpu::DeviceType::Cpu,
+    }
+}
+
+fn instance() -> wgpu::Instance {
+    // WGPU_BACKEND and friends still apply (with_env), so a user can pick a backend.
+    wgpu::Instance::new(wgpu::InstanceDescriptor::new_without_display_handle().with_env())
+}
+
+/// Every adapter wgpu can see.
+pub fn list_adapters() -> Vec<AdapterDescription> {
+    let instance = instance();
+    pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()))
+        .iter()
+        .map(|a| describe(&a.get_info()))
+        .collect()
+}
+
+impl GpuContext {
+    /// Opens a device. `adapter_filter`: a case-insensitive substring of the adapter's name
+    /// (`--adapter`); without one, the first hardware adapter, else the first of any kind
+    /// (lavapipe is a `Cpu` adapter).
+    pub fn new(adapter_filter: Option<&str>) -> Result<GpuContext> {
+        let instance = instance();
+        let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
+        if adapters.is_empty() {
+            return Err(PgtError::Gpu(NO_ADAPTER.into()));
+        }
+        let adapter = match adapter_filter {
+            Some(filter) => {
+                let needle = filter.to_lowercase();
+                adapters
+                    .iter()
+                    .find(|a| a.get_info().name.to_lowercase().contains(&needle))
+                    .ok_or_else(|| {
+                        let names: Vec<String> = adapters
+                            .iter()
+                            .map(|a| describe(&a.get_info()).to_string())
+                            .collect();
+                        PgtError::Gpu(format!(
+                            "no GPU adapter matches --adapter '{filter}'; available: {}",
+                            names.join("; ")
+                        ))
+                    })?
+            }
+            None => adapters
+                .iter()
+                .find(|a| {
+                    matches!(
+                        a.get_info().device_type,
+                        wgpu::DeviceType::DiscreteGpu | wgpu::DeviceType::IntegratedGpu
+                    )
+                })
+                .unwrap_or(&adapters[0]),
+        };
+        let info = adapter.get_info();
+        let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
+        let required_features = if timestamps {
+            wgpu::Features::TIMESTAMP_QUERY
+        } else {
+            wgpu::Features::empty()
+        };
+        // Ask for everything the adapter offers: the storage-buffer limits bound the scene size.
+        let desc = wgpu::DeviceDescriptor {
+            label: Some("pgt"),
+            required_features,
+            required_limits: adapter.limits(),
+            ..Default::default()
+        };
+        let (device, queue) = pollster::block_on(adapter.request_device(&desc))
+            .map_err(|e| PgtError::Gpu(format!("cannot open a device on {}: {e}", info.name)))?;
+        let uncaptured: Arc<Mutex<Vec<String>>> = Arc::default();
+        let sink = Arc::clone(&uncaptured);
+        device.on_uncaptured_error(Arc::new(move |e: wgpu::Error| {
+            if let Ok(mut v) = sink.lock() {
+                v.push(e.to_string());
+            }
+        }));
+        Ok(GpuContext {
+            adapter: describe(&info),
+            device,
+            queue,
+            timestamps,
+            uncaptured,
+        })
+    }
+
+    /// Runs `f` inside validation and out-of-memory error scopes; an error caught by either, or
+    /// one that reached the uncaptured handler meanwhile, becomes `PgtError::Gpu` naming `what`.
+    pub fn checked<T>(&self, what: &str, f: impl FnOnce() -> T) -> Result<T> {
+        let oom = self.device.push_error_scope(wgpu::ErrorFilter::OutOfMemory);
+        let validation = self.device.push_error_scope(wgpu::ErrorFilter::Validation);
+        let value = f();
+        let v = pollster::block_on(validation.pop());
+        let o = pollster::block_on(oom.pop());
+        if let Some(e) = v.or(o) {
+            return Err(PgtError::Gpu(format!("{what}: {e}")));
+        }
+        self.check_uncaptured(what)?;
+        Ok(value)
+    }
+
+    /// Reports an error that wgpu raised outside any scope.
+    pub fn check_uncaptured(&self, what: &str) -> Result<()> {
+        let mut v = self
+            .uncaptured
+            .lock()
+            .map_err(|_| PgtError::Gpu(format!("{what}: GPU error handler poisoned")))?;
+        if v.is_empty() {
+            return Ok(());
+        }
+        let all = v.drain(..).collect::<Vec<_>>().join("; ");
+        Err(PgtError::Gpu(format!("{what}: {all}")))
+    }
+}

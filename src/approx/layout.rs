@@ -1,0 +1,288 @@
+//! The scene as the GPU sees it (DESIGN.md §4): one Rust definition of every struct that the
+//! WGSL prelude `shaders/common.wgsl` declares, with explicit padding, so that `bytemuck` can
+//! upload them byte for byte. `tests/gpu_layout.rs` parses the WGSL with naga and compares every
+//! member offset and struct size with these definitions, so a mismatch fails a test instead of
+//! silently scrambling the scene.
+//!
+//! Coordinates are **camera-relative** (world position − camera position, computed in f64 and
+//! then rounded to f32): the camera sits at the origin, so f32 keeps its precision where the
+//! image is, however far the scene is from the world origin.
+
+use crate::geometry::Bvh;
+use crate::scene::{Falloff, Light, LightWeight, Scene};
+use bytemuck::{Pod, Zeroable};
+use glam::DVec3;
+
+/// σ = +∞ (Θmax = 1) has no reliable f32 encoding in WGSL (implementations may assume no
+/// infinities), so it travels as this sentinel; `particle_transmittance` in the prelude maps it
+/// back to a transmittance of 0.
+pub const SIGMA_INFINITE: f32 = -1.0;
+
+/// `struct Particle` of `common.wgsl`, 64 bytes.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuParticle {
+    /// Camera-relative centre (m).
+    pub center: [f32; 3],
+    /// Radius (m).
+    pub radius: f32,
+    /// Linear RGB colour C.
+    pub color: [f32; 3],
+    /// Extinction σ (1/m), or [`SIGMA_INFINITE`].
+    pub sigma: f32,
+    /// Single-scatter albedo.
+    pub albedo: [f32; 3],
+    /// Blinn–Phong specular weight.
+    pub ks: f32,
+    /// Blinn–Phong exponent.
+    pub shininess: f32,
+    pub _pad: [f32; 3],
+}
+
+/// `struct BvhNode` of `common.wgsl`, 32 bytes: the foundation's [`crate::geometry::BvhNode`]
+/// in f32 (camera-relative). `count > 0`: a leaf holding `leaf_indices[first..first+count]`;
+/// `count == 0`: an inner node with children `first` and `first + 1`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuBvhNode {
+    pub min: [f32; 3],
+    pub first: u32,
+    pub max: [f32; 3],
+    pub count: u32,
+}
+
+/// Light kinds in `GpuLight::kind`.
+pub const LIGHT_DIRECTIONAL: u32 = 0;
+pub const LIGHT_POINT: u32 = 1;
+/// Point-light falloffs in `GpuLight::falloff`.
+pub const FALLOFF_INVERSE_SQUARE: u32 = 0;
+pub const FALLOFF_NONE: u32 = 1;
+
+/// `struct Light` of `common.wgsl`, 32 bytes (DESIGN.md §1).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuLight {
+    /// Directional: the unit direction the light travels. Point: camera-relative position.
+    pub vector: [f32; 3],
+    /// [`LIGHT_DIRECTIONAL`] or [`LIGHT_POINT`].
+    pub kind: u32,
+    /// Directional: irradiance E (W/m²). Point: intensity I (W/sr).
+    pub power: [f32; 3],
+    /// [`FALLOFF_INVERSE_SQUARE`] or [`FALLOFF_NONE`] (point lights).
+    pub falloff: u32,
+}
+
+/// `struct Frame` of `common.wgsl` (the uniform buffer), 112 bytes: camera, background and the
+/// method's parameters.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
+pub struct GpuFrame {
+    /// Camera frame f, r, u of DESIGN.md §1 (the camera is at the origin).
+    pub forward: [f32; 3],
+    /// tan(fov_y / 2).
+    pub tan_half_fov: f32,
+    pub right: [f32; 3],
+    pub width: u32,
+    pub up: [f32; 3],
+    pub height: u32,
+    /// L_bg, linear RGB.
+    pub background: [f32; 3],
+    pub light_count: u32,
+    pub particle_count: u32,
+    /// `thesis`: midpoint-rule samples per particle chord.
+    pub samples: u32,
+    /// `thesis`: how many particles from the eye use the lit model.
+    pub n_exact: u32,
+    /// Lit model light weight w (1/m or 1).
+    pub light_weight: f32,
+    /// Opaque-mode ambient factor.
+    pub ambient: f32,
+    /// 1 when the scene's model is `lit` (the `thesis` method lights the first `n_exact`
+    /// particles only then), 0 otherwise.
+    pub lit: u32,
+    /// `thesis`: this pass computes the (particle, sample) pairs with index in
+    /// [pair_begin, pair_end), pair = k·samples + j for the k-th particle from the eye and its
+    /// j-th sample. Work is split into passes because lavapipe ends every loop of an invocation
+    /// after 65535 iterations in total (see `dispatch`). Pass 0 also adds everything that is not
+    /// a lit sample; later passes add to the image.
+    pub pair_begin: u32,
+    pub pair_end: u32,
+    /// World position of the camera (f32; for user shaders that need world coordinates:
+    /// world = camera-relative + camera_position).
+    pub camera_position: [f32; 3],
+    pub _pad2: u32,
+}
+
+/// `struct Stats` of `common.wgsl`: counters the shaders raise (atomics).
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Pod, Zeroable)]
+pub struct GpuStats {
+    /// Hit lists that were full: the farthest hits were dropped (see `MAX_HITS`).
+    pub hit_overflows: u32,
+    /// Pixels whose shader ran at least `LOOP_LIMIT_REPORT` (32768) loop iterations (counted in
+    /// the prelude's and pgt's loops): on lavapipe, which ends all loops of a group of 8 pixels
+    /// after 65535 iterations, such a pixel may have been cut short.
+    pub loop_limited: u32,
+    /// Pixels that have (particle, sample) pairs beyond this pass's range: another pass follows.
+    pub more_work: u32,
+    /// The most loop iterations any pixel counted in this pass.
+    pub max_loop_iterations: u32,
+}
+
+/// The scene converted for upload.
+#[derive(Debug, Clone)]
+pub struct SceneBuffers {
+    pub particles: Vec<GpuParticle>,
+    pub nodes: Vec<GpuBvhNode>,
+    pub leaf_indices: Vec<u32>,
+    pub lights: Vec<GpuLight>,
+    /// Depth of the BVH (root = 1), checked against the shader's traversal stack.
+    pub bvh_depth: u32,
+}
+
+fn rel(v: DVec3, origin: DVec3) -> [f32; 3] {
+    (v - origin).as_vec3().to_array()
+}
+
+/// σ in f32: +∞ or beyond f32's range becomes the sentinel.
+fn sigma_f32(sigma: f64) -> f32 {
+    let s = sigma as f32;
+    if s.is_finite() {
+        s
+    } else {
+        SIGMA_INFINITE
+    }
+}
+
+/// Rounds a camera-relative box outwards by a relative margin so that the f32 box still contains
+/// the f32 sphere: rounding the corners to nearest could cull a grazing ray.
+fn widen(min: DVec3, max: DVec3, origin: DVec3) -> ([f32; 3], [f32; 3]) {
+    let (lo, hi) = (min - origin, max - origin);
+    let pad = (hi - lo).max_element().max(0.0) * 1e-6 + lo.abs().max(hi.abs()).max_element() * 1e-6;
+    (
+        (lo - DVec3::splat(pad)).as_vec3().to_array(),
+        (hi + DVec3::splat(pad)).as_vec3().to_array(),
+    )
+}
+
+impl SceneBuffers {
+    /// Converts the scene and its BVH (built by the foundation's binned SAH) to the GPU layout.
+    pub fn new(scene: &Scene, bvh: &Bvh) -> SceneBuffers {
+        let origin = scene.camera.position;
+        let particles = scene
+            .particles
+            .iter()
+            .map(|p| GpuParticle {
+                center: rel(p.center, origin),
+                radius: p.radius as f32,
+                color: p.color.as_vec3().to_array(),
+                sigma: sigma_f32(p.sigma),
+                albedo: p.albedo.as_vec3().to_array(),
+                ks: p.ks as f32,
+                shininess: p.shininess as f32,
+                _pad: [0.0; 3],
+            })
+            .collect();
+        let nodes = bvh
+            .nodes
+            .iter()
+            .map(|n| {
+                let (min, max) = if n.min.x <= n.max.x {
+                    widen(n.min, n.max, origin)
+                } else {
+                    // The empty tree's root: an inverted box no ray enters.
+                    ([f32::MAX; 3], [f32::MIN; 3])
+                };
+                GpuBvhNode {
+                    min,
+                    first: n.first,
+                    max,
+                    count: n.count,
+                }
+            })
+            .collect();
+        let lights = scene
+            .lights
+            .iter()
+            .map(|l| match *l {
+                Light::Directional {
+                    direction,
+                    irradiance,
+                } => GpuLight {
+                    vector: direction.normalize().as_vec3().to_array(),
+                    kind: LIGHT_DIRECTIONAL,
+                    power: irradiance.as_vec3().to_array(),
+                    falloff: FALLOFF_NONE,
+                },
+                Light::Point {
+                    position,
+                    intensity,
+                    falloff,
+                } => GpuLight {
+                    vector: rel(position, origin),
+                    kind: LIGHT_POINT,
+                    power: intensity.as_vec3().to_array(),
+                    falloff: match falloff {
+                        Falloff::InverseSquare => FALLOFF_INVERSE_SQUARE,
+                        Falloff::None => FALLOFF_NONE,
+                    },
+                },
+            })
+            .collect();
+        SceneBuffers {
+            particles,
+            nodes,
+            leaf_indices: bvh.indices.clone(),
+            lights,
+            bvh_depth: bvh_depth(bvh),
+        }
+    }
+}
+
+/// Depth of the tree (a lone root is 1), by an explicit stack: no recursion on deep trees.
+pub fn bvh_depth(bvh: &Bvh) -> u32 {
+    let mut deepest = 0;
+    let mut stack = vec![(0usize, 1u32)];
+    while let Some((n, d)) = stack.pop() {
+        deepest = deepest.max(d);
+        let Some(node) = bvh.nodes.get(n) else {
+            continue;
+        };
+        if node.count == 0 && !bvh.is_empty() {
+            stack.push((node.first as usize, d + 1));
+            stack.push((node.first as usize + 1, d + 1));
+        }
+    }
+    deepest
+}
+
+impl GpuFrame {
+    /// The frame uniform of a scene: camera of DESIGN.md §1 and the render settings.
+    pub fn new(scene: &Scene, samples: u32, n_exact: u32) -> GpuFrame {
+        let cam = &scene.camera;
+        let m = scene.lights.len().max(1) as f32;
+        GpuFrame {
+            forward: cam.forward.as_vec3().to_array(),
+            tan_half_fov: cam.tan_half_fov as f32,
+            right: cam.right.as_vec3().to_array(),
+            width: cam.width,
+            up: cam.up.as_vec3().to_array(),
+            height: cam.height,
+            background: scene.render.background.as_vec3().to_array(),
+            light_count: scene.lights.len() as u32,
+            particle_count: scene.particles.len() as u32,
+            samples,
+            n_exact,
+            light_weight: match scene.render.light_weight {
+                LightWeight::Mean => 1.0 / m,
+                LightWeight::Sum => 1.0,
+            },
+            ambient: scene.render.ambient as f32,
+            lit: (scene.render.model == crate::scene::OpticalModel::Lit) as u32,
+            pair_begin: 0,
+            pair_end: u32::MAX,
+            camera_position: cam.position.as_vec3().to_array(),
+            _pad2: 0,
+        }
+    }
+}

@@ -1,0 +1,246 @@
+//! WGSL programs: the prelude `shaders/common.wgsl`, one method file and the entry point
+//! `shaders/entry.wgsl`, concatenated, then parsed and validated with naga before any pipeline
+//! exists (DESIGN.md §4). Errors name the file the offending line came from and its line in
+//! *that* file, so a user's mistake points at the user's line, not at the concatenation.
+
+use crate::error::{PgtError, Result};
+use std::borrow::Cow;
+
+/// The prelude every method is appended to.
+pub const COMMON_WGSL: &str = include_str!("../../shaders/common.wgsl");
+/// The compute entry point `pgt_main`, appended after the method.
+pub const ENTRY_WGSL: &str = include_str!("../../shaders/entry.wgsl");
+/// Name of the compute entry point.
+pub const ENTRY_POINT: &str = "pgt_main";
+
+/// One source file of a program.
+#[derive(Debug, Clone)]
+pub struct ShaderPart {
+    /// How messages name it (a path).
+    pub name: String,
+    pub text: Cow<'static, str>,
+}
+
+/// A complete WGSL program and where each part starts in it.
+#[derive(Debug, Clone)]
+pub struct ShaderProgram {
+    parts: Vec<ShaderPart>,
+    /// Byte offset of each part in `source`.
+    starts: Vec<usize>,
+    source: String,
+}
+
+/// A position in one part: file name, 1-based line and column.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct SourcePosition {
+    pub file: String,
+    pub line: usize,
+    pub column: usize,
+}
+
+impl ShaderProgram {
+    /// prelude + `method` + entry point.
+    pub fn with_method(method: ShaderPart) -> ShaderProgram {
+        ShaderProgram::from_parts(vec![
+            ShaderPart {
+                name: "shaders/common.wgsl".into(),
+                text: Cow::Borrowed(COMMON_WGSL),
+            },
+            method,
+            ShaderPart {
+                name: "shaders/entry.wgsl".into(),
+                text: Cow::Borrowed(ENTRY_WGSL),
+            },
+        ])
+    }
+
+    /// Concatenates parts, each ending with a newline so lines never merge across files.
+    pub fn from_parts(parts: Vec<ShaderPart>) -> ShaderProgram {
+        let mut source = String::new();
+        let mut starts = Vec::with_capacity(parts.len());
+        for part in &parts {
+            starts.push(source.len());
+            source.push_str(&part.text);
+            if !part.text.ends_with('\n') {
+                source.push('\n');
+            }
+        }
+        ShaderProgram {
+            parts,
+            starts,
+            source,
+        }
+    }
+
+    /// The concatenated WGSL.
+    pub fn source(&self) -> &str {
+        &self.source
+    }
+
+    /// Maps a byte offset of the concatenated source to (file, line, column) of its part.
+    pub fn position(&self, offset: usize) -> SourcePosition {
+        let offset = offset.min(self.source.len());
+        let k = self.starts.iter().rposition(|&s| s <= offset).unwrap_or(0);
+        let start = self.starts.get(k).copied().unwrap_or(0);
+        let prefix = self.source.get(start..offset).unwrap_or("");
+        let line = prefix.matches('\n').count() + 1;
+        let line_start = prefix.rfind('\n').map_or(0, |p| p + 1);
+        SourcePosition {
+            file: self
+                .parts
+                .get(k)
+                .map_or_else(String::new, |p| p.name.clone()),
+            line,
+            column: prefix.len() - line_start + 1,
+        }
+    }
+
+    fn describe_span(&self, span: naga::Span) -> Option<String> {
+        let range = span.to_range()?;
+        let p = self.position(range.start);
+        let text = self.source.get(range).unwrap_or("");
+        let snippet: String = text.lines().next().unwrap_or("").chars().take(60).collect();
+        Some(if snippet.is_empty() {
+            format!("{}:{}:{}", p.file, p.line, p.column)
+        } else {
+            format!("{}:{}:{} (`{}`)", p.file, p.line, p.column, snippet)
+        })
+    }
+
+    /// Parses and validates the program with naga; errors name the file and line.
+    pub fn validate(&self) -> Result<naga::Module> {
+        let module = naga::front::wgsl::parse_str(&self.source).map_err(|e| {
+            let mut msg = String::new();
+            let first = e.labels().next().and_then(|(span, _)| span.to_range());
+            if let Some(range) = first {
+                let p = self.position(range.start);
+                msg += &format!("{}:{}:{}: ", p.file, p.line, p.column);
+            }
+            msg += &format!("WGSL error: {}", e.message());
+            for (span, label) in e.labels() {
+                if let Some(at) = self.describe_span(span) {
+                    if !label.is_empty() {
+                        msg += &format!("\n  {at}: {label}");
+                    }
+                }
+            }
+            for note in e.notes() {
+                msg += &format!("\n  note: {note}");
+            }
+            PgtError::Gpu(msg)
+        })?;
+        let mut validator = naga::valid::Validator::new(
+            naga::valid::ValidationFlags::all(),
+            naga::valid::Capabilities::default(),
+        );
+        validator.validate(&module).map_err(|e| {
+            let mut msg = String::new();
+            // The last span is the most specific (the expression, after the function that holds it).
+            let first = e.spans().last().and_then(|(span, _)| span.to_range());
+            if let Some(range) = first {
+                let p = self.position(range.start);
+                msg += &format!("{}:{}:{}: ", p.file, p.line, p.column);
+            }
+            // The error chain names the function, expression and reason.
+            msg += &format!("WGSL validation error: {}", e.as_inner());
+            let mut source = std::error::Error::source(e.as_inner());
+            while let Some(s) = source {
+                msg += &format!(": {s}");
+                source = s.source();
+            }
+            for (span, label) in e.spans() {
+                if let Some(at) = self.describe_span(*span) {
+                    msg += &format!("\n  {at}: {label}");
+                }
+            }
+            PgtError::Gpu(msg)
+        })?;
+        Ok(module)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn part(name: &str, text: &'static str) -> ShaderPart {
+        ShaderPart {
+            name: name.into(),
+            text: Cow::Borrowed(text),
+        }
+    }
+
+    #[test]
+    fn positions_are_relative_to_each_part() {
+        let p =
+            ShaderProgram::from_parts(vec![part("a.wgsl", "x\ny\n"), part("b.wgsl", "one\ntwo")]);
+        let at = |needle: &str| p.position(p.source().find(needle).unwrap());
+        assert_eq!(
+            at("y"),
+            SourcePosition {
+                file: "a.wgsl".into(),
+                line: 2,
+                column: 1
+            }
+        );
+        assert_eq!(
+            at("two"),
+            SourcePosition {
+                file: "b.wgsl".into(),
+                line: 2,
+                column: 1
+            }
+        );
+        assert_eq!(
+            at("wo"),
+            SourcePosition {
+                file: "b.wgsl".into(),
+                line: 2,
+                column: 2
+            }
+        );
+    }
+
+    #[test]
+    fn shipped_methods_validate() {
+        for (name, text) in [
+            ("emission", crate::approx::methods::EMISSION_WGSL),
+            ("opaque", crate::approx::methods::OPAQUE_WGSL),
+            ("thesis", crate::approx::methods::THESIS_WGSL),
+            (
+                "examples/centre_shadow",
+                include_str!("../../shaders/examples/centre_shadow.wgsl"),
+            ),
+            (
+                "examples/no_shadows",
+                include_str!("../../shaders/examples/no_shadows.wgsl"),
+            ),
+        ] {
+            let prog = ShaderProgram::with_method(part(name, text));
+            if let Err(e) = prog.validate() {
+                panic!("{name}: {e}");
+            }
+        }
+    }
+
+    #[test]
+    fn an_error_in_the_method_names_the_method_file_and_its_line() {
+        let prog = ShaderProgram::with_method(part(
+            "mine.wgsl",
+            "// line 1\nfn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {\n    return vec3<f32>(undefined_thing);\n}\n",
+        ));
+        let err = prog.validate().unwrap_err().to_string();
+        assert!(err.starts_with("mine.wgsl:3:"), "{err}");
+        assert!(err.contains("undefined_thing"), "{err}");
+    }
+
+    #[test]
+    fn a_type_error_found_by_the_validator_points_at_the_method_line() {
+        let prog = ShaderProgram::with_method(part(
+            "mine.wgsl",
+            "fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {\n    let a = 1.0;\n    return a;\n}\n",
+        ));
+        let err = prog.validate().unwrap_err().to_string();
+        assert!(err.contains("mine.wgsl:"), "{err}");
+    }
+}

@@ -1,0 +1,157 @@
+//! The Rust structs of `src/approx/layout.rs` and the WGSL structs of `shaders/common.wgsl` must
+//! agree byte for byte (DESIGN.md §4). naga computes the WGSL layout; this compares every named
+//! member's offset and every struct's size with `offset_of!` and `size_of`. No GPU needed.
+
+use pgt::approx::layout::{GpuBvhNode, GpuFrame, GpuLight, GpuParticle, GpuStats};
+use pgt::approx::shader::COMMON_WGSL;
+use std::mem::{offset_of, size_of};
+
+/// (member name, offset) of a WGSL struct, and its size, as naga lays it out.
+fn wgsl_layout(module: &naga::Module, name: &str) -> (Vec<(String, u32)>, u32) {
+    for (_, ty) in module.types.iter() {
+        if ty.name.as_deref() == Some(name) {
+            if let naga::TypeInner::Struct { members, span } = &ty.inner {
+                let m = members
+                    .iter()
+                    .map(|m| (m.name.clone().unwrap_or_default(), m.offset))
+                    .collect();
+                return (m, *span);
+            }
+        }
+    }
+    panic!("struct {name} not found in shaders/common.wgsl");
+}
+
+/// Compares the named (non-padding) members and the size; padding members must exist on both
+/// sides only as far as the size says.
+fn check(module: &naga::Module, name: &str, rust_size: usize, rust: &[(&str, usize)]) {
+    let (members, size) = wgsl_layout(module, name);
+    assert_eq!(
+        size as usize, rust_size,
+        "{name}: WGSL size {size}, Rust size {rust_size}"
+    );
+    let named: Vec<&(String, u32)> = members
+        .iter()
+        .filter(|(n, _)| !n.starts_with('_'))
+        .collect();
+    assert_eq!(
+        named.len(),
+        rust.len(),
+        "{name}: WGSL has members {named:?}, the Rust check lists {rust:?}"
+    );
+    for ((wn, wo), (rn, ro)) in named.iter().zip(rust) {
+        assert_eq!(wn, rn, "{name}: member order differs");
+        assert_eq!(
+            *wo as usize, *ro,
+            "{name}.{wn}: WGSL offset {wo}, Rust offset {ro}"
+        );
+    }
+}
+
+fn particle_members() -> Vec<(&'static str, usize)> {
+    vec![
+        ("center", offset_of!(GpuParticle, center)),
+        ("radius", offset_of!(GpuParticle, radius)),
+        ("color", offset_of!(GpuParticle, color)),
+        ("sigma", offset_of!(GpuParticle, sigma)),
+        ("albedo", offset_of!(GpuParticle, albedo)),
+        ("ks", offset_of!(GpuParticle, ks)),
+        ("shininess", offset_of!(GpuParticle, shininess)),
+    ]
+}
+
+#[test]
+fn rust_and_wgsl_struct_layouts_agree() {
+    let module = naga::front::wgsl::parse_str(COMMON_WGSL).expect("common.wgsl parses");
+    check(
+        &module,
+        "Particle",
+        size_of::<GpuParticle>(),
+        &particle_members(),
+    );
+    check(
+        &module,
+        "BvhNode",
+        size_of::<GpuBvhNode>(),
+        &[
+            ("min", offset_of!(GpuBvhNode, min)),
+            ("first", offset_of!(GpuBvhNode, first)),
+            ("max", offset_of!(GpuBvhNode, max)),
+            ("count", offset_of!(GpuBvhNode, count)),
+        ],
+    );
+    check(
+        &module,
+        "Light",
+        size_of::<GpuLight>(),
+        &[
+            ("vector", offset_of!(GpuLight, vector)),
+            ("kind", offset_of!(GpuLight, kind)),
+            ("power", offset_of!(GpuLight, power)),
+            ("falloff", offset_of!(GpuLight, falloff)),
+        ],
+    );
+    check(
+        &module,
+        "Frame",
+        size_of::<GpuFrame>(),
+        &[
+            ("forward", offset_of!(GpuFrame, forward)),
+            ("tan_half_fov", offset_of!(GpuFrame, tan_half_fov)),
+            ("right", offset_of!(GpuFrame, right)),
+            ("width", offset_of!(GpuFrame, width)),
+            ("up", offset_of!(GpuFrame, up)),
+            ("height", offset_of!(GpuFrame, height)),
+            ("background", offset_of!(GpuFrame, background)),
+            ("light_count", offset_of!(GpuFrame, light_count)),
+            ("particle_count", offset_of!(GpuFrame, particle_count)),
+            ("samples", offset_of!(GpuFrame, samples)),
+            ("n_exact", offset_of!(GpuFrame, n_exact)),
+            ("light_weight", offset_of!(GpuFrame, light_weight)),
+            ("ambient", offset_of!(GpuFrame, ambient)),
+            ("lit", offset_of!(GpuFrame, lit)),
+            ("pair_begin", offset_of!(GpuFrame, pair_begin)),
+            ("pair_end", offset_of!(GpuFrame, pair_end)),
+            ("camera_position", offset_of!(GpuFrame, camera_position)),
+        ],
+    );
+    check(
+        &module,
+        "Stats",
+        size_of::<GpuStats>(),
+        &[
+            ("hit_overflows", offset_of!(GpuStats, hit_overflows)),
+            ("loop_limited", offset_of!(GpuStats, loop_limited)),
+            ("more_work", offset_of!(GpuStats, more_work)),
+            (
+                "max_loop_iterations",
+                offset_of!(GpuStats, max_loop_iterations),
+            ),
+        ],
+    );
+}
+
+#[test]
+fn the_check_catches_a_shifted_member() {
+    // The subtle mismatch: padding moved in front of `shininess`. Same size, same member order,
+    // only one offset differs (52 instead of 48); the check must still fail.
+    let wrong = COMMON_WGSL.replace(
+        "    shininess: f32,\n    _pad0: f32,",
+        "    _pad0: f32,\n    shininess: f32,",
+    );
+    assert_ne!(wrong, COMMON_WGSL, "the replacement must apply");
+    let module = naga::front::wgsl::parse_str(&wrong).expect("still valid WGSL");
+    assert_eq!(
+        wgsl_layout(&module, "Particle").1 as usize,
+        size_of::<GpuParticle>()
+    );
+    let result = std::panic::catch_unwind(|| {
+        check(
+            &module,
+            "Particle",
+            size_of::<GpuParticle>(),
+            &particle_members(),
+        )
+    });
+    assert!(result.is_err());
+}
