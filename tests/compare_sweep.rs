@@ -1,6 +1,6 @@
 //! End-to-end test of `pgt sweep` (DESIGN.md §5, §7): reference once (then from the cache), one
-//! approximation per parameter combination, a report with a table and SVG plots, and the GPU
-//! method refused with exit 2 while it is not part of the build.
+//! approximation per parameter combination, a report with a table and SVG plots, the GPU
+//! `thesis` method converging as its samples grow, and bad experiments refused with exit 2.
 
 use std::path::Path;
 use std::process::Command;
@@ -72,18 +72,99 @@ fn riemann_sweep_reports_and_caches_the_reference() {
 }
 
 #[test]
-fn gpu_method_and_bad_experiments_exit_2() {
+fn thesis_sweep_on_the_gpu_converges_with_samples() {
+    if let Err(e) = pgt::approx::GpuContext::new(None) {
+        if std::env::var("CI").is_ok_and(|v| v == "true") {
+            panic!("CI=true and no GPU adapter: {e}");
+        }
+        eprintln!("skipping: {e}");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // Disjoint spheres, lit model: the thesis's per-particle scheme converges to the reference
+    // as samples grow when n_exact covers every particle (DESIGN.md §4).
+    let scene = dir.path().join("disjoint.toml");
+    std::fs::write(
+        &scene,
+        r#"[camera]
+position = [0.0, 0.0, -8.0]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 40.0
+[render]
+model = "lit"
+[[lights]]
+type = "directional"
+direction = [0.3, -1.0, 0.2]
+irradiance = [1.0, 0.9, 0.8]
+[[lights]]
+type = "point"
+position = [2.0, 3.0, -4.0]
+intensity = [8.0, 8.0, 10.0]
+[[particles]]
+center = [-1.2, 0.0, 0.0]
+radius = 0.9
+color = [1.0, 0.3, 0.2]
+opacity = 0.7
+[[particles]]
+center = [1.0, 0.4, 0.5]
+radius = 0.8
+color = [0.2, 0.5, 1.0]
+opacity = 0.9
+[[particles]]
+center = [0.2, -1.3, -0.5]
+radius = 0.5
+color = [0.9, 0.9, 0.3]
+opacity = 0.5
+"#,
+    )
+    .unwrap();
+    let exp = dir.path().join("exp.toml");
+    std::fs::write(
+        &exp,
+        "scene = \"disjoint.toml\"\nsize = [32, 24]\n[[approximations]]\nmethod = \"thesis\"\nsamples = [1, 4, 64]\nn_exact = [100]\n",
+    )
+    .unwrap();
+    let rep = dir.path().join("rep");
+    let o = sweep(&exp, &rep);
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    let runs: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(rep.join("sweep.json")).unwrap()).unwrap();
+    let rmse_at = |samples: u64| {
+        runs.as_array()
+            .unwrap()
+            .iter()
+            .find(|r| r["params"]["samples"] == samples)
+            .map(|r| r["rmse"]["mean"].as_f64().unwrap())
+            .unwrap()
+    };
+    let (r1, r4, r64) = (rmse_at(1), rmse_at(4), rmse_at(64));
+    assert!(
+        r1 > r4 && r4 > r64,
+        "RMSE not falling with samples: {r1} {r4} {r64}"
+    );
+    assert!(rep.join("thesis_samples_64_n_exact_100.png").is_file());
+}
+
+#[test]
+fn bad_experiments_exit_2() {
     let dir = tempfile::tempdir().unwrap();
     let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/shadows.toml");
     let exp = dir.path().join("exp.toml");
     let rep = dir.path().join("rep");
+    // The thesis method needs a volume scene; shadows.toml is opaque.
     std::fs::write(
         &exp,
-        format!("scene = {:?}\n[[approximations]]\nmethod = \"thesis\"\nsamples = [100]\nn_exact = [1, 5]\n", scene.to_string_lossy()),
+        format!("scene = {:?}\nsize = [16, 16]\n[[approximations]]\nmethod = \"thesis\"\nsamples = [100]\nn_exact = [1, 5]\n", scene.to_string_lossy()),
     )
     .unwrap();
     let o = sweep(&exp, &rep);
-    assert_eq!(o.status.code(), Some(2));
+    assert_eq!(
+        o.status.code(),
+        Some(2),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
     assert!(String::from_utf8_lossy(&o.stderr).contains("thesis"));
     std::fs::write(
         &exp,

@@ -28,10 +28,11 @@
 //!
 //! Each `[[approximations]]` entry runs the Cartesian product of its lists. Methods are
 //! dispatched in [`render_approximation`]: adding one is one match arm there and one variant of
-//! [`MethodSpec`]. The `thesis` GPU method is not part of this build; a sweep that lists it
-//! stops with a clear error (exit 2) before any rendering.
+//! [`MethodSpec`]. The `thesis` runs use the GPU approximation (`crate::approx`) on the first
+//! adapter wgpu finds; their time is the GPU time, the others' the wall time.
 
 use super::Outcome;
+use crate::approx::{render_approx_with, ApproxParams, GpuContext, Method, N_EXACT_ALL};
 use crate::error::PgtError;
 use crate::image_io::{read_exr_layer, write_image, RgbImage};
 use crate::metrics::{compare, maps, CompareOptions, Comparison};
@@ -156,12 +157,15 @@ impl MethodSpec {
     }
 }
 
-/// Renders one approximation run; returns the image. The one place methods are dispatched.
+/// Renders one approximation run; returns the image and, for GPU methods, the GPU time (the
+/// wall time would include the shader compilation). The one place methods are dispatched. The
+/// GPU context is opened on the first GPU run and kept for the rest of the sweep.
 pub fn render_approximation(
     scene: &Scene,
     run: &Run,
     threads: Option<usize>,
-) -> anyhow::Result<RgbImage> {
+    gpu: &mut Option<GpuContext>,
+) -> anyhow::Result<(RgbImage, Option<f64>)> {
     let param = |name: &str| run.params.iter().find(|(k, _)| *k == name).map(|(_, v)| *v);
     match run.method {
         "riemann" => {
@@ -173,17 +177,24 @@ pub fn render_approximation(
                     samples: param("samples").unwrap_or(1),
                 },
             };
-            Ok(reference::render(scene, &options)?.image)
+            Ok((reference::render(scene, &options)?.image, None))
         }
-        "thesis" => Err(thesis_unavailable().into()),
+        "thesis" => {
+            if gpu.is_none() {
+                *gpu = Some(GpuContext::new(None)?);
+            }
+            let ctx = gpu.as_ref().expect("opened above");
+            let params = ApproxParams {
+                method: Some(Method::Thesis),
+                samples: param("samples").unwrap_or(100),
+                n_exact: param("n_exact").unwrap_or(N_EXACT_ALL),
+                adapter: None,
+            };
+            let out = render_approx_with(ctx, scene, &params)?;
+            Ok((out.image, Some(out.gpu_seconds)))
+        }
         other => anyhow::bail!("unknown approximation method '{other}'"),
     }
-}
-
-fn thesis_unavailable() -> PgtError {
-    PgtError::Gpu(
-        "method \"thesis\" is the GPU approximation (pgt approx), which is not part of this build; remove it from the experiment or use a build with the GPU renderer".into(),
-    )
 }
 
 /// FNV-1a, 64 bit: a stable hash for the cache key (not cryptographic; a collision would need a
@@ -257,9 +268,6 @@ pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
             )
             .into());
         }
-        if r.method == "thesis" {
-            return Err(thesis_unavailable().into());
-        }
     }
     let base = args.experiment.parent().unwrap_or(Path::new("."));
     let scene_path = base.join(&exp.scene);
@@ -311,11 +319,12 @@ pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
     make_readable(&dir.join("reference.png"));
 
     let mut results = Vec::new();
+    let mut gpu = None;
     for run in runs {
         let t = Instant::now();
-        let image =
-            render_approximation(&scene, &run, args.threads).with_context(|| run.label())?;
-        let seconds = t.elapsed().as_secs_f64();
+        let (image, gpu_seconds) = render_approximation(&scene, &run, args.threads, &mut gpu)
+            .with_context(|| run.label())?;
+        let seconds = gpu_seconds.unwrap_or_else(|| t.elapsed().as_secs_f64());
         let cmp = compare(&reference_image, &image, &options).with_context(|| run.label())?;
         let image_file = format!("{}.png", run.file_stem());
         write_image(&dir.join(&image_file), &image, &[], exposure)?;
