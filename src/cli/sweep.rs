@@ -37,7 +37,7 @@ use crate::error::PgtError;
 use crate::image_io::{read_exr_layer, write_image, RgbImage};
 use crate::metrics::{compare, maps, CompareOptions, Comparison};
 use crate::reference::{self, Integrator, RenderOptions};
-use crate::report::html::{escape, make_readable, page, write_text};
+use crate::report::html::{escape, page, write_text};
 use crate::report::plot::{line_plot_svg, PlotSpec, Series};
 use crate::report::summary::short;
 use crate::report::{heatmap, ColorMap, Scale};
@@ -316,7 +316,6 @@ pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
     };
     let exposure = 0.0;
     write_image(&dir.join("reference.png"), &reference_image, &[], exposure)?;
-    make_readable(&dir.join("reference.png"));
 
     let mut results = Vec::new();
     let mut gpu = None;
@@ -328,7 +327,6 @@ pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
         let cmp = compare(&reference_image, &image, &options).with_context(|| run.label())?;
         let image_file = format!("{}.png", run.file_stem());
         write_image(&dir.join(&image_file), &image, &[], exposure)?;
-        make_readable(&dir.join(&image_file));
         let ssim = cmp
             .ssim_values()
             .map(|s| format!("{:.6}", s.mean))

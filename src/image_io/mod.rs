@@ -6,7 +6,7 @@ mod read;
 mod write;
 
 pub use read::{read_exr_layer, read_image, read_image_layer, ReadImage};
-pub use write::{linear_to_srgb8, write_image, ImageFormat};
+pub use write::{linear_to_srgb8, write_atomically, write_image, ImageFormat};
 
 /// A linear RGB image, row-major, row 0 at the top.
 #[derive(Debug, Clone, PartialEq)]

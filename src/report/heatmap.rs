@@ -4,8 +4,7 @@
 //! 3×5 pixel font; no font files needed).
 
 use super::colormap::{ColorMap, Scale};
-use crate::error::{PgtError, Result};
-use std::io::{BufWriter, Write};
+use crate::error::Result;
 use std::path::Path;
 
 /// An 8-bit sRGB image, ready for PNG.
@@ -42,29 +41,16 @@ impl Srgb8Image {
     /// Writes the image as an 8-bit PNG, atomically (a temporary file renamed at the end).
     pub fn write_png(&self, path: &Path) -> Result<()> {
         use image::ImageEncoder;
-        let dir = match path.parent() {
-            Some(p) if !p.as_os_str().is_empty() => p,
-            _ => Path::new("."),
-        };
-        let tmp = tempfile::Builder::new()
-            .prefix(".pgt-partial-")
-            .tempfile_in(dir)
-            .map_err(|e| PgtError::io(dir, e))?;
-        {
-            let mut w = BufWriter::new(tmp.as_file());
-            image::codecs::png::PngEncoder::new(&mut w)
+        crate::image_io::write_atomically(path, |w| {
+            image::codecs::png::PngEncoder::new(w)
                 .write_image(
                     &self.data,
                     self.width,
                     self.height,
                     image::ExtendedColorType::Rgb8,
                 )
-                .map_err(|e| PgtError::io(path, std::io::Error::other(e)))?;
-            w.flush().map_err(|e| PgtError::io(path, e))?;
-        }
-        tmp.persist(path).map_err(|e| PgtError::io(path, e.error))?;
-        super::html::make_readable(path);
-        Ok(())
+                .map_err(std::io::Error::other)
+        })
     }
 }
 

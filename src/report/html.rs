@@ -54,7 +54,6 @@ pub fn write_report(dir: &Path, inputs: &ReportInputs) -> Result<std::path::Path
         ("approximation.png", inputs.approximation),
     ] {
         write_image(&dir.join(name), img, &[], exposure)?;
-        make_readable(&dir.join(name));
     }
     let exposure_note = if exposure == 0.0 {
         "sRGB of the linear values".to_string()
@@ -331,77 +330,13 @@ pub fn escape(s: &str) -> String {
 }
 
 /// Writes the maps as a float32 EXR, atomically: `abs` as the unnamed `R`, `G`, `B`, each of
-/// `layers` as `NAME.R/G/B`. Run-length compression in 64×64 tiles: lossless, nearly as fast as
-/// no compression, and small where the error is exactly 0 (the background of most renders).
-/// ZIP and PIZ took 30 s for the maps of a 3840×2160 pair of noisy images, RLE ~2 s.
+/// `layers` as `NAME.R/G/B` (run-length compressed: see `image_io`).
 fn write_maps_exr(path: &Path, abs: &RgbImage, layers: &[(&str, &RgbImage)]) -> Result<()> {
-    use exr::prelude::*;
-    let size = (abs.width as usize, abs.height as usize);
-    let mut channels: Vec<AnyChannel<FlatSamples>> = Vec::new();
-    for (prefix, img) in std::iter::once(("", abs)).chain(layers.iter().copied()) {
-        for (c, name) in ["R", "G", "B"].iter().enumerate() {
-            let full = if prefix.is_empty() {
-                name.to_string()
-            } else {
-                format!("{prefix}.{name}")
-            };
-            let samples: Vec<f32> = img.pixels.iter().map(|p| p[c]).collect();
-            channels.push(AnyChannel::new(full.as_str(), FlatSamples::F32(samples)));
-        }
-    }
-    let layer = Layer::new(
-        size,
-        LayerAttributes::default(),
-        Encoding::FAST_LOSSLESS,
-        AnyChannels::sort(channels.into_iter().collect()),
-    );
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let tmp = tempfile::Builder::new()
-        .prefix(".pgt-partial-")
-        .tempfile_in(dir)
-        .map_err(|e| PgtError::io(dir, e))?;
-    {
-        let mut w = std::io::BufWriter::new(tmp.as_file());
-        Image::from_layer(layer)
-            .write()
-            .to_buffered(&mut w)
-            .map_err(|e| PgtError::io(path, std::io::Error::other(e)))?;
-        std::io::Write::flush(&mut w).map_err(|e| PgtError::io(path, e))?;
-    }
-    tmp.persist(path).map_err(|e| PgtError::io(path, e.error))?;
-    make_readable(path);
-    Ok(())
-}
-
-/// Report files are for reading by anyone (a web server, a CI artefact store): 0644 instead of
-/// the temporary file's 0600. Best effort.
-pub fn make_readable(path: &Path) {
-    #[cfg(unix)]
-    {
-        use std::os::unix::fs::PermissionsExt;
-        let _ = std::fs::set_permissions(path, std::fs::Permissions::from_mode(0o644));
-    }
-    #[cfg(not(unix))]
-    let _ = path;
+    write_image(path, abs, layers, 0.0)
 }
 
 /// Writes a text file atomically.
 pub fn write_text(path: &Path, text: &str) -> Result<()> {
     use std::io::Write;
-    let dir = match path.parent() {
-        Some(p) if !p.as_os_str().is_empty() => p,
-        _ => Path::new("."),
-    };
-    let mut tmp = tempfile::Builder::new()
-        .prefix(".pgt-partial-")
-        .tempfile_in(dir)
-        .map_err(|e| PgtError::io(dir, e))?;
-    tmp.write_all(text.as_bytes())
-        .map_err(|e| PgtError::io(path, e))?;
-    tmp.persist(path).map_err(|e| PgtError::io(path, e.error))?;
-    make_readable(path);
-    Ok(())
+    crate::image_io::write_atomically(path, |w| w.write_all(text.as_bytes()))
 }
