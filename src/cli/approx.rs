@@ -4,7 +4,7 @@
 use super::Outcome;
 use crate::approx::{self, ApproxParams, Method, Timing, N_EXACT_ALL};
 use crate::image_io::write_image;
-use crate::scene::{OpticalModel, RenderMode, Scene, SceneLoadOptions};
+use crate::scene::{OpticalModel, RenderMode, SceneLoadOptions};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 
@@ -66,20 +66,13 @@ fn parse_n_exact(s: &str) -> Result<u32, String> {
 /// Loads the scene, runs the approximation (DESIGN.md §4), writes the image and prints the
 /// one-line summary with the adapter and the GPU time (DESIGN.md §7).
 pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
-    crate::image_io::ImageFormat::from_path(&args.output)?;
-    if !args.exposure.is_finite() {
-        anyhow::bail!("--exposure must be a finite number");
-    }
     let options = SceneLoadOptions {
         size: args.size,
         mode: args.mode,
         model: args.model,
         tol: None,
     };
-    let scene = Scene::load(&args.scene, &options)?;
-    for w in &scene.warnings {
-        eprintln!("warning: {w}");
-    }
+    let scene = super::load_scene_for(&args.scene, &options, &args.output, args.exposure)?;
     let method = match (&args.shader, args.method) {
         (Some(path), _) => Some(Method::User(path.clone())),
         (None, Some(MethodName::Emission)) => Some(Method::Emission),

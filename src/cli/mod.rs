@@ -72,6 +72,25 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     crate::scene::check_image_size(w as i64, h as i64)
 }
 
+/// What `render` and `approx` do before any work: check the output name and exposure (so a
+/// typo fails at once, not after a long render), load the scene, print its warnings.
+pub fn load_scene_for(
+    scene: &std::path::Path,
+    options: &crate::scene::SceneLoadOptions,
+    output: &std::path::Path,
+    exposure: f32,
+) -> anyhow::Result<crate::scene::Scene> {
+    crate::image_io::ImageFormat::from_path(output)?;
+    if !exposure.is_finite() {
+        anyhow::bail!("--exposure must be a finite number");
+    }
+    let scene = crate::scene::Scene::load(scene, options)?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(scene)
+}
+
 /// Whether stderr is a terminal (progress bars only then).
 pub fn stderr_is_terminal() -> bool {
     use std::io::IsTerminal;

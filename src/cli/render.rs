@@ -3,7 +3,7 @@
 use super::Outcome;
 use crate::image_io::write_image;
 use crate::reference::{self, Integrator, RenderOptions};
-use crate::scene::{OpticalModel, RenderMode, Scene, SceneLoadOptions};
+use crate::scene::{OpticalModel, RenderMode, SceneLoadOptions};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 
@@ -49,21 +49,13 @@ pub struct RenderArgs {
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
-    // Check the output name before the (possibly long) render.
-    crate::image_io::ImageFormat::from_path(&args.output)?;
-    if !args.exposure.is_finite() {
-        anyhow::bail!("--exposure must be a finite number");
-    }
     let options = SceneLoadOptions {
         size: args.size,
         mode: args.mode,
         model: args.model,
         tol: args.tol,
     };
-    let scene = Scene::load(&args.scene, &options)?;
-    for w in &scene.warnings {
-        eprintln!("warning: {w}");
-    }
+    let scene = super::load_scene_for(&args.scene, &options, &args.output, args.exposure)?;
     let integrator = match args.integrator {
         IntegratorName::Adaptive => Integrator::Adaptive,
         IntegratorName::Riemann => {
