@@ -4,35 +4,25 @@
 //! and compare ratios within one run.
 
 use glam::DVec3;
+use pgt::formats::random::SplitMix64;
 use pgt::geometry::Camera;
 use pgt::reference::{render, RenderOptions};
 use pgt::scene::{thesis_lights, Particle, RenderMode, RenderSettings, Scene};
 use std::time::Instant;
 
-/// Deterministic uniform numbers in [0, 1) (SplitMix64), so every run measures the same scene.
-struct SplitMix(u64);
-impl SplitMix {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
-
 /// `n` spheres of radius 1.2–1.9 Å in a cube holding one sphere per 20 Å³ (about a protein's
 /// atom density).
 fn random_scene(n: usize, size: u32) -> Scene {
-    let mut rng = SplitMix(n as u64);
+    // Deterministic (the library's SplitMix64), so every run measures the same scene.
+    let mut rng = SplitMix64::new(n as u64);
     let side = (n as f64 * 20.0).cbrt();
     let particles: Vec<Particle> = (0..n)
         .map(|_| {
-            let c = DVec3::new(rng.next(), rng.next(), rng.next()) * side;
-            let color = DVec3::new(rng.next(), rng.next(), rng.next());
+            let c = DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * side;
+            let color = DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64());
             Particle {
                 center: c,
-                radius: 1.2 + 0.7 * rng.next(),
+                radius: 1.2 + 0.7 * rng.next_f64(),
                 color,
                 sigma: 0.5,
                 albedo: color,

@@ -48,7 +48,7 @@ fn benchmark_adaptive_against_riemann() {
         .and_then(|v| v.parse().ok())
         .unwrap_or(64);
     let side = (PARTICLES as f64 * VOLUME_PER_ATOM).cbrt();
-    let mut rng = Rng(1);
+    let mut rng = Rng::new(1);
     let particles: Vec<_> = (0..PARTICLES)
         .map(|_| {
             let r = rng.range(1.2, 1.9);

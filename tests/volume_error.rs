@@ -26,7 +26,7 @@ fn render_f64(scene: &Scene) -> Vec<Sample> {
 /// A 32×32 render of six overlapping particles, a directional and a point light, at tol 1e-4 and
 /// 1e-6, against the same render at tol 1e-10.
 fn honest_at(model: OpticalModel, seed: u64) {
-    let mut rng = Rng(seed);
+    let mut rng = Rng::new(seed);
     let mut s = scene(model, random_particles(&mut rng, 6), two_lights(), SIZE);
     s.camera = pgt::geometry::Camera::new(
         DVec3::new(0.5, 0.8, -6.0),

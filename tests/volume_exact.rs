@@ -9,6 +9,7 @@ use pgt::reference::volume::VolumeRenderer;
 use pgt::reference::{render, render_with, Integrator, RadianceEstimator, RenderOptions};
 use pgt::scene::{Falloff, Light, OpticalModel};
 use proptest::prelude::*;
+use volume_support::Rng;
 use volume_support::*;
 
 /// DESIGN.md §2: one particle alone gives exactly L = L_bg·T + C·(1 − T), T = e^{−σ·chord},
@@ -122,7 +123,7 @@ fn two_coincident_spheres_are_one_with_twice_sigma() {
 /// model, with overlapping particles, both light kinds and the error layer included.
 #[test]
 fn shuffling_the_particles_changes_no_pixel() {
-    let mut rng = Rng(7);
+    let mut rng = Rng::new(7);
     for model in MODELS {
         let particles = random_particles(&mut rng, 12);
         let mut shuffled = particles.clone();
@@ -265,7 +266,7 @@ fn eye_inside_a_particle_and_particles_behind_the_eye() {
 /// (lit and single-scatter, overlapping particles, both light kinds).
 #[test]
 fn riemann_sums_converge_to_the_adaptive_reference() {
-    let mut rng = Rng(5);
+    let mut rng = Rng::new(5);
     for model in [OpticalModel::Lit, OpticalModel::SingleScatter] {
         let mut s = scene(model, random_particles(&mut rng, 6), two_lights(), 8);
         s.render.tol = 1e-10;
@@ -299,7 +300,7 @@ fn riemann_sums_converge_to_the_adaptive_reference() {
 /// DESIGN.md §3: the image (and its error layer) is bit-identical for any thread count.
 #[test]
 fn image_is_identical_for_any_thread_count() {
-    let mut rng = Rng(9);
+    let mut rng = Rng::new(9);
     let mut s = scene(
         OpticalModel::Lit,
         random_particles(&mut rng, 8),
@@ -402,7 +403,7 @@ fn limit_case() -> impl Strategy<Value = (u64, usize, usize)> {
 }
 
 fn case_scene(seed: u64, n: usize, model: usize) -> (pgt::scene::Scene, Ray) {
-    let mut rng = Rng(seed);
+    let mut rng = Rng::new(seed);
     let particles = random_particles(&mut rng, n);
     let mut s = scene(MODELS[model], particles, two_lights(), 1);
     s.render.tol = 1e-9;

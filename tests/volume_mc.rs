@@ -147,7 +147,7 @@ fn mean_and_standard_error(samples: &[DVec3]) -> (DVec3, DVec3) {
 
 fn agree_on_random_scenes(model: OpticalModel) {
     const SAMPLES: usize = 40_000;
-    let mut rng = Rng(0xC0FFEE ^ model as u64);
+    let mut rng = Rng::new(0xC0FFEE ^ model as u64);
     let mut compared = 0;
     let mut non_trivial = 0;
     for scene_seed in 0..3 {
@@ -220,7 +220,7 @@ fn monte_carlo_oracle_reproduces_the_one_sphere_closed_form() {
     let ray = Ray::new(DVec3::new(0.3, 0.0, -5.0), DVec3::Z);
     let t = (-0.8 * 2.0 * (1.0f64 - 0.09).sqrt()).exp();
     let expected = s.render.background * t + p.color * (1.0 - t);
-    let mut rng = Rng(3);
+    let mut rng = Rng::new(3);
     let samples: Vec<DVec3> = (0..40_000).map(|_| mc.sample(&ray, &mut rng)).collect();
     let (mean, se) = mean_and_standard_error(&samples);
     assert!(

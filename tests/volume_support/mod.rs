@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 use glam::DVec3;
+use pgt::formats::random::SplitMix64;
 use pgt::geometry::{Camera, Ray};
 use pgt::reference::volume::VolumeRenderer;
 use pgt::reference::{Integrator, RadianceEstimator, Sample};
@@ -9,20 +10,20 @@ use pgt::scene::{
     Falloff, Light, LightWeight, OpticalModel, Particle, RenderMode, RenderSettings, Scene,
 };
 
-/// A small deterministic generator (SplitMix64), so the tests need no RNG crate.
-pub struct Rng(pub u64);
+/// The library's deterministic SplitMix64 (the one `pgt gen random` uses), with the draws the
+/// volume tests need.
+pub struct Rng(SplitMix64);
 
 impl Rng {
+    pub fn new(seed: u64) -> Self {
+        Rng(SplitMix64::new(seed))
+    }
     pub fn next_u64(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
-        z ^ (z >> 31)
+        self.0.next_u64()
     }
     /// Uniform in [0, 1).
     pub fn uniform(&mut self) -> f64 {
-        (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64
+        self.0.next_f64()
     }
     pub fn range(&mut self, lo: f64, hi: f64) -> f64 {
         lo + (hi - lo) * self.uniform()
