@@ -416,6 +416,14 @@ fn an_include_emptied_by_its_filters_names_the_filter() {
         };
         every_command_refuses(&p, &[data, "holds no particles", filter]);
     }
+    std::fs::write(
+        d.join("frames.xyz"),
+        "1\nfirst\nC 0 0 0\n0\nsecond, empty\n",
+    )
+    .expect("write");
+    let p = d.join("frame.toml");
+    std::fs::write(&p, "[[include]]\npath = \"frames.xyz\"\nframe = 1\n").expect("write");
+    every_command_refuses(&p, &["frames.xyz", "`frame = 1` holds no particles"]);
     // Without the filter the same include loads.
     let p = d.join("ok.toml");
     std::fs::write(&p, "[[include]]\npath = \"water.pdb\"\n").expect("write");

@@ -3,7 +3,7 @@
 //! validated with [`Scene::load`], so its includes count too).
 
 use super::Outcome;
-use crate::formats::{format_of, known_extensions, load_bytes, read_input, Format, IncludeSpec};
+use crate::formats::{format_of, load_bytes, read_input, Format, IncludeSpec, FORMATS};
 use crate::scene::{Scene, SceneLoadOptions};
 use clap::Args;
 use glam::DVec3;
@@ -14,11 +14,29 @@ use std::path::PathBuf;
 #[derive(Debug, Args)]
 pub struct InfoArgs {
     /// A particle file or a scene file (.toml).
-    #[arg(long_help = format!("A particle file ({}) or a scene file (.toml)", known_extensions()))]
+    #[arg(long_help = file_help())]
     pub file: PathBuf,
     /// Print JSON on stdout instead of text.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `pgt info --help` for FILE, from the table of formats.
+fn file_help() -> String {
+    let mut help = String::from(
+        "A particle file or a scene file (.toml). Particle formats (the name for `format` in an \
+         [[include]], the extensions, the format):",
+    );
+    for f in FORMATS {
+        let ext: Vec<String> = f.extensions.iter().map(|e| format!(".{e}")).collect();
+        help.push_str(&format!(
+            "\n  {:<6} {:<13} {}",
+            f.name,
+            ext.join(" "),
+            f.description
+        ));
+    }
+    help
 }
 
 /// How many of the most common colours the summary lists.

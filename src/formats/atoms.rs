@@ -229,7 +229,8 @@ fn resolve_alternate_locations(
 /// every atom still left is an error naming it (issue 13: an include that yields nothing is
 /// nearly always a mistake), with the count each earlier filter kept.
 fn apply_filters(spec: &IncludeSpec, mut atoms: Vec<Atom>, model: i64) -> Result<Vec<Atom>> {
-    let mut story = format!("model {model} has {} atoms", atoms.len());
+    let atom_s = |n: usize| if n == 1 { "atom" } else { "atoms" };
+    let mut story = format!("model {model} has {} {}", atoms.len(), atom_s(atoms.len()));
     let mut stage = |atoms: &mut Vec<Atom>, filter: String, keep: &dyn Fn(&Atom) -> bool| {
         atoms.retain(|a| keep(a));
         if atoms.is_empty() {

@@ -216,7 +216,7 @@ fn no_particles(spec: &IncludeSpec, format: &Format, len: usize, warnings: &[Str
             .to_string()
     } else {
         format!(
-            "the file holds no particles: its {len} bytes contain no {} ({})",
+            "the file holds no particles: its {len} bytes contain no {}, read as {}",
             format.particles, format.description
         )
     };

@@ -20,7 +20,7 @@ use std::path::Path;
 pub const FORMAT: Format = Format {
     name: "pdb",
     extensions: &["pdb", "ent"],
-    description: "PDB, wwPDB format 3.3 (fixed columns)",
+    description: "PDB (wwPDB format 3.3, fixed columns)",
     particles: "ATOM or HETATM records",
     read,
     details: Some(details),

@@ -22,7 +22,7 @@ use std::path::Path;
 pub const XYZ: Format = Format {
     name: "xyz",
     extensions: &["xyz"],
-    description: "XYZ (element x y z)",
+    description: "XYZ (lines of element x y z)",
     particles: "atoms in the frame",
     read: read_xyz,
     details: None,
@@ -154,6 +154,13 @@ pub fn read_xyz(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
             break;
         }
         current += 1;
+    }
+    if records.is_empty() && spec.frame.is_some() {
+        // The selection emptied the include: name it (issue 13).
+        return Err(PgtError::in_file(
+            path,
+            format!("`frame = {frame}` holds no particles (its atom count is 0)"),
+        ));
     }
     if unknown > 0 {
         warnings.push(format!(
