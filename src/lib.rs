@@ -6,6 +6,7 @@
 
 pub mod approx;
 pub mod cli;
+pub mod color;
 pub mod error;
 pub mod formats;
 pub mod geometry;

@@ -6,7 +6,7 @@ mod file;
 mod framing;
 mod validate;
 
-pub use file::{ColorBy, IncludeSpec};
+pub use crate::formats::{ColorBy, IncludeSpec, ParticleRecord};
 pub use framing::{default_camera, thesis_lights};
 
 use crate::error::{PgtError, Result};
@@ -187,18 +187,6 @@ pub struct SceneLoadOptions {
     pub mode: Option<RenderMode>,
     pub model: Option<OpticalModel>,
     pub tol: Option<f64>,
-}
-
-/// A particle as a file format delivers it, before defaults and validation.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ParticleRecord {
-    pub center: DVec3,
-    pub radius: f64,
-    pub color: Option<DVec3>,
-    /// Θmax, if the format carries one (e.g. VRML transparency).
-    pub opacity: Option<f64>,
-    /// Where in its file the particle was defined (line, or byte offset for binary formats).
-    pub location: crate::error::Location,
 }
 
 /// Largest image side pgt accepts; beyond it a typo (`--size 5120000x512`) would allocate
