@@ -78,11 +78,11 @@ pub fn render_approx_with(
     ApproxPipeline::from_program(ctx, method, &values, &program)?.render(ctx, scene, params)
 }
 
+/// A method ready to compile: the method, its parameter values in slot order, its program.
+type Prepared = (Method, Vec<(String, u32)>, shader::ShaderProgram);
+
 /// Resolves the method, checks it against the scene and the parameters, validates its WGSL.
-fn prepare(
-    scene: &Scene,
-    params: &ApproxParams,
-) -> Result<(Method, Vec<(String, u32)>, shader::ShaderProgram)> {
+fn prepare(scene: &Scene, params: &ApproxParams) -> Result<Prepared> {
     let method = params
         .method
         .clone()
