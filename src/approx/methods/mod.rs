@@ -47,6 +47,7 @@ registry! {
     emission::Emission,
     opaque::Opaque,
     thesis::Thesis,
+    sorted_blend::SortedBlend,
 }
 
 /// The registered method called `name`.
