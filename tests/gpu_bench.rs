@@ -10,7 +10,7 @@
 mod gpu_common;
 
 use glam::DVec3;
-use pgt::approx::{render_approx_with, ApproxParams, Method, Timing, N_EXACT_ALL};
+use pgt::approx::{render_approx_with, ApproxParams, Timing, N_EXACT_ALL};
 use pgt::geometry::Camera;
 use pgt::scene::{OpticalModel, RenderMode};
 
@@ -79,20 +79,12 @@ fn thesis_timings_on_random_particles() {
             side,
         );
         // Warm-up: lavapipe compiles the shader at its first dispatch, inside the first timing.
-        let warm = ApproxParams {
-            method: Some(Method::Thesis),
-            samples: 1,
-            n_exact: 1,
-            adapter: None,
-        };
+        let warm = ApproxParams::for_method("thesis", &[("samples", 1), ("n_exact", 1)]).unwrap();
         render_approx_with(ctx, &s, &warm).unwrap();
         for n_exact in n_exacts.iter().copied() {
-            let params = ApproxParams {
-                method: Some(Method::Thesis),
-                samples,
-                n_exact,
-                adapter: None,
-            };
+            let params =
+                ApproxParams::for_method("thesis", &[("samples", samples), ("n_exact", n_exact)])
+                    .unwrap();
             let wall = std::time::Instant::now();
             let out = render_approx_with(ctx, &s, &params).unwrap();
             let wall = wall.elapsed().as_secs_f64();

@@ -32,7 +32,7 @@
 //! adapter wgpu finds; their time is the GPU time, the others' the wall time.
 
 use super::Outcome;
-use crate::approx::{render_approx_with, ApproxParams, GpuContext, Method, N_EXACT_ALL};
+use crate::approx::{render_approx_with, ApproxParams, GpuContext, N_EXACT_ALL};
 use crate::error::PgtError;
 use crate::image_io::{read_exr_layer, write_image, RgbImage};
 use crate::metrics::{compare, maps, CompareOptions, Comparison};
@@ -184,12 +184,13 @@ pub fn render_approximation(
                 *gpu = Some(GpuContext::new(None)?);
             }
             let ctx = gpu.as_ref().expect("opened above");
-            let params = ApproxParams {
-                method: Some(Method::Thesis),
-                samples: param("samples").unwrap_or(100),
-                n_exact: param("n_exact").unwrap_or(N_EXACT_ALL),
-                adapter: None,
-            };
+            let params = ApproxParams::for_method(
+                "thesis",
+                &[
+                    ("samples", param("samples").unwrap_or(100)),
+                    ("n_exact", param("n_exact").unwrap_or(N_EXACT_ALL)),
+                ],
+            )?;
             let out = render_approx_with(ctx, scene, &params)?;
             Ok((out.image, Some(out.gpu_seconds)))
         }
