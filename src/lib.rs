@@ -16,6 +16,7 @@ pub mod optics;
 pub mod reference;
 pub mod report;
 pub mod scene;
+pub mod sweep;
 
 pub use error::{PgtError, Result};
 pub use scene::{Scene, SceneLoadOptions};
