@@ -17,7 +17,7 @@ pub const LIT: OpticalModel = OpticalModel::new(&lit::Lit);
 /// DESIGN.md §2, single-scatter model.
 pub const SINGLE_SCATTER: OpticalModel = OpticalModel::new(&single_scatter::SingleScatter);
 
-/// The registry, one line per model, in the order of `--help` and of error messages.
+/// The registry, one entry per model, in the order of `--help` and of error messages.
 pub const ALL: &[OpticalModel] = &[EMISSION, LIT, SINGLE_SCATTER];
 
 #[cfg(test)]
