@@ -12,7 +12,8 @@ mod gpu_common;
 use glam::DVec3;
 use pgt::approx::{render_approx_with, ApproxParams, Timing, N_EXACT_ALL};
 use pgt::geometry::Camera;
-use pgt::scene::{OpticalModel, RenderMode};
+use pgt::optics::models;
+use pgt::scene::RenderMode;
 
 fn env_or(name: &str, default: &str) -> String {
     std::env::var(name).unwrap_or_else(|_| default.to_string())
@@ -66,7 +67,7 @@ fn thesis_timings_on_random_particles() {
             particles,
             pgt::scene::thesis_lights(),
             RenderMode::Volume,
-            OpticalModel::Lit,
+            models::LIT,
         );
         // From −z, framing the cube (its bounding sphere) with fov_y 40°, like the default camera.
         let distance = 0.5 * cube * 3f64.sqrt() / (20f64.to_radians().sin());

@@ -6,8 +6,9 @@ mod gpu_common;
 use glam::DVec3;
 use gpu_common::*;
 use pgt::approx::{render_approx_with, ApproxParams, Method, N_EXACT_ALL};
+use pgt::optics::models;
 use pgt::reference::{self, RenderOptions};
-use pgt::scene::{Light, OpticalModel, RenderMode};
+use pgt::scene::{Light, RenderMode};
 use std::path::PathBuf;
 
 /// A built-in method with no parameters chosen (its defaults).
@@ -36,7 +37,7 @@ fn emission_matches_the_exact_answer_on_disjoint_particles() {
         disjoint_particles(),
         vec![],
         RenderMode::Volume,
-        OpticalModel::Emission,
+        models::EMISSION,
     );
     let bvh = s.build_bvh();
     let gpu = render_approx_with(ctx, &s, &plain("emission")).unwrap();
@@ -69,7 +70,7 @@ fn thesis_on_an_emission_scene_is_the_emission_method() {
         disjoint_particles(),
         lights(),
         RenderMode::Volume,
-        OpticalModel::Emission,
+        models::EMISSION,
     );
     let a = render_approx_with(ctx, &s, &plain("emission")).unwrap();
     let b = render_approx_with(ctx, &s, &thesis(16, N_EXACT_ALL)).unwrap();
@@ -84,7 +85,7 @@ fn opaque_matches_the_reference_except_on_silhouettes() {
     let mut ps = disjoint_particles();
     ps[1].ks = 0.5;
     ps[1].shininess = 20.0;
-    let mut s = scene(ps, lights(), RenderMode::Opaque, OpticalModel::Lit);
+    let mut s = scene(ps, lights(), RenderMode::Opaque, models::LIT);
     s.render.ambient = 0.05;
     let bvh = s.build_bvh();
     let gpu = render_approx_with(ctx, &s, &plain("opaque")).unwrap();
@@ -120,7 +121,7 @@ fn thesis_converges_to_the_lit_model_on_disjoint_particles() {
         disjoint_particles(),
         lights(),
         RenderMode::Volume,
-        OpticalModel::Lit,
+        models::LIT,
     );
     let bvh = s.build_bvh();
     let oracle = cpu_image(&s.camera, |r| lit_oracle(&s, &bvh, r, 2048));
@@ -161,7 +162,7 @@ fn thesis_on_overlapping_lit_particles_stays_away_from_the_reference() {
         particle([-0.6, 0.0, 0.0], 1.5, [1.0, 0.1, 0.1], 0.9),
         particle([0.6, 0.2, 0.8], 1.5, [0.1, 0.2, 1.0], 0.7),
     ];
-    let s = scene(ps, lights(), RenderMode::Volume, OpticalModel::Lit);
+    let s = scene(ps, lights(), RenderMode::Volume, models::LIT);
     let reference = reference::render(&s, &RenderOptions::default()).unwrap();
     let e = |samples| {
         let out = render_approx_with(ctx, &s, &thesis(samples, N_EXACT_ALL)).unwrap();
@@ -181,7 +182,7 @@ fn thesis_with_fewer_exact_particles_is_further_from_the_lit_model() {
         disjoint_particles(),
         lights(),
         RenderMode::Volume,
-        OpticalModel::Lit,
+        models::LIT,
     );
     let bvh = s.build_bvh();
     let oracle = cpu_image(&s.camera, |r| lit_oracle(&s, &bvh, r, 1024));
@@ -207,7 +208,7 @@ fn thesis_ignores_overlaps_and_differs_from_exact_intervals() {
         particle([-0.6, 0.0, 0.0], 1.5, [1.0, 0.1, 0.1], 0.9),
         particle([0.6, 0.2, 0.8], 1.5, [0.1, 0.2, 1.0], 0.7),
     ];
-    let s = scene(ps, vec![], RenderMode::Volume, OpticalModel::Emission);
+    let s = scene(ps, vec![], RenderMode::Volume, models::EMISSION);
     let bvh = s.build_bvh();
     let exact = cpu_image(&s.camera, |r| emission_exact_intervals(&s, &bvh, r));
     let per_particle = cpu_image(&s.camera, |r| {
@@ -230,7 +231,7 @@ fn thesis_ignores_overlaps_and_differs_from_exact_intervals() {
 #[test]
 fn an_empty_scene_renders_the_background() {
     let Some(ctx) = gpu() else { return };
-    let s = scene(vec![], vec![], RenderMode::Volume, OpticalModel::Lit);
+    let s = scene(vec![], vec![], RenderMode::Volume, models::LIT);
     for method in pgt::approx::METHODS {
         let out = render_approx_with(ctx, &s, &plain(method.name())).unwrap();
         let bg = s.render.background.as_vec3().to_array();
@@ -253,7 +254,7 @@ fn a_crowded_ray_reports_hit_list_overflow() {
             )
         })
         .collect();
-    let s = scene(ps, vec![], RenderMode::Volume, OpticalModel::Emission);
+    let s = scene(ps, vec![], RenderMode::Volume, models::EMISSION);
     let out = render_approx_with(ctx, &s, &plain("emission")).unwrap();
     assert!(out.hit_overflow_pixels > 0);
     assert!(out.image.all_finite());
@@ -273,9 +274,9 @@ fn a_point_light_inside_no_particle_lights_the_gas() {
         ps.clone(),
         vec![light(0.0)],
         RenderMode::Volume,
-        OpticalModel::Lit,
+        models::LIT,
     );
-    let far = scene(ps, vec![light(8.0)], RenderMode::Volume, OpticalModel::Lit);
+    let far = scene(ps, vec![light(8.0)], RenderMode::Volume, models::LIT);
     let a = render_approx_with(ctx, &near, &thesis(16, N_EXACT_ALL)).unwrap();
     let b = render_approx_with(ctx, &far, &thesis(16, N_EXACT_ALL)).unwrap();
     let centre = (SIDE / 2 * SIDE + SIDE / 2) as usize;
@@ -289,7 +290,7 @@ fn the_opaque_gas_limit_agrees_with_nearly_opaque_gas() {
     // the f64 oracle integrates the same particle with σ = 10⁴ /m (depth scale 0.1 mm on a
     // 0.7 m sphere) without any limit formula. They must agree.
     let ps = disjoint_particles();
-    let s_inf = scene(ps.clone(), lights(), RenderMode::Volume, OpticalModel::Lit);
+    let s_inf = scene(ps.clone(), lights(), RenderMode::Volume, models::LIT);
     assert!(s_inf.particles[2].sigma.is_infinite());
     let mut s_big = s_inf.clone();
     s_big.particles[2].sigma = 1e4;
@@ -323,7 +324,7 @@ fn pixels_beyond_lavapipes_loop_limit_are_reported() {
             )
         })
         .collect();
-    let s = scene(ps, vec![], RenderMode::Volume, OpticalModel::Emission);
+    let s = scene(ps, vec![], RenderMode::Volume, models::EMISSION);
     let out = render_approx_with(ctx, &s, &user(shader, 1, 0)).unwrap();
     if ctx.adapter.is_cpu {
         assert!(out.loop_limited_pixels > 0);
@@ -335,7 +336,7 @@ fn pixels_beyond_lavapipes_loop_limit_are_reported() {
         disjoint_particles(),
         lights(),
         RenderMode::Volume,
-        OpticalModel::Lit,
+        models::LIT,
     );
     let out = render_approx_with(ctx, &s, &thesis(400, N_EXACT_ALL)).unwrap();
     assert_eq!(out.loop_limited_pixels, 0);
@@ -372,7 +373,7 @@ fn thesis_stays_right_on_a_crowded_random_scene() {
         ps,
         pgt::scene::thesis_lights(),
         RenderMode::Volume,
-        OpticalModel::Lit,
+        models::LIT,
     );
     s.camera = pgt::geometry::Camera::new(
         DVec3::new(0.0, 0.0, -3.0 * cube),
@@ -402,7 +403,7 @@ fn the_example_user_methods_are_measurably_worse_than_the_thesis_method() {
         disjoint_particles(),
         lights(),
         RenderMode::Volume,
-        OpticalModel::Lit,
+        models::LIT,
     );
     let reference = reference::render(&s, &RenderOptions::default()).unwrap();
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));

@@ -8,8 +8,9 @@ use glam::DVec3;
 use gpu_common::*;
 use pgt::approx::{render_approx_with, ApproxParams};
 use pgt::geometry::{Bvh, Hit, Ray};
+use pgt::optics::models;
 use pgt::reference::{self, RenderOptions};
-use pgt::scene::{OpticalModel, RenderMode, Scene};
+use pgt::scene::{RenderMode, Scene};
 
 fn sorted_blend() -> ApproxParams {
     ApproxParams::for_method("sorted-blend", &[]).unwrap()
@@ -57,7 +58,7 @@ fn sorted_blend_is_exact_where_centre_order_is_entry_order() {
             );
         }
     }
-    let s = scene(ps, vec![], RenderMode::Volume, OpticalModel::Emission);
+    let s = scene(ps, vec![], RenderMode::Volume, models::EMISSION);
     let bvh = s.build_bvh();
     let layered = (0..SIDE * SIDE)
         .filter(|i| {
@@ -93,7 +94,7 @@ fn sorted_blend_on_overlapping_particles_measures_its_error() {
         particle([0.6, 0.2, 0.8], 1.5, [0.1, 0.2, 1.0], 0.7),
         particle([0.0, -1.0, 1.5], 2.5, [0.2, 0.9, 0.2], 0.5),
     ];
-    let s = scene(ps, vec![], RenderMode::Volume, OpticalModel::Emission);
+    let s = scene(ps, vec![], RenderMode::Volume, models::EMISSION);
     let bvh = s.build_bvh();
     let gpu = render_approx_with(ctx, &s, &sorted_blend()).unwrap();
     // It does what it claims, to f32 precision …
@@ -116,7 +117,7 @@ fn sorted_blend_refuses_opaque_scenes() {
         disjoint_particles(),
         vec![],
         RenderMode::Opaque,
-        OpticalModel::Emission,
+        models::EMISSION,
     );
     // The scene check runs before any adapter is needed.
     let Some(ctx) = gpu() else { return };

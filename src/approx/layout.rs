@@ -333,7 +333,7 @@ impl GpuFrame {
                 scene.lights.len(),
             ) as f32,
             ambient: scene.render.ambient as f32,
-            lit: (scene.render.model == crate::scene::OpticalModel::Lit) as u32,
+            lit: (scene.render.model == crate::optics::models::LIT) as u32,
             camera_position: cam.position.as_vec3().to_array(),
             pair_begin: 0,
             pair_end: u32::MAX,

@@ -20,7 +20,8 @@
 use super::ApproxMethod;
 use crate::approx::params::{ParamSpec, N_EXACT_ALL};
 use crate::error::{PgtError, Result};
-use crate::scene::{OpticalModel, RenderMode, Scene};
+use crate::optics::models;
+use crate::scene::{RenderMode, Scene};
 
 /// The `thesis` method (see the module docs).
 pub struct Thesis;
@@ -66,10 +67,12 @@ impl ApproxMethod for Thesis {
                 "the thesis method renders gas (volume mode); this scene is in opaque mode: use --method opaque or --mode volume".into(),
             ));
         }
-        if scene.render.model == OpticalModel::SingleScatter {
-            return Err(PgtError::Usage(
-                "the thesis method implements the emission and lit models; this scene uses single-scatter: use --model lit or a user shader".into(),
-            ));
+        let model = scene.render.model;
+        if model != models::EMISSION && model != models::LIT {
+            return Err(PgtError::Usage(format!(
+                "the thesis method implements the emission and lit models; this scene uses {}: use --model lit or a user shader",
+                model.name()
+            )));
         }
         Ok(())
     }
