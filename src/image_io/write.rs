@@ -216,3 +216,51 @@ fn write_exr(
         .to_buffered(w)
         .map_err(std::io::Error::other)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image_with(value: f32, at: usize, channel: usize) -> RgbImage {
+        let mut img = RgbImage::new(5, 4);
+        img.pixels[at][channel] = value;
+        img
+    }
+
+    /// Writes and expects a refusal mentioning every needle, with nothing left in the folder.
+    fn refused(name: &str, image: &RgbImage, layers: &[(&str, &RgbImage)], needles: &[&str]) {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(name);
+        let e = write_image(&path, image, layers, 0.0).unwrap_err().to_string();
+        for n in needles {
+            assert!(e.contains(n), "'{n}' not in: {e}");
+        }
+        assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none(), "{e}");
+    }
+
+    #[test]
+    fn non_finite_values_are_refused_in_every_layer_and_format() {
+        let fine = RgbImage::new(5, 4);
+        let nan = image_with(f32::NAN, 5 + 2, 1);
+        let inf = image_with(f32::NEG_INFINITY, 19, 2);
+        let main = ["out.exr", "pixel (2, 1)", "channel G of the image", "NaN"];
+        refused("out.exr", &nan, &[], &main);
+        refused("out.exr", &fine, &[("err", &inf)], &["pixel (4, 3)", "err.B", "layer 'err'", "-inf"]);
+        refused("out.png", &nan, &[], &["out.png", "pixel (2, 1)"]);
+        refused("out.png", &inf, &[("err", &fine)], &["pixel (4, 3)", "channel B"]);
+        // Every layer given is checked, even for a PNG that does not store them: a non-finite
+        // value anywhere is a bug.
+        let dir = tempfile::tempdir().unwrap();
+        write_image(&dir.path().join("ok.png"), &fine, &[("err", &inf)], 0.0)
+            .expect_err("every layer given is checked");
+        let with_header = write_exr_with_header(
+            &dir.path().join("part.exr"),
+            &fine,
+            &[("err", &nan)],
+            &[("pgtFormat", "x".into())],
+        );
+        assert!(with_header.unwrap_err().to_string().contains("layer 'err'"));
+        assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none());
+        write_image(&dir.path().join("ok.exr"), &fine, &[("err", &fine)], 0.0).unwrap();
+    }
+}
