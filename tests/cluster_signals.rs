@@ -50,7 +50,12 @@ fn finish(mut child: Child) -> (Option<i32>, String) {
         if let Some(status) = child.try_wait().unwrap() {
             let mut err = String::new();
             use std::io::Read;
-            child.stderr.take().unwrap().read_to_string(&mut err).unwrap();
+            child
+                .stderr
+                .take()
+                .unwrap()
+                .read_to_string(&mut err)
+                .unwrap();
             return (status.code(), err);
         }
         if start.elapsed() > Duration::from_secs(60) {
@@ -95,7 +100,10 @@ fn interrupt_render(signal: &str, code: i32) {
     let (status, err) = finish(child);
     assert_eq!(status, Some(code), "{err}");
     assert_eq!(err.trim().lines().count(), 1, "one line: {err}");
-    assert!(err.contains(&format!("interrupted by SIG{signal}")), "{err}");
+    assert!(
+        err.contains(&format!("interrupted by SIG{signal}")),
+        "{err}"
+    );
     assert_eq!(snapshot(dir.path()), before, "the folder changed");
 }
 
@@ -139,9 +147,12 @@ fn sigint_while_a_report_is_written_leaves_no_report_and_no_temporary_folder() {
     let start = Instant::now();
     let mut seen = false;
     while start.elapsed() < Duration::from_secs(120) {
-        seen = std::fs::read_dir(d)
-            .unwrap()
-            .any(|e| e.unwrap().file_name().to_string_lossy().starts_with(".pgt-partial-"));
+        seen = std::fs::read_dir(d).unwrap().any(|e| {
+            e.unwrap()
+                .file_name()
+                .to_string_lossy()
+                .starts_with(".pgt-partial-")
+        });
         if seen {
             break;
         }

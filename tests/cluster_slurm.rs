@@ -56,7 +56,10 @@ fn an_array_job_and_a_dependent_merge_through_slurm_equal_a_direct_render() {
     let log = String::from_utf8_lossy(&out.stderr);
     // Whatever happened, the daemons the script started must be gone.
     let pids = std::fs::read_to_string(work.path().join("daemon-pids")).unwrap_or_default();
-    for pid in pids.split_whitespace().filter_map(|p| p.parse::<u32>().ok()) {
+    for pid in pids
+        .split_whitespace()
+        .filter_map(|p| p.parse::<u32>().ok())
+    {
         assert!(!alive(pid), "daemon {pid} is still running\n{log}");
     }
     if out.status.code() == Some(77) {
@@ -81,7 +84,10 @@ fn an_array_job_and_a_dependent_merge_through_slurm_equal_a_direct_render() {
     assert!(st.success());
     let (a, b) = (channels(&direct), channels(&work.path().join("merged.exr")));
     assert!(a.contains_key("err.R"), "the lit scene has an err layer");
-    assert_eq!(a, b, "the merge through Slurm differs from the direct render\n{log}");
+    assert_eq!(
+        a, b,
+        "the merge through Slurm differs from the direct render\n{log}"
+    );
     // All four array tasks ran as Slurm jobs.
     assert!(log.contains("4 JobState=COMPLETED"), "{log}");
 }

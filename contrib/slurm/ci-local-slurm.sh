@@ -44,6 +44,13 @@ chown slurm:slurm "$state/ctld" "$state/log"
 pids=()
 stop_daemons() {
     local pid
+    # Let the job steps of slurmd end first, so none is orphaned mid-exit.
+    for pid in "${pids[@]}"; do
+        for _ in $(seq 50); do
+            pgrep -P "$pid" slurmstepd >/dev/null 2>&1 || break
+            sleep 0.1
+        done
+    done
     for pid in "${pids[@]}"; do kill -TERM "$pid" 2>/dev/null; done
     for pid in "${pids[@]}"; do
         # An exited daemon stays a zombie until waited for: look at its state, not at kill -0.

@@ -231,11 +231,16 @@ mod tests {
     fn refused(name: &str, image: &RgbImage, layers: &[(&str, &RgbImage)], needles: &[&str]) {
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join(name);
-        let e = write_image(&path, image, layers, 0.0).unwrap_err().to_string();
+        let e = write_image(&path, image, layers, 0.0)
+            .unwrap_err()
+            .to_string();
         for n in needles {
             assert!(e.contains(n), "'{n}' not in: {e}");
         }
-        assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none(), "{e}");
+        assert!(
+            std::fs::read_dir(dir.path()).unwrap().next().is_none(),
+            "{e}"
+        );
     }
 
     #[test]
@@ -245,9 +250,19 @@ mod tests {
         let inf = image_with(f32::NEG_INFINITY, 19, 2);
         let main = ["out.exr", "pixel (2, 1)", "channel G of the image", "NaN"];
         refused("out.exr", &nan, &[], &main);
-        refused("out.exr", &fine, &[("err", &inf)], &["pixel (4, 3)", "err.B", "layer 'err'", "-inf"]);
+        refused(
+            "out.exr",
+            &fine,
+            &[("err", &inf)],
+            &["pixel (4, 3)", "err.B", "layer 'err'", "-inf"],
+        );
         refused("out.png", &nan, &[], &["out.png", "pixel (2, 1)"]);
-        refused("out.png", &inf, &[("err", &fine)], &["pixel (4, 3)", "channel B"]);
+        refused(
+            "out.png",
+            &inf,
+            &[("err", &fine)],
+            &["pixel (4, 3)", "channel B"],
+        );
         // Every layer given is checked, even for a PNG that does not store them: a non-finite
         // value anywhere is a bug.
         let dir = tempfile::tempdir().unwrap();
