@@ -34,6 +34,28 @@ fn snapshot(dir: &Path) -> BTreeMap<String, Vec<u8>> {
     out
 }
 
+/// Waits until the child catches SIGINT and SIGTERM (its handler is installed: the `SigCgt`
+/// mask of /proc/PID/status has bits 2 and 15), so that a signal sent next reaches pgt's
+/// cleanup and not the default action.
+fn wait_for_handlers(child: &Child) {
+    let start = Instant::now();
+    while start.elapsed() < Duration::from_secs(30) {
+        let status =
+            std::fs::read_to_string(format!("/proc/{}/status", child.id())).unwrap_or_default();
+        let caught = status
+            .lines()
+            .find_map(|l| l.strip_prefix("SigCgt:"))
+            .and_then(|m| u64::from_str_radix(m.trim(), 16).ok())
+            .unwrap_or(0);
+        let want = (1u64 << (2 - 1)) | (1u64 << (15 - 1));
+        if caught & want == want {
+            return;
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    }
+    panic!("pgt did not install its SIGINT/SIGTERM handlers within 30 s");
+}
+
 fn send(child: &Child, signal: &str) {
     let st = Command::new("kill")
         .args([&format!("-{signal}"), &child.id().to_string()])
@@ -94,8 +116,9 @@ fn interrupt_render(signal: &str, code: i32) {
         .arg(&out)
         .spawn()
         .unwrap();
-    // Long enough for the binary to start and install its handler, far shorter than the render.
-    std::thread::sleep(Duration::from_millis(1500));
+    wait_for_handlers(&child);
+    // A moment into the render, far shorter than it.
+    std::thread::sleep(Duration::from_millis(300));
     send(&child, signal);
     let (status, err) = finish(child);
     assert_eq!(status, Some(code), "{err}");
