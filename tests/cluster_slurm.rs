@@ -36,26 +36,24 @@ fn alive(pid: u32) -> bool {
     }
 }
 
-#[test]
-fn an_array_job_and_a_dependent_merge_through_slurm_equal_a_direct_render() {
+/// Runs `contrib/slurm/ci-local-slurm.sh WORK disjoint_lit.toml 4 --size 40x30` with `PGT=pgt`,
+/// checks that no daemon it started survived, and returns its exit code and stderr, or `None`
+/// (after saying why) where Slurm cannot start outside CI.
+fn local_slurm(work: &Path, pgt: &Path) -> Option<(Option<i32>, String)> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let pgt = env!("CARGO_BIN_EXE_pgt");
-    let work = tempfile::tempdir().unwrap();
-    let scene = root.join("examples").join("disjoint_lit.toml");
-    let size = ["--size", "40x30"];
     let out = Command::new("bash")
         .arg(root.join("contrib/slurm/ci-local-slurm.sh"))
-        .arg(work.path())
-        .arg(&scene)
+        .arg(work)
+        .arg(root.join("examples").join("disjoint_lit.toml"))
         .arg("4")
-        .args(size)
+        .args(SIZE)
         .env("PGT", pgt)
         .stdin(std::process::Stdio::null())
         .output()
         .expect("bash runs");
-    let log = String::from_utf8_lossy(&out.stderr);
+    let log = String::from_utf8_lossy(&out.stderr).into_owned();
     // Whatever happened, the daemons the script started must be gone.
-    let pids = std::fs::read_to_string(work.path().join("daemon-pids")).unwrap_or_default();
+    let pids = std::fs::read_to_string(work.join("daemon-pids")).unwrap_or_default();
     for pid in pids
         .split_whitespace()
         .filter_map(|p| p.parse::<u32>().ok())
@@ -69,14 +67,28 @@ fn an_array_job_and_a_dependent_merge_through_slurm_equal_a_direct_render() {
             "CI=true: Slurm must start here: {reason}\n{log}"
         );
         println!("skipping: {reason}");
-        return;
+        return None;
     }
-    assert!(out.status.success(), "exit {:?}\n{log}", out.status.code());
+    Some((out.status.code(), log))
+}
+
+const SIZE: [&str; 2] = ["--size", "40x30"];
+
+/// One test, so that the two Slurm runs do not overlap.
+#[test]
+fn an_array_job_and_a_dependent_merge_through_slurm_equal_a_direct_render() {
+    let pgt = Path::new(env!("CARGO_BIN_EXE_pgt"));
+    let work = tempfile::tempdir().unwrap();
+    let Some((code, log)) = local_slurm(work.path(), pgt) else {
+        return;
+    };
+    assert_eq!(code, Some(0), "{log}");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/disjoint_lit.toml");
     let direct = work.path().join("direct.exr");
     let st = Command::new(pgt)
         .arg("render")
         .arg(&scene)
-        .args(size)
+        .args(SIZE)
         .arg("-o")
         .arg(&direct)
         .status()
@@ -90,4 +102,26 @@ fn an_array_job_and_a_dependent_merge_through_slurm_equal_a_direct_render() {
     );
     // All four array tasks ran as Slurm jobs.
     assert!(log.contains("4 JobState=COMPLETED"), "{log}");
+
+    // A part that fails: the merge job must be cancelled (--kill-on-invalid-dep=yes), not left
+    // pending, and nothing merged.
+    let failing = tempfile::tempdir().unwrap();
+    let wrapper = failing.path().join("pgt-fails-part-2");
+    std::fs::write(
+        &wrapper,
+        format!(
+            "#!/bin/sh\n[ \"$SLURM_ARRAY_TASK_ID\" = 2 ] && {{ echo 'part 2 fails' >&2; exit 3; }}\nexec '{}' \"$@\"\n",
+            pgt.display()
+        ),
+    )
+    .unwrap();
+    use std::os::unix::fs::PermissionsExt;
+    std::fs::set_permissions(&wrapper, std::fs::Permissions::from_mode(0o755)).unwrap();
+    let Some((code, log)) = local_slurm(failing.path(), &wrapper) else {
+        return;
+    };
+    assert_eq!(code, Some(1), "{log}");
+    assert!(log.contains("JobState=CANCELLED"), "{log}");
+    assert!(log.contains("1 JobState=FAILED"), "{log}");
+    assert!(!failing.path().join("merged.exr").exists());
 }
