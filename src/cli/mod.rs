@@ -5,6 +5,7 @@ pub mod approx;
 pub mod compare;
 pub mod gen;
 pub mod info;
+pub mod merge;
 pub mod render;
 pub mod sweep;
 
@@ -44,6 +45,8 @@ pub enum Command {
     Info(info::InfoArgs),
     /// Generate synthetic data sets (`pgt gen random`).
     Gen(gen::GenArgs),
+    /// Join the parts of a cluster render (`pgt render --tile I/N`) into the whole image.
+    Merge(merge::MergeArgs),
 }
 
 /// Runs the parsed command line.
@@ -55,6 +58,7 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Sweep(args) => sweep::run(args),
         Command::Info(args) => info::run(args),
         Command::Gen(args) => gen::run(args),
+        Command::Merge(args) => merge::run(args),
     }
 }
 

@@ -4,6 +4,7 @@
 pub mod opaque;
 pub mod quadrature;
 pub mod riemann;
+pub mod rows;
 pub mod volume;
 
 use crate::error::{PgtError, Result};
@@ -90,6 +91,17 @@ pub struct RenderOutput {
 
 /// Renders the scene with the renderer its mode and model call for.
 pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
+    let estimator = estimator_for(scene, options)?;
+    render_with(&scene.camera, estimator.as_ref(), options)
+}
+
+/// The estimator the scene's mode and model call for, after checking the options that every
+/// renderer shares (`spp` range, Riemann sample count). `render` and the part renderer of
+/// [`rows`] both start here, so a part is rendered exactly as the whole image is.
+pub fn estimator_for<'a>(
+    scene: &'a Scene,
+    options: &RenderOptions,
+) -> Result<Box<dyn RadianceEstimator + 'a>> {
     if !(1..=MAX_SPP).contains(&options.spp) {
         return Err(PgtError::Usage(format!(
             "--spp must be between 1 and {MAX_SPP}, got {}",
@@ -97,18 +109,17 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
         )));
     }
     match scene.render.mode {
-        RenderMode::Opaque => {
-            let renderer = opaque::OpaqueRenderer::new(scene);
-            render_with(&scene.camera, &renderer, options)
-        }
+        RenderMode::Opaque => Ok(Box::new(opaque::OpaqueRenderer::new(scene))),
         RenderMode::Volume => {
             if let Integrator::Riemann { samples: 0 } = options.integrator {
                 return Err(PgtError::Usage(
                     "Riemann sums need at least 1 sample per interval".into(),
                 ));
             }
-            let renderer = volume::VolumeRenderer::new(scene, options.integrator);
-            render_with(&scene.camera, &renderer, options)
+            Ok(Box::new(volume::VolumeRenderer::new(
+                scene,
+                options.integrator,
+            )))
         }
     }
 }
@@ -145,7 +156,6 @@ pub fn render_with(
         None
     };
     let k = options.spp;
-    let inv_n = 1.0 / (k * k) as f64;
     let run = || {
         tiles
             .par_iter()
@@ -154,19 +164,9 @@ pub fn render_with(
                 let mut shadow_rays = 0u64;
                 for py in ty * TILE..((ty + 1) * TILE).min(h) {
                     for px in tx * TILE..((tx + 1) * TILE).min(w) {
-                        let mut radiance = DVec3::ZERO;
-                        let mut error = DVec3::ZERO;
-                        for sy in 0..k {
-                            for sx in 0..k {
-                                let x = px as f64 + (sx as f64 + 0.5) / k as f64;
-                                let y = py as f64 + (sy as f64 + 0.5) / k as f64;
-                                let s = estimator.radiance(&camera.ray_at(x, y));
-                                radiance += s.radiance;
-                                error += s.error;
-                                shadow_rays += s.shadow_rays;
-                            }
-                        }
-                        out.push((px, py, radiance * inv_n, error * inv_n));
+                        let (radiance, error, rays) = render_pixel(camera, estimator, px, py, k);
+                        shadow_rays += rays;
+                        out.push((px, py, radiance, error));
                     }
                 }
                 if let Some(bar) = &bar {
@@ -194,8 +194,7 @@ pub fn render_with(
         shadow_rays += rays;
         for (px, py, rad, err) in tile {
             let i = py as usize * w as usize + px as usize;
-            image.pixels[i] = rad.as_vec3().to_array();
-            err_image.pixels[i] = err.as_vec3().to_array();
+            (image.pixels[i], err_image.pixels[i]) = stored_pixel(rad, err);
         }
     }
     let pixels = w as u64 * h as u64;
@@ -218,4 +217,39 @@ pub fn render_with(
             mean_error,
         },
     })
+}
+
+/// One pixel: the mean of k×k stratified samples at the sub-pixel centres (DESIGN.md §1 camera
+/// convention, `--spp k`), as (radiance, error estimate, shadow rays). Every renderer of whole
+/// images or parts goes through this one function, so a pixel is the same bits wherever it is
+/// rendered.
+pub fn render_pixel(
+    camera: &Camera,
+    estimator: &dyn RadianceEstimator,
+    px: u32,
+    py: u32,
+    k: u32,
+) -> (DVec3, DVec3, u64) {
+    let inv_n = 1.0 / (k * k) as f64;
+    let mut radiance = DVec3::ZERO;
+    let mut error = DVec3::ZERO;
+    let mut shadow_rays = 0;
+    for sy in 0..k {
+        for sx in 0..k {
+            let x = px as f64 + (sx as f64 + 0.5) / k as f64;
+            let y = py as f64 + (sy as f64 + 0.5) / k as f64;
+            let s = estimator.radiance(&camera.ray_at(x, y));
+            radiance += s.radiance;
+            error += s.error;
+            shadow_rays += s.shadow_rays;
+        }
+    }
+    (radiance * inv_n, error * inv_n, shadow_rays)
+}
+
+/// The float32 values stored for a pixel's f64 radiance and error estimate (the image and its
+/// `err` layer), shared by whole-image and part renders so both store the same bits.
+#[inline]
+pub fn stored_pixel(radiance: DVec3, error: DVec3) -> ([f32; 3], [f32; 3]) {
+    (radiance.as_vec3().to_array(), error.as_vec3().to_array())
 }
