@@ -2,7 +2,9 @@
 //! [`Outcome`]; `main` maps it and errors to exit codes 0 / 1 / 2.
 
 pub mod approx;
+pub mod camera;
 pub mod compare;
+pub mod export;
 pub mod gen;
 pub mod info;
 pub mod render;
@@ -44,6 +46,10 @@ pub enum Command {
     Info(info::InfoArgs),
     /// Generate synthetic data sets (`pgt gen random`).
     Gen(gen::GenArgs),
+    /// The camera as view and projection matrices per graphics API (OpenGL, Vulkan, WebGPU, Direct3D).
+    Camera(camera::CameraArgs),
+    /// Write the resolved particles (centre, radius, colour, σ, Θmax) as CSV or PLY.
+    Export(export::ExportArgs),
 }
 
 /// Runs the parsed command line.
@@ -55,6 +61,8 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Sweep(args) => sweep::run(args),
         Command::Info(args) => info::run(args),
         Command::Gen(args) => gen::run(args),
+        Command::Camera(args) => camera::run(args),
+        Command::Export(args) => export::run(args),
     }
 }
 
