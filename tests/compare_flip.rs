@@ -112,7 +112,10 @@ fn hdr_flip_matches_flip_evaluator() {
          {eight_worst:.2e}"
     );
     assert!(float_mean < 1e-5, "float HDR-FLIP mean off by {float_mean}");
-    assert!(float_worst < 1e-4, "float HDR-FLIP map off by {float_worst}");
+    assert!(
+        float_worst < 1e-4,
+        "float HDR-FLIP map off by {float_worst}"
+    );
     assert!(eight_mean < 1e-3 && eight_worst < 0.03);
     // Identical images: 0; a black reference has no exposure range.
     assert_eq!(flip_hdr(&r, &r, 67.0, None).unwrap().mean, 0.0);

@@ -122,7 +122,7 @@ pub fn near_far(camera: &Camera, spheres: impl IntoIterator<Item = (DVec3, f64)>
         near = near.min(d - r);
         far = far.max(d + r);
     }
-    if !(far > 0.0) || !far.is_finite() {
+    if !far.is_finite() || far <= 0.0 {
         return EMPTY_NEAR_FAR;
     }
     let extent = (far - near.max(0.0)).max(far * MIN_NEAR_OVER_FAR);

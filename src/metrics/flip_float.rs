@@ -19,14 +19,14 @@
 use rayon::prelude::*;
 
 /// FLIP's constants (paper, Table 1; NVIDIA `FLIPConstants`): colour exponent q_c, cut-off p_c,
-/// remapped cut-off p_t, feature filter width w (degrees), feature exponent q_f.
+/// remapped cut-off p_t, feature filter width w (degrees). The feature exponent q_f = 0.5 is
+/// applied as a square root.
 const GQC: f32 = 0.7;
 const GPC: f32 = 0.4;
 const GPT: f32 = 0.95;
 const GW: f32 = 0.082;
-const GQF: f32 = 0.5;
-/// π as NVIDIA's code holds it (a float literal).
-const PI: f32 = 3.141_592_7;
+/// π in f32, the value NVIDIA's code holds (its literal 3.14159265358979f rounds to it).
+const PI: f32 = std::f32::consts::PI;
 /// Contrast sensitivity Gaussians (paper eq. 2) for the Y, Cx and Cz channels: a₁, b₁, a₂, b₂
 /// (the second Gaussian is used by Cz only).
 const A1: [f32; 3] = [1.0, 1.0, 34.1];
@@ -102,9 +102,11 @@ fn xyz_to_lab(c: [f32; 3]) -> [f32; 3] {
     let delta_cube = delta * delta_sq;
     let factor = 1.0 / (3.0 * delta_sq);
     let term = 4.0f32 / 29.0;
+    // cbrt instead of NVIDIA's powf(v, 1/3): within an ulp, and several times faster; this and
+    // the powers below dominate the cost per pixel.
     let f = |v: f32| {
         if v > delta_cube {
-            v.powf(1.0 / 3.0)
+            v.cbrt()
         } else {
             factor * v + term
         }
@@ -183,9 +185,9 @@ impl Filters {
                 csf_gaussian_sqrt(x2, A1[2], B1[2]),
                 csf_gaussian_sqrt(x2, A2[2], B2[2]),
             ];
-            for k in 0..2 {
-                sum_ycx[k] += t[k];
-                sum_cz[k] += z[k];
+            for ((s, v), (sz, vz)) in sum_ycx.iter_mut().zip(t).zip(sum_cz.iter_mut().zip(z)) {
+                *s += v;
+                *sz += vz;
             }
             ycx.push(t);
             cz.push(z);
@@ -305,8 +307,8 @@ fn x_passes(
     let mut ycxcz: [Vec<f32>; 3] = std::array::from_fn(|_| Vec::with_capacity(n));
     for p in &image[rows.start * w..rows.end * w] {
         let c = xyz_to_ycxcz(linear_rgb_to_xyz(transform(*p)));
-        for k in 0..3 {
-            ycxcz[k].push(c[k]);
+        for (plane, v) in ycxcz.iter_mut().zip(c) {
+            plane.push(v);
         }
     }
     let gray: Vec<f32> = ycxcz[0]
@@ -426,7 +428,7 @@ fn band(
             };
             let de = (edge(&r) - edge(&t)).abs();
             let dp = (point(&r) - point(&t)).abs();
-            let feature = (inv_sqrt2 * de.max(dp)).powf(GQF);
+            let feature = (inv_sqrt2 * de.max(dp)).sqrt();
             let flip = color.powf(1.0 - feature);
             *d = d.max(flip);
         }
