@@ -34,6 +34,24 @@ fn secs(t: Instant) -> f64 {
     t.elapsed().as_secs_f64()
 }
 
+/// CPU seconds (user + system) of this process so far, from /proc/self/stat (Linux; 0 elsewhere).
+/// On a shared machine wall times swing with the load; CPU time measures the work itself.
+fn cpu() -> f64 {
+    let stat = std::fs::read_to_string("/proc/self/stat").unwrap_or_default();
+    let fields: Vec<&str> = stat
+        .rsplit_once(')')
+        .map_or(vec![], |(_, rest)| rest.split_whitespace().collect());
+    // Fields 14 and 15 of the file (utime, stime) are 11 and 12 after the command name, in
+    // USER_HZ = 100 ticks per second.
+    let tick = |i: usize| {
+        fields
+            .get(i)
+            .and_then(|v| v.parse::<f64>().ok())
+            .unwrap_or(0.0)
+    };
+    (tick(11) + tick(12)) / 100.0
+}
+
 /// The former `compare`: SSIM and the error statistics beside FLIP through nv-flip.
 fn compare_before(r: &RgbImage, a: &RgbImage, range: f64) -> f64 {
     let ldr = pgt::metrics::is_ldr(r) && pgt::metrics::is_ldr(a);
@@ -212,25 +230,27 @@ fn compare_4k_timings() {
             flip::flip_hdr(&r, &a, ppd, None).unwrap()
         };
         let t_flip_new = secs(t);
-        let t = Instant::now();
+        let (t, c) = (Instant::now(), cpu());
         compare_before(&r, &a, range);
-        let t_before = secs(t);
+        let (t_before, c_before) = (secs(t), cpu() - c);
         let options = CompareOptions {
             data_range: Some(range),
             ..CompareOptions::default()
         };
-        let t = Instant::now();
+        let (t, c) = (Instant::now(), cpu());
         compare(&r, &a, &options).unwrap();
-        let t_after = secs(t);
+        let (t_after, c_after) = (secs(t), cpu() - c);
         eprintln!(
             "{name} 3840x2160, {threads} threads: SSIM (3 channels) before {t_ssim_old:.2} s, after {t_ssim:.2} s, \
              RMSE/PSNR/abs/rel {t_err:.2} s, FLIP nv-flip 8-bit {t_flip_old:.2} s (mean {:.6}), \
              FLIP float {t_flip_new:.2} s (mean {:.6}), exposures {:?}; \
-             compare before {t_before:.2} s, after {t_after:.2} s: {:.1}x",
+             compare before {t_before:.2} s, after {t_after:.2} s: {:.1}x wall; \
+             CPU {c_before:.2} s before, {c_after:.2} s after: {:.1}x",
             old.mean,
             new.mean,
             new.exposures,
-            t_before / t_after
+            t_before / t_after,
+            c_before / c_after.max(1e-9)
         );
         assert!(t_ssim < 60.0);
     }
