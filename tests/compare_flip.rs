@@ -152,3 +152,69 @@ fn banded_flip_equals_whole_image_flip() {
         assert_eq!(differing, 0, "ppd {ppd}: {differing} pixels differ");
     }
 }
+
+/// Float images that are not 8-bit representable (tests/data/compare/flip_float_vectors.json,
+/// written by scripts/flip_float_vectors.py with flip-evaluator 1.7): pgt's float FLIP must match
+/// flip-evaluator to float rounding — budget 1e-5 on the mean, 1e-4 per pixel (the sRGB encoding
+/// the script applies for flip-evaluator's LDR input and its decoding cost ~1e-7) — while the
+/// former 8-bit path (nv-flip) is printed beside it to show what quantising cost.
+#[test]
+fn float_flip_matches_flip_evaluator_on_float_images() {
+    let dir = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/compare");
+    let doc: serde_json::Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.join("flip_float_vectors.json")).unwrap(),
+    )
+    .unwrap();
+    let ppd = doc["ppd"].as_f64().unwrap() as f32;
+    for case in ["ldr", "hdr"] {
+        let v = &doc[case];
+        let (w, h) = (
+            v["width"].as_u64().unwrap() as u32,
+            v["height"].as_u64().unwrap() as u32,
+        );
+        let image = |key: &str| {
+            let flat: Vec<f32> = v[key]
+                .as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_f64().unwrap() as f32)
+                .collect();
+            RgbImage {
+                width: w,
+                height: h,
+                pixels: flat.chunks(3).map(|c| [c[0], c[1], c[2]]).collect(),
+            }
+        };
+        let (r, a) = (image("reference"), image("approximation"));
+        let (float, eight) = if case == "ldr" {
+            (
+                flip_ldr(&r, &a, ppd).unwrap(),
+                pgt::metrics::flip::flip_ldr_8bit(&r, &a, ppd).unwrap(),
+            )
+        } else {
+            (
+                flip_hdr(&r, &a, ppd, None).unwrap(),
+                flip_hdr_8bit(&r, &a, ppd, None).unwrap(),
+            )
+        };
+        let want = v["mean"].as_f64().unwrap();
+        let map = v["map"].as_array().unwrap();
+        let worst = |f: &pgt::metrics::Flip| {
+            f.map
+                .iter()
+                .zip(map)
+                .map(|(x, y)| (*x as f64 - y.as_f64().unwrap()).abs())
+                .fold(0.0, f64::max)
+        };
+        let (fm, em) = ((float.mean - want).abs(), (eight.mean - want).abs());
+        let (fw, ew) = (worst(&float), worst(&eight));
+        eprintln!(
+            "{case} float images vs flip-evaluator (mean {want:.6}): float FLIP mean off by \
+             {fm:.2e}, worst pixel {fw:.2e}; 8-bit nv-flip mean off by {em:.2e}, worst pixel {ew:.2e}"
+        );
+        assert!(
+            fm < 1e-5 && fw < 1e-4,
+            "{case}: float FLIP off by {fm} (mean), {fw} (pixel)"
+        );
+    }
+}
