@@ -2,7 +2,9 @@
 //! [`Outcome`]; `main` maps it and errors to exit codes 0 / 1 / 2.
 
 pub mod approx;
+pub mod camera;
 pub mod compare;
+pub mod export;
 pub mod gen;
 pub mod info;
 pub mod merge;
@@ -47,6 +49,10 @@ pub enum Command {
     Gen(gen::GenArgs),
     /// Join the parts of a cluster render (`pgt render --tile I/N`) into the whole image.
     Merge(merge::MergeArgs),
+    /// The camera as view and projection matrices per graphics API (OpenGL, Vulkan, WebGPU, Direct3D).
+    Camera(camera::CameraArgs),
+    /// Write the resolved particles (centre, radius, colour, σ, Θmax) as CSV or PLY.
+    Export(export::ExportArgs),
 }
 
 /// Runs the parsed command line.
@@ -59,6 +65,8 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Info(args) => info::run(args),
         Command::Gen(args) => gen::run(args),
         Command::Merge(args) => merge::run(args),
+        Command::Camera(args) => camera::run(args),
+        Command::Export(args) => export::run(args),
     }
 }
 
