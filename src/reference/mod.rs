@@ -176,14 +176,7 @@ pub fn render_with(
             })
             .collect::<Vec<_>>()
     };
-    let results = match options.threads {
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n.max(1))
-            .build()
-            .map_err(|e| PgtError::Usage(format!("cannot start {n} threads: {e}")))?
-            .install(run),
-        None => run(),
-    };
+    let results = with_threads(options.threads, run)?;
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
@@ -252,4 +245,19 @@ pub fn render_pixel(
 #[inline]
 pub fn stored_pixel(radiance: DVec3, error: DVec3) -> ([f32; 3], [f32; 3]) {
     (radiance.as_vec3().to_array(), error.as_vec3().to_array())
+}
+
+/// Runs `work` on a pool of `threads` workers (`--threads`), or on rayon's global pool.
+pub(crate) fn with_threads<T: Send>(
+    threads: Option<usize>,
+    work: impl FnOnce() -> T + Send,
+) -> Result<T> {
+    match threads {
+        Some(n) => Ok(rayon::ThreadPoolBuilder::new()
+            .num_threads(n.max(1))
+            .build()
+            .map_err(|e| PgtError::Usage(format!("cannot start {n} threads: {e}")))?
+            .install(work)),
+        None => Ok(work()),
+    }
 }

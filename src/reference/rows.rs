@@ -58,14 +58,7 @@ pub fn render_rows(scene: &Scene, options: &RenderOptions, rows: &[u32]) -> Resu
             })
             .collect::<Vec<_>>()
     };
-    let results = match options.threads {
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n.max(1))
-            .build()
-            .map_err(|e| PgtError::Usage(format!("cannot start {n} threads: {e}")))?
-            .install(run),
-        None => run(),
-    };
+    let results = super::with_threads(options.threads, run)?;
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
