@@ -298,7 +298,7 @@ fn attribution_splits_the_error_into_causes_whose_shares_add_up() {
     let exp = dir.path().join("exp.toml");
     std::fs::write(
         &exp,
-        "scene = \"disjoint.toml\"\nsize = [32, 24]\nplot_x = \"samples\"\n[[approximations]]\nmethod = \"thesis-cpu\"\nsamples = 4\nn_exact = [1, \"all\"]\n[[approximations]]\nmethod = \"riemann\"\nsamples = 4\n[[attribution]]\nrun = { method = \"thesis-cpu\", samples = 4, n_exact = 1 }\nsteps = [\n    { cause = \"n_exact\", swap = { n_exact = \"all\" } },\n    { cause = \"overlap\", swap = { method = \"riemann\" } },\n    { cause = \"sampling\", swap = \"reference\" },\n]\n",
+        "scene = \"disjoint.toml\"\nsize = [32, 24]\nplot_x = \"samples\"\n[[approximations]]\nmethod = \"thesis-cpu\"\nsamples = 4\nn_exact = [0, \"all\"]\n[[approximations]]\nmethod = \"riemann\"\nsamples = 4\n[[attribution]]\nrun = { method = \"thesis-cpu\", samples = 4, n_exact = 0 }\nsteps = [\n    { cause = \"n_exact\", swap = { n_exact = \"all\" } },\n    { cause = \"overlap\", swap = { method = \"riemann\" } },\n    { cause = \"sampling\", swap = \"reference\" },\n]\n",
     )
     .unwrap();
     let rep = dir.path().join("rep");
@@ -310,7 +310,7 @@ fn attribution_splits_the_error_into_causes_whose_shares_add_up() {
         String::from_utf8_lossy(&o.stderr)
     );
     let a = first_attribution(&rep);
-    assert_eq!(a["run"], "thesis-cpu samples=4 n_exact=1");
+    assert_eq!(a["run"], "thesis-cpu samples=4 n_exact=0");
     let causes = a["causes"].as_array().unwrap();
     let names: Vec<&str> = causes
         .iter()
@@ -324,7 +324,8 @@ fn attribution_splits_the_error_into_causes_whose_shares_add_up() {
     assert!((sum("mse_share") + interaction - 1.0).abs() < 1e-9, "{a}");
     // The particles are disjoint: whole-particle compositing is exact, so the overlap stage
     // (thesis-cpu against the reference with the same Riemann sums) changes nothing but
-    // rounding, while N truncation and sampling do change the image.
+    // rounding, while N truncation (here N = 0: the emission model only) and sampling do change
+    // the image.
     assert!(causes[1]["rmse"].as_f64().unwrap() < 1e-6, "{a}");
     assert!(causes[0]["rmse"].as_f64().unwrap() > 1e-4, "{a}");
     assert!(causes[2]["rmse"].as_f64().unwrap() > 1e-5, "{a}");

@@ -105,7 +105,7 @@ def pct(v, digits=4):
 def cells(d):
     if not d:
         return "<td>—</td>" * 4
-    return "".join("<td>%s</td>" % pct(d[k]) for k in ("R", "G", "B")) + "<td><b>%s</b></td>" % pct(d["mean"])
+    return "".join("<td>%s</td>" % pct(d[k], 3) for k in ("R", "G", "B")) + "<td><b>%s</b></td>" % pct(d["mean"], 4)
 
 
 def table(name, d):
@@ -167,10 +167,10 @@ def section(name, d, side):
 
 
 CSS = """body{font-family:sans-serif;max-width:1300px;margin:1em auto;padding:0 1em;color:#222}
-table{border-collapse:collapse;margin:.5em 0}td,th{border:1px solid #bbb;padding:2px 6px;text-align:right}
+table{border-collapse:collapse;margin:.5em 0;font-size:13px}td,th{border:1px solid #bbb;padding:2px 6px;text-align:right}
 th{background:#eee}.grid{display:flex;flex-wrap:wrap;gap:8px}figure{margin:0}
 figure img{image-rendering:pixelated;max-width:640px}figcaption{font-size:12px;max-width:320px}
-.grid figure img[src$=".png"]{width:256px}"""
+.grid figure img[src$=".png"]{width:256px}.grid figure img[src$=".svg"]{width:620px}"""
 
 
 # The mark the browser test reads (the same script as pgt's own pages, src/report/html.rs).
@@ -220,7 +220,7 @@ def written(data, side):
         scale = (512.0 / side) ** 2
         gpu = sum(t["seconds"] for t in d["timing"] if t["method"] == "thesis")
         ref = d["reference_seconds"]
-        cost.append("%s: the thesis runs ≈ %.0f s of GPU time%s" % (
+        cost.append("%s: the thesis runs ≈ %.0f s of lavapipe time%s" % (
             name, gpu * scale,
             "" if ref is None else ", the reference ≈ %.0f s" % (ref * scale)))
     text = open(os.path.join(HERE, "comparison.html"), encoding="utf-8").read()
