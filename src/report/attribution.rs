@@ -30,8 +30,9 @@ pub fn map_file(a: &AttributionResult, cause: &str) -> String {
     )
 }
 
-/// One horizontal stacked bar at `y`: segments (label, share, colour); negative shares are drawn
-/// hatched-free to the left of 0 so that the bar's extent still shows them.
+/// One horizontal stacked bar at `y`: segments (label, share, colour); negative shares (a
+/// cause whose removal alone makes the image worse, or causes that cancel) are drawn left of
+/// the 0 line, so that they are seen rather than hidden.
 fn bar(svg: &mut String, y: f64, title: &str, segments: &[(String, f64, &str)]) {
     let (x0, width) = (150.0, 600.0);
     let neg: f64 = segments.iter().map(|s| s.1.min(0.0)).sum::<f64>().abs();
