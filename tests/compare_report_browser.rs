@@ -179,7 +179,91 @@ fn sweep_report_loads_in_headless_chromium_with_its_plots() {
         String::from_utf8_lossy(&o.stderr)
     );
     let dom = run_chromium(&exe, &rep.join("index.html"), &["--dump-dom".to_string()]);
-    // Three SVG plots, the reference, and two runs with their error heatmaps.
+    // Four SVG plots (1 − SSIM, RMSE, time, error against time), the reference, and two runs
+    // with their error heatmaps.
     assert!(dom.contains("data-pgt-images=\"ok\""), "{dom}");
-    assert!(dom.contains("data-pgt-image-count=\"8\""), "{dom}");
+    assert!(dom.contains("data-pgt-image-count=\"9\""), "{dom}");
+}
+
+/// Copies the committed report `reports/thesis` (without its caches) into `to`.
+fn copy_report(from: &Path, to: &Path) {
+    std::fs::create_dir_all(to).unwrap();
+    for entry in std::fs::read_dir(from).unwrap() {
+        let entry = entry.unwrap();
+        let path = entry.path();
+        if entry.file_name() == "cache" {
+            continue;
+        }
+        if path.is_dir() {
+            copy_report(&path, &to.join(entry.file_name()));
+        } else {
+            std::fs::copy(&path, to.join(entry.file_name())).unwrap();
+        }
+    }
+}
+
+/// The `src` of every `<img>` of an HTML page.
+fn image_sources(page: &str) -> Vec<String> {
+    page.split("<img src=\"")
+        .skip(1)
+        .filter_map(|s| s.split('"').next().map(str::to_string))
+        .collect()
+}
+
+#[test]
+fn thesis_report_loads_in_headless_chromium_with_every_image_and_plot() {
+    let report = Path::new(env!("CARGO_MANIFEST_DIR")).join("reports/thesis");
+    let page = report.join("index.html");
+    let text = std::fs::read_to_string(&page).expect("reports/thesis/index.html is committed");
+    let sources = image_sources(&text);
+    // Per data set: the four plots (time and error against samples and time, 1 − SSIM
+    // against the GT), the reference and five runs, and the attributions' bars and maps.
+    for set in ["1uun", "random"] {
+        for plot in [
+            "time.svg",
+            "error_time.svg",
+            "dssim.svg",
+            "dssim_baseline.svg",
+        ] {
+            let src = format!("{set}/{plot}");
+            assert!(sources.contains(&src), "{src} is not on the page");
+        }
+        for cause in ["float32", "n_exact", "overlap", "sampling"] {
+            let src = format!("{set}/attribution_thesis_samples_100_n_exact_5_{cause}.png");
+            assert!(sources.contains(&src), "{src} is not on the page");
+        }
+        let bars = format!("{set}/attribution_thesis_samples_100_n_exact_5.svg");
+        assert!(sources.contains(&bars), "{bars} is not on the page");
+    }
+    for src in &sources {
+        assert!(
+            report.join(src).is_file(),
+            "{src} is on the page but not committed"
+        );
+    }
+    let Some(exe) = chromium() else {
+        if in_ci() {
+            panic!("CI is set but chromium is not installed (apt-get install chromium)");
+        }
+        eprintln!("skipping the browser: chromium not installed (CI not set)");
+        return;
+    };
+    let dom = run_chromium(&exe, &page, &["--dump-dom".to_string()]);
+    assert!(dom.contains("data-pgt-images=\"ok\""), "{dom}");
+    let count = format!("data-pgt-image-count=\"{}\"", sources.len());
+    assert!(dom.contains(&count), "expected {count}: {dom}");
+
+    // A missing plot is caught by the same mark (the check can fail).
+    let dir = tempfile::tempdir().unwrap();
+    copy_report(&report, dir.path());
+    std::fs::remove_file(dir.path().join("random/error_time.svg")).unwrap();
+    let dom = run_chromium(
+        &exe,
+        &dir.path().join("index.html"),
+        &["--dump-dom".to_string()],
+    );
+    assert!(
+        dom.contains("data-pgt-images=\"missing\"") && dom.contains("random/error_time.svg"),
+        "{dom}"
+    );
 }

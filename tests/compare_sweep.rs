@@ -283,3 +283,106 @@ fn bad_experiments_exit_2() {
         "{err}"
     );
 }
+
+/// Reads `summary.json`'s first attribution.
+fn first_attribution(rep: &Path) -> serde_json::Value {
+    let summary: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(rep.join("summary.json")).unwrap()).unwrap();
+    summary["attribution"][0].clone()
+}
+
+#[test]
+fn attribution_splits_the_error_into_causes_whose_shares_add_up() {
+    let dir = tempfile::tempdir().unwrap();
+    disjoint_scene(dir.path());
+    let exp = dir.path().join("exp.toml");
+    std::fs::write(
+        &exp,
+        "scene = \"disjoint.toml\"\nsize = [32, 24]\nplot_x = \"samples\"\n[[approximations]]\nmethod = \"thesis-cpu\"\nsamples = 4\nn_exact = [0, \"all\"]\n[[approximations]]\nmethod = \"riemann\"\nsamples = 4\n[[attribution]]\nrun = { method = \"thesis-cpu\", samples = 4, n_exact = 0 }\nsteps = [\n    { cause = \"n_exact\", swap = { n_exact = \"all\" } },\n    { cause = \"overlap\", swap = { method = \"riemann\" } },\n    { cause = \"sampling\", swap = \"reference\" },\n]\n",
+    )
+    .unwrap();
+    let rep = dir.path().join("rep");
+    let o = sweep(&exp, &rep);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let a = first_attribution(&rep);
+    assert_eq!(a["run"], "thesis-cpu samples=4 n_exact=0");
+    let causes = a["causes"].as_array().unwrap();
+    let names: Vec<&str> = causes
+        .iter()
+        .map(|c| c["cause"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["n_exact", "overlap", "sampling"]);
+    // The SSIM shares telescope to exactly 1; the MSE shares plus the interaction are 1.
+    let sum = |key: &str| causes.iter().map(|c| c[key].as_f64().unwrap()).sum::<f64>();
+    assert!((sum("ssim_share") - 1.0).abs() < 1e-9, "{a}");
+    let interaction = a["interaction"].as_f64().unwrap();
+    assert!((sum("mse_share") + interaction - 1.0).abs() < 1e-9, "{a}");
+    // The particles are disjoint: whole-particle compositing is exact, so the overlap stage
+    // (thesis-cpu against the reference with the same Riemann sums) changes nothing but
+    // rounding, while N truncation (here N = 0: the emission model only) and sampling do change
+    // the image.
+    assert!(causes[1]["rmse"].as_f64().unwrap() < 1e-6, "{a}");
+    assert!(causes[0]["rmse"].as_f64().unwrap() > 1e-4, "{a}");
+    assert!(causes[2]["rmse"].as_f64().unwrap() > 1e-5, "{a}");
+    for c in causes {
+        assert!(rep.join(c["map"].as_str().unwrap()).is_file(), "{c}");
+    }
+    let bars = std::fs::read_to_string(rep.join(a["bars"].as_str().unwrap())).unwrap();
+    assert!(
+        bars.starts_with("<svg") && bars.contains("interaction"),
+        "{bars}"
+    );
+    let page = std::fs::read_to_string(rep.join("index.html")).unwrap();
+    assert!(page.contains("Error attribution") && page.contains("SSIM share"));
+    assert!(rep.join("error_time.svg").is_file());
+
+    // A swap to a run the experiment does not list is an error at its line.
+    std::fs::write(
+        &exp,
+        "scene = \"disjoint.toml\"\n[[approximations]]\nmethod = \"thesis-cpu\"\nn_exact = 1\n[[attribution]]\nrun = { method = \"thesis-cpu\", n_exact = 1 }\nsteps = [\n    { cause = \"n_exact\", swap = { n_exact = 2 } },\n]\n",
+    )
+    .unwrap();
+    let o = sweep(&exp, &rep);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("exp.toml:8:") && err.contains("thesis-cpu samples=100 n_exact=2"),
+        "{err}"
+    );
+}
+
+#[test]
+fn thesis_on_the_gpu_differs_from_thesis_cpu_by_float32_rounding_only() {
+    if !have_gpu() {
+        eprintln!("skipping: no GPU adapter");
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    disjoint_scene(dir.path());
+    let exp = dir.path().join("exp.toml");
+    std::fs::write(
+        &exp,
+        "scene = \"disjoint.toml\"\nsize = [32, 24]\n[[approximations]]\nmethod = \"thesis\"\nsamples = 8\nn_exact = [1, \"all\"]\n[[approximations]]\nmethod = \"thesis-cpu\"\nsamples = 8\nn_exact = [1, \"all\"]\n[[attribution]]\nrun = { method = \"thesis\", samples = 8, n_exact = 1 }\nsteps = [{ cause = \"float32\", swap = { method = \"thesis-cpu\" } }]\n",
+    )
+    .unwrap();
+    let rep = dir.path().join("rep");
+    let o = sweep(&exp, &rep);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let a = first_attribution(&rep);
+    let causes = a["causes"].as_array().unwrap();
+    // The chain stops before the reference: the rest is the residual.
+    assert_eq!(causes[1]["cause"], "residual");
+    let float32 = causes[0]["rmse"].as_f64().unwrap();
+    assert!(float32 < 1e-5, "{a}");
+    assert!(causes[1]["rmse"].as_f64().unwrap() > 100.0 * float32, "{a}");
+}

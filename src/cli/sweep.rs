@@ -16,6 +16,9 @@ pub struct SweepArgs {
     /// Folder for the report, the images and the reference cache.
     #[arg(long)]
     pub report: PathBuf,
+    /// Image size WIDTHxHEIGHT, overriding the experiment's `size` and the scene's.
+    #[arg(long, value_parser = super::parse_size)]
+    pub size: Option<(u32, u32)>,
     /// Worker threads for the renders.
     #[arg(long)]
     pub threads: Option<usize>,
@@ -24,7 +27,10 @@ pub struct SweepArgs {
 /// Runs the experiment, printing a line for the reference and one per run on stderr, and
 /// writes the report.
 pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
-    let experiment = Experiment::load(&args.experiment)?;
+    let mut experiment = Experiment::load(&args.experiment)?;
+    if let Some((w, h)) = args.size {
+        experiment.size = Some([w, h]);
+    }
     let scene = load_scene(&experiment)?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");

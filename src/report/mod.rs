@@ -1,6 +1,7 @@
 //! Reports of a comparison (DESIGN.md §5): colour maps and heatmaps with colour bars, the
 //! self-contained HTML page, SVG plots of swept parameters, and the page of a sweep.
 
+pub mod attribution;
 pub mod colormap;
 mod colormap_data;
 pub mod heatmap;

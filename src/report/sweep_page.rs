@@ -1,8 +1,10 @@
 //! The report of a sweep (DESIGN.md §5): error heatmaps on one scale for all runs, SVG plots of
 //! error and time against the swept parameter (the thesis's Figures 6.2/6.3), the HTML page
-//! with the table (the thesis's Tables 6.1/6.2) and `sweep.json`, from a
+//! with the table (the thesis's Tables 6.1/6.2), the error attributions, `sweep.json` and
+//! `summary.json` (size, reference time and threads, adapter, attributions), from a
 //! [`SweepResults`](crate::sweep::SweepResults).
 
+use super::attribution::{attribution_json, attribution_section, write_attribution_files};
 use super::html::{escape, page, write_text};
 use super::plot::{line_plot_svg, PlotSpec, Series};
 use super::summary::{format_db, short};
@@ -34,13 +36,34 @@ pub fn write_sweep_report(dir: &Path, results: &SweepResults) -> Result<PathBuf>
         )
         .write_png(&dir.join(heatmap_file(r)))?;
     }
-    write_plots(dir, &results.runs)?;
+    write_plots(dir, &results.runs, results.plot_x)?;
+    write_attribution_files(dir, &results.attributions, results.width, results.height)?;
     let page_path = dir.join("index.html");
     write_text(&page_path, &sweep_page(results))?;
-    let json = serde_json::to_string_pretty(&sweep_json(&results.runs))
-        .map_err(|e| PgtError::io(dir.join("sweep.json"), std::io::Error::other(e)))?;
-    write_text(&dir.join("sweep.json"), &(json + "\n"))?;
+    write_json(dir, "sweep.json", &sweep_json(&results.runs))?;
+    write_json(dir, "summary.json", &summary_json(results))?;
     Ok(page_path)
+}
+
+/// Writes `value` as pretty JSON to `dir/name`.
+fn write_json(dir: &Path, name: &str, value: &serde_json::Value) -> Result<()> {
+    let json = serde_json::to_string_pretty(value)
+        .map_err(|e| PgtError::io(dir.join(name), std::io::Error::other(e)))?;
+    write_text(&dir.join(name), &(json + "\n"))
+}
+
+/// `summary.json`: what the sweep ran on (size, reference time and threads, adapter) and the
+/// error attributions; the runs are in `sweep.json`.
+fn summary_json(results: &SweepResults) -> serde_json::Value {
+    serde_json::json!({
+        "experiment": results.experiment.display().to_string(),
+        "scene": results.scene.display().to_string(),
+        "size": [results.width, results.height],
+        "reference_seconds": results.reference.seconds,
+        "threads": results.threads,
+        "adapter": results.adapter,
+        "attribution": attribution_json(&results.attributions),
+    })
 }
 
 /// The run's |a − r| heatmap.
@@ -48,9 +71,13 @@ fn heatmap_file(r: &RunResult) -> String {
     format!("{}_abs_error.png", r.run.file_stem())
 }
 
-/// The plots' x axis: the parameter with the most distinct values over all runs (ties: the one
-/// named first), e.g. `samples` for the thesis's Figures 6.2/6.3.
-fn x_parameter(runs: &[RunResult]) -> &'static str {
+/// The plots' x axis: the experiment's `plot_x`, else the parameter with the most distinct
+/// values over all runs (ties: the one named first), e.g. `samples` for the thesis's Figures
+/// 6.2/6.3.
+fn x_parameter(runs: &[RunResult], plot_x: Option<&'static str>) -> &'static str {
+    if let Some(x) = plot_x {
+        return x;
+    }
     let mut names: Vec<&'static str> = Vec::new();
     let mut values: BTreeMap<&'static str, BTreeSet<ParamValue>> = BTreeMap::new();
     for r in runs {
@@ -78,8 +105,8 @@ struct XAxis {
 }
 
 impl XAxis {
-    fn of(runs: &[RunResult]) -> XAxis {
-        let name = x_parameter(runs);
+    fn of(runs: &[RunResult], plot_x: Option<&'static str>) -> XAxis {
+        let name = x_parameter(runs, plot_x);
         let values: BTreeSet<ParamValue> = runs.iter().filter_map(|r| r.run.param(name)).collect();
         let categories = values
             .contains(&ParamValue::All)
@@ -128,9 +155,54 @@ fn all_positive(series: &[Series]) -> bool {
     series.iter().all(|s| s.points.iter().any(|p| p.1 > 0.0))
 }
 
-/// `dssim.svg`, `rmse.svg`, `time.svg`, and `dssim_baseline.svg` where runs have baselines.
-fn write_plots(dir: &Path, runs: &[RunResult]) -> Result<()> {
-    let x = XAxis::of(runs);
+/// The error-against-time plot's series: one per method and combination of the parameters
+/// other than `x`, each point (time, 1 − SSIM) of one run.
+fn error_time_series(runs: &[RunResult], x: &str) -> Vec<Series> {
+    let mut groups: BTreeMap<String, Vec<(f64, f64)>> = BTreeMap::new();
+    for r in runs {
+        let Some(s) = r.comparison.ssim_values() else {
+            continue;
+        };
+        let mut label = r.run.method.to_string();
+        for (k, v) in r.run.params.iter().filter(|(k, _)| *k != x) {
+            let _ = write!(label, " {k}={v}");
+        }
+        groups
+            .entry(label)
+            .or_default()
+            .push((r.seconds, 1.0 - s.mean));
+    }
+    groups
+        .into_iter()
+        .map(|(label, points)| Series { label, points })
+        .collect()
+}
+
+/// `error_time.svg`: 1 − SSIM against the render time, the trade-off the thesis's Figures
+/// 6.2/6.3 show only one side of.
+fn write_error_time_plot(dir: &Path, runs: &[RunResult], x: &str) -> Result<()> {
+    let series = error_time_series(runs, x);
+    let positive = |v: f64| v > 0.0;
+    let log = series
+        .iter()
+        .all(|s| s.points.iter().all(|p| positive(p.0) && positive(p.1)));
+    let title = format!("1 − SSIM against render time (points along {x})");
+    let spec = PlotSpec {
+        title: &title,
+        x_label: "seconds",
+        y_label: "1 − SSIM",
+        log_x: log,
+        log_y: log,
+        x_categories: None,
+    };
+    line_plot_svg(&dir.join("error_time.svg"), &spec, &series)
+}
+
+/// `dssim.svg`, `rmse.svg`, `time.svg`, `error_time.svg`, and `dssim_baseline.svg` where runs
+/// have baselines.
+fn write_plots(dir: &Path, runs: &[RunResult], plot_x: Option<&'static str>) -> Result<()> {
+    let x = XAxis::of(runs, plot_x);
+    write_error_time_plot(dir, runs, x.name)?;
     let categories = x.labels();
     let plot = |file: &str, title: String, y_label: &str, log_y: bool, series: &[Series]| {
         let spec = PlotSpec {
@@ -209,6 +281,19 @@ fn sweep_page(results: &SweepResults) -> String {
             Some(s) => format!("rendered in {s:.2} s"),
         }
     );
+    let _ = writeln!(
+        b,
+        "<p>{}×{} pixels; CPU renders on {} threads; GPU runs on {}.</p>",
+        results.width,
+        results.height,
+        results.threads,
+        escape(
+            results
+                .adapter
+                .as_deref()
+                .unwrap_or("no adapter (no GPU run)")
+        )
+    );
     b += "<h2>SSIM per channel (as the thesis's Tables 6.1/6.2, in %)</h2>\n<table><tr><th>run</th><th>R</th><th>G</th><th>B</th><th>mean</th><th>RMSE</th><th>PSNR</th><th>FLIP</th><th>time (s)</th></tr>\n";
     for r in &results.runs {
         let cmp = &r.comparison;
@@ -249,6 +334,7 @@ fn sweep_page(results: &SweepResults) -> String {
         ("dssim.svg", "1 − SSIM"),
         ("rmse.svg", "RMSE"),
         ("time.svg", "time"),
+        ("error_time.svg", "1 − SSIM against time"),
     ];
     if results.runs.iter().any(|r| r.baseline.is_some()) {
         plots.push(("dssim_baseline.svg", "1 − SSIM against the baseline"));
@@ -256,7 +342,9 @@ fn sweep_page(results: &SweepResults) -> String {
     for (f, t) in plots {
         let _ = writeln!(b, "<div class=\"plot\"><img src=\"{f}\" alt=\"{t}\"></div>");
     }
-    b += "</div>\n<h2>Images</h2>\n<div class=\"grid\">\n<figure><img src=\"reference.png\" alt=\"reference\"><figcaption><b>reference</b></figcaption></figure>\n";
+    b += "</div>\n";
+    b += &attribution_section(&results.attributions);
+    b += "<h2>Images</h2>\n<div class=\"grid\">\n<figure><img src=\"reference.png\" alt=\"reference\"><figcaption><b>reference</b></figcaption></figure>\n";
     for r in &results.runs {
         let label = escape(&r.run.label());
         let _ = writeln!(

@@ -20,6 +20,25 @@ struct ExperimentFile {
     #[serde(default)]
     reference: ReferenceSpec,
     approximations: Vec<BTreeMap<Spanned<String>, Spanned<toml::Value>>>,
+    plot_x: Option<Spanned<String>>,
+    #[serde(default)]
+    attribution: Vec<AttributionFile>,
+}
+
+/// An `[[attribution]]` table as TOML sees it.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AttributionFile {
+    run: Spanned<toml::Value>,
+    steps: Vec<StepFile>,
+}
+
+/// One `{ cause = "…", swap = { … } | "reference" }` of an attribution's `steps`.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct StepFile {
+    cause: String,
+    swap: Spanned<toml::Value>,
 }
 
 /// Options of the one reference render.
@@ -44,6 +63,30 @@ pub struct Experiment {
     pub reference: ReferenceSpec,
     /// Every run of every entry, in file order.
     pub runs: Vec<Run>,
+    /// The parameter on the plots' x axis (`plot_x`); `None`: the one with the most values.
+    pub plot_x: Option<&'static str>,
+    /// The error attributions (`[[attribution]]`), in file order.
+    pub attributions: Vec<Attribution>,
+}
+
+/// An error attribution (`[[attribution]]`): a run, and a chain of runs each with one more
+/// stage swapped for its exact counterpart, ending at the reference (or not: what is left is
+/// then the `residual` cause).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Attribution {
+    /// The index in [`Experiment::runs`] of the run explained.
+    pub run: usize,
+    pub steps: Vec<AttributionStep>,
+}
+
+/// One stage swap of an attribution: the cause it removes and the run without it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AttributionStep {
+    /// The cause's name (`overlap`, `sampling`, `n_exact`, `float32`, …).
+    pub cause: String,
+    /// The index of the run with this stage (and the ones before) exact; `None`: the exact
+    /// reference.
+    pub run: Option<usize>,
 }
 
 /// One parameter combination of one method.
@@ -130,6 +173,16 @@ impl Experiment {
             ));
         }
         resolve_baselines(&at, &entries, ref_spp, &mut runs)?;
+        let attributions = file
+            .attribution
+            .iter()
+            .map(|a| at.attribution(a, &runs, ref_spp))
+            .collect::<Result<Vec<_>>>()?;
+        let plot_x = file
+            .plot_x
+            .as_ref()
+            .map(|x| at.plot_x(x, &runs))
+            .transpose()?;
         let base = path.parent().unwrap_or(Path::new("."));
         Ok(Experiment {
             path: path.to_path_buf(),
@@ -138,6 +191,8 @@ impl Experiment {
             data_range: file.data_range,
             reference: file.reference,
             runs,
+            plot_x,
+            attributions,
         })
     }
 }
@@ -384,6 +439,89 @@ impl Place<'_> {
     }
 }
 
+impl Place<'_> {
+    /// `plot_x = "NAME"`: a parameter of at least one run.
+    fn plot_x(&self, x: &Spanned<String>, runs: &[Run]) -> Result<&'static str> {
+        runs.iter()
+            .flat_map(|r| r.params.iter().map(|(k, _)| *k))
+            .find(|k| *k == x.get_ref())
+            .ok_or_else(|| {
+                self.error(
+                    self.line(x),
+                    format!("plot_x: no run has a parameter '{}'", x.get_ref()),
+                )
+            })
+    }
+
+    /// The index of `target` among `runs`, or an error at `line` saying what to add.
+    fn find_run(&self, runs: &[Run], target: &Run, line: usize, what: &str) -> Result<usize> {
+        runs.iter()
+            .position(|r| r.method == target.method && r.params == target.params)
+            .ok_or_else(|| {
+                self.error(
+                    line,
+                    format!(
+                        "{what} is `{}`, which is not one of the experiment's runs; list it in an [[approximations]] entry",
+                        target.label()
+                    ),
+                )
+            })
+    }
+
+    /// An `[[attribution]]` table: `run = { method = …, … }` and its chain of `steps`, each
+    /// swap applied to the previous run as a `baseline` is (see [`baseline_run`]).
+    fn attribution(&self, a: &AttributionFile, runs: &[Run], ref_spp: u32) -> Result<Attribution> {
+        let line = self.line(&a.run);
+        let has_method = a
+            .run
+            .get_ref()
+            .as_table()
+            .is_some_and(|t| t.contains_key("method"));
+        if !has_method {
+            return Err(self.error(
+                line,
+                "attribution: `run` must be a table naming the method, e.g. run = { method = \"thesis\", n_exact = 5 }".into(),
+            ));
+        }
+        let any: &'static dyn SweepMethod = &super::riemann::RIEMANN;
+        let spec = self.baseline(any, &a.run)?;
+        let empty = Run {
+            method: spec.method.name(),
+            params: Vec::new(),
+            baseline: None,
+        };
+        let mut current = baseline_run(&empty, &spec, ref_spp);
+        let first = self.find_run(runs, &current, line, "the attributed run")?;
+        let mut steps = Vec::new();
+        for (i, step) in a.steps.iter().enumerate() {
+            let line = self.line(&step.swap);
+            if step.swap.get_ref().as_str() == Some("reference") {
+                if i + 1 != a.steps.len() {
+                    return Err(self.error(
+                        line,
+                        "attribution: swap = \"reference\" ends the chain; it must be the last step".into(),
+                    ));
+                }
+                steps.push(AttributionStep {
+                    cause: step.cause.clone(),
+                    run: None,
+                });
+                break;
+            }
+            let method = find_method(current.method).unwrap_or(any);
+            let spec = self.baseline(method, &step.swap)?;
+            current = baseline_run(&current, &spec, ref_spp);
+            let what = format!("the run without {}", step.cause);
+            let run = self.find_run(runs, &current, line, &what)?;
+            steps.push(AttributionStep {
+                cause: step.cause.clone(),
+                run: Some(run),
+            });
+        }
+        Ok(Attribution { run: first, steps })
+    }
+}
+
 /// One value of parameter `p`: a count ≥ `p.min`, or `"all"` where `p` accepts it.
 fn one_value(p: &SweepParam, v: &toml::Value) -> std::result::Result<ParamValue, String> {
     let expected = || {
@@ -467,7 +605,10 @@ mod tests {
             err.starts_with("dir/exp.toml:3: unknown method \"magic\""),
             "{err}"
         );
-        assert!(err.contains("riemann, emission, opaque, thesis"), "{err}");
+        assert!(
+            err.contains("riemann, thesis-cpu, emission, opaque, thesis"),
+            "{err}"
+        );
         let err = parse("scene = \"s.toml\"\n[[approximations]]\nmethod = \"riemann\"\nsamples = [1]\nsample = [1]\n").unwrap_err().to_string();
         assert!(err.starts_with("dir/exp.toml:5: method riemann has no parameter 'sample'; its parameters are samples, spp"), "{err}");
         let err = parse("scene = \"s.toml\"\n[[approximations]]\nsamples = [1]\n")
@@ -504,6 +645,57 @@ mod tests {
         .to_string();
         assert!(
             err.contains("exp.toml:4:") && err.contains("no parameter 'n'"),
+            "{err}"
+        );
+    }
+
+    const CHAIN_RUNS: &str = "scene = \"s.toml\"\nplot_x = \"samples\"\n[[approximations]]\nmethod = \"thesis\"\nn_exact = [5, \"all\"]\n[[approximations]]\nmethod = \"thesis-cpu\"\nn_exact = [5, \"all\"]\n[[approximations]]\nmethod = \"riemann\"\n";
+
+    #[test]
+    fn attributions_are_chains_of_the_experiments_runs() {
+        let text = format!("{CHAIN_RUNS}[[attribution]]\nrun = {{ method = \"thesis\", n_exact = 5 }}\nsteps = [\n  {{ cause = \"float32\", swap = {{ method = \"thesis-cpu\" }} }},\n  {{ cause = \"n_exact\", swap = {{ n_exact = \"all\" }} }},\n  {{ cause = \"overlap\", swap = {{ method = \"riemann\" }} }},\n  {{ cause = \"sampling\", swap = \"reference\" }},\n]\n");
+        let e = parse(&text).unwrap();
+        assert_eq!(e.plot_x, Some("samples"));
+        // Runs: thesis 5, thesis all, thesis-cpu 5, thesis-cpu all, riemann.
+        let a = &e.attributions[0];
+        assert_eq!(a.run, 0);
+        let chain: Vec<(&str, Option<usize>)> =
+            a.steps.iter().map(|s| (s.cause.as_str(), s.run)).collect();
+        assert_eq!(
+            chain,
+            vec![
+                ("float32", Some(2)),
+                ("n_exact", Some(3)),
+                ("overlap", Some(4)),
+                ("sampling", None)
+            ]
+        );
+        let err = parse(&format!("{CHAIN_RUNS}[[attribution]]\nrun = {{ method = \"thesis\", n_exact = 3 }}\nsteps = []\n")).unwrap_err().to_string();
+        assert!(
+            err.starts_with(
+                "dir/exp.toml:12: the attributed run is `thesis samples=100 n_exact=3`"
+            ),
+            "{err}"
+        );
+        let err = parse(&format!("{CHAIN_RUNS}[[attribution]]\nrun = {{ method = \"thesis\", n_exact = 5 }}\nsteps = [{{ cause = \"x\", swap = \"reference\" }}, {{ cause = \"y\", swap = {{ n_exact = 1 }} }}]\n")).unwrap_err().to_string();
+        assert!(
+            err.contains("exp.toml:13:") && err.contains("must be the last step"),
+            "{err}"
+        );
+        let err = parse(&format!(
+            "{CHAIN_RUNS}[[attribution]]\nrun = {{ n_exact = 5 }}\nsteps = []\n"
+        ))
+        .unwrap_err()
+        .to_string();
+        assert!(
+            err.contains("exp.toml:12:") && err.contains("naming the method"),
+            "{err}"
+        );
+        let err = parse(&CHAIN_RUNS.replace("plot_x = \"samples\"", "plot_x = \"spp2\""))
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.starts_with("dir/exp.toml:2: plot_x: no run has a parameter 'spp2'"),
             "{err}"
         );
     }

@@ -97,6 +97,16 @@ impl SweepContext {
         SweepContext { threads, gpu: None }
     }
 
+    /// The adapter's name, once a GPU run opened the context.
+    pub fn adapter_name(&self) -> Option<String> {
+        self.gpu.as_ref().map(|g| {
+            format!(
+                "{} ({}, {})",
+                g.adapter.name, g.adapter.backend, g.adapter.device_type
+            )
+        })
+    }
+
     /// The GPU context, opened on first use (on the first adapter wgpu finds).
     pub fn gpu(&mut self) -> Result<&GpuContext> {
         let gpu = match self.gpu.take() {
@@ -139,10 +149,16 @@ pub fn value_of(values: &[(&'static str, u32)], name: &str, default: u32) -> u32
         .map_or(default, |(_, v)| *v)
 }
 
-/// The method named `name`: the CPU `riemann`, then every method of the approximation registry.
+/// The CPU methods: `riemann` and `thesis-cpu`.
+fn cpu_methods() -> [&'static dyn SweepMethod; 2] {
+    [&super::riemann::RIEMANN, &super::thesis_cpu::THESIS_CPU]
+}
+
+/// The method named `name`: the CPU methods (`riemann`, `thesis-cpu`), then every method of
+/// the approximation registry.
 pub fn find_method(name: &str) -> Option<&'static dyn SweepMethod> {
-    if name == super::riemann::RIEMANN.name() {
-        return Some(&super::riemann::RIEMANN);
+    if let Some(m) = cpu_methods().into_iter().find(|m| m.name() == name) {
+        return Some(m);
     }
     super::gpu::gpu_methods()
         .iter()
@@ -152,7 +168,9 @@ pub fn find_method(name: &str) -> Option<&'static dyn SweepMethod> {
 
 /// The names [`find_method`] knows, for error messages and docs.
 pub fn method_names() -> Vec<&'static str> {
-    std::iter::once(super::riemann::RIEMANN.name())
+    cpu_methods()
+        .into_iter()
+        .map(|m| m.name())
         .chain(super::gpu::gpu_methods().iter().map(|m| m.name()))
         .collect()
 }

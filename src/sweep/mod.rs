@@ -11,6 +11,7 @@
 //! scene = "scene.toml"        # relative to the experiment file
 //! size = [256, 256]           # optional: overrides the scene's image size
 //! data_range = 1.0            # optional: SSIM/PSNR data range (default as in `pgt compare`)
+//! plot_x = "samples"          # optional: the plots' x axis (default: the most varied parameter)
 //!
 //! [reference]                 # optional: the one reference render
 //! spp = 1
@@ -26,9 +27,22 @@
 //! samples = 100               # one value or a list
 //! n_exact = [1, 2, 3, 5, "all"]
 //! baseline = { n_exact = "all" }
+//!
+//! [[approximations]]
+//! method = "thesis-cpu"       # the same scheme in f64 on the CPU (for the float32 stage)
+//! n_exact = [5, "all"]
+//!
+//! [[attribution]]             # optional: split a run's error into causes (DESIGN.md §5)
+//! run = { method = "thesis", samples = 100, n_exact = 5 }
+//! steps = [
+//!     { cause = "float32",  swap = { method = "thesis-cpu" } },
+//!     { cause = "n_exact",  swap = { n_exact = "all" } },
+//!     { cause = "overlap",  swap = { method = "riemann" } },
+//!     { cause = "sampling", swap = "reference" },
+//! ]
 //! ```
 //!
-//! * `method` names any method of [`find_method`]: `riemann` (CPU), and every GPU method of the
+//! * `method` names any method of [`find_method`]: `riemann` and `thesis-cpu` (CPU), and every GPU method of the
 //!   approximation registry (`pgt approx --list-methods`); every other key is one of the method's parameters, with one value or a
 //!   list of values (whole numbers, or `"all"` where the parameter allows it: `n_exact`).
 //!   A parameter an entry does not list takes its default (the table in `riemann.rs`, and each
@@ -43,17 +57,31 @@
 //!   experiment's runs (an error at the `baseline` line otherwise). With the example above,
 //!   `thesis samples=100 n_exact=2` is compared with `thesis samples=100 n_exact=all`. The
 //!   comparison with the exact reference is always made too.
+//! * `[[attribution]]` explains the error of `run` (one of the experiment's runs, named by its
+//!   method and parameters; unlisted parameters take their defaults) by a chain of stage swaps:
+//!   each step's `swap` is applied to the previous step's run the way a `baseline` table is
+//!   (method and parameters replaced, the rest kept), and must name a run of the experiment;
+//!   `swap = "reference"` ends the chain at the exact reference (a chain that stops earlier
+//!   gets a `residual` cause for the rest). Any method works whose stages have exact
+//!   counterparts among the sweep's methods and parameters. For `thesis`: `float32` (the same
+//!   scheme in f64, `thesis-cpu`), `n_exact` (N = all), `overlap` (exact intervals instead of
+//!   whole particles in entry order: `riemann`, the reference with the same Riemann sums) and
+//!   `sampling` (the adaptive quadrature: the reference). What a cause's share means, and how
+//!   the interaction is reported, is in [`attribution`].
 //!
 //! The GPU methods run on the first adapter wgpu finds, one context for the whole sweep; their
 //! time is the GPU time, the CPU methods' the wall time.
 
+pub mod attribution;
 pub mod experiment;
 pub mod gpu;
 pub mod method;
 pub mod riemann;
 pub mod runner;
+pub mod thesis_cpu;
 
-pub use experiment::{Experiment, ReferenceSpec, Run};
+pub use attribution::{AttributionResult, CauseResult};
+pub use experiment::{Attribution, AttributionStep, Experiment, ReferenceSpec, Run};
 pub use method::{
     find_method, method_names, ParamDefault, ParamValue, RunImage, SweepContext, SweepMethod,
     SweepParam,

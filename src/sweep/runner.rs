@@ -3,6 +3,7 @@
 //! compared with the reference and, where the run names one, with its baseline run. Writes the
 //! images (`reference.png`, one PNG per run); the page, plots and JSON are `report::sweep_page`'s.
 
+use super::attribution::{attribute, AttributionResult};
 use super::experiment::{Experiment, Run};
 use super::method::{find_method, SweepContext, SweepMethod};
 use crate::error::{PgtError, Result};
@@ -69,6 +70,14 @@ pub struct SweepResults {
     pub width: u32,
     pub height: u32,
     pub runs: Vec<RunResult>,
+    /// The experiment's `plot_x`.
+    pub plot_x: Option<&'static str>,
+    /// The experiment's error attributions.
+    pub attributions: Vec<AttributionResult>,
+    /// The adapter of the GPU runs (`None`: no GPU run).
+    pub adapter: Option<String>,
+    /// Worker threads of the CPU renders (the reference's among them).
+    pub threads: usize,
 }
 
 /// What [`run_sweep`] reports while it works (the CLI prints one line each).
@@ -183,7 +192,11 @@ pub fn run_sweep(
         )
         .map_err(|e| e.context(run.label()))?;
         progress(Progress::Run(&result));
-        if run.baseline.is_some() || exp.runs.iter().any(|r| r.baseline == Some(i)) {
+        let in_chain = exp
+            .attributions
+            .iter()
+            .any(|a| a.run == i || a.steps.iter().any(|s| s.run == Some(i)));
+        if in_chain || run.baseline.is_some() || exp.runs.iter().any(|r| r.baseline == Some(i)) {
             kept[i] = Some(image);
         }
         runs.push(result);
@@ -202,6 +215,11 @@ pub fn run_sweep(
             comparison,
         });
     }
+    let attributions = exp
+        .attributions
+        .iter()
+        .map(|a| attribute(exp, a, &kept, &runs, &reference_image, &compare_options))
+        .collect::<Result<Vec<_>>>()?;
     Ok(SweepResults {
         experiment: exp.path.clone(),
         scene: exp.scene.clone(),
@@ -209,6 +227,10 @@ pub fn run_sweep(
         width: reference_image.width,
         height: reference_image.height,
         runs,
+        plot_x: exp.plot_x,
+        attributions,
+        adapter: ctx.adapter_name(),
+        threads: options.threads.unwrap_or_else(rayon::current_num_threads),
     })
 }
 
