@@ -2,6 +2,7 @@
 //! [`Outcome`]; `main` maps it and errors to exit codes 0 / 1 / 2.
 
 pub mod approx;
+pub mod bench;
 pub mod compare;
 pub mod gen;
 pub mod info;
@@ -44,6 +45,8 @@ pub enum Command {
     Info(info::InfoArgs),
     /// Generate synthetic data sets (`pgt gen random`).
     Gen(gen::GenArgs),
+    /// The speed of the reference on standard workloads, as one table of ratios.
+    Bench(bench::BenchArgs),
 }
 
 /// Runs the parsed command line.
@@ -55,6 +58,7 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Sweep(args) => sweep::run(args),
         Command::Info(args) => info::run(args),
         Command::Gen(args) => gen::run(args),
+        Command::Bench(args) => bench::run(args),
     }
 }
 
