@@ -88,6 +88,9 @@ struct Row {
     size: u32,
     spheres: usize,
     out: RenderOutput,
+    /// Wall seconds of the whole render, BVH build included (`out.stats.seconds` is the
+    /// pixels alone).
+    wall: f64,
     /// Seconds of the Riemann-100 and emission renders of the same scene, where run.
     riemann: Option<f64>,
     emission: Option<f64>,
@@ -120,7 +123,8 @@ fn render(
     integrator: Integrator,
     tol: f64,
     threads: Option<usize>,
-) -> anyhow::Result<RenderOutput> {
+) -> anyhow::Result<(RenderOutput, f64)> {
+    let start = std::time::Instant::now();
     let mut s = scene.clone();
     if let Some(m) = model {
         s.render.model = m;
@@ -132,18 +136,20 @@ fn render(
         progress: false,
         integrator,
     };
-    Ok(reference::render(&s, &options)?)
+    let out = reference::render(&s, &options)?;
+    Ok((out, start.elapsed().as_secs_f64()))
 }
 
 /// The rows of one workload: adaptive, and (unless skipped) Riemann-100 and emission.
 fn bench_scene(name: &str, scene: &Scene, args: &BenchArgs) -> anyhow::Result<Vec<Row>> {
     let threads = args.threads;
-    let row = |renderer: &str, out: RenderOutput| Row {
+    let row = |renderer: &str, (out, wall): (RenderOutput, f64)| Row {
         workload: name.to_string(),
         renderer: renderer.to_string(),
         size: args.size,
         spheres: scene.particles.len(),
         out,
+        wall,
         riemann: None,
         emission: None,
         max_error: None,
@@ -173,12 +179,12 @@ fn bench_scene(name: &str, scene: &Scene, args: &BenchArgs) -> anyhow::Result<Ve
                 threads,
             )?,
         );
-        adaptive.riemann = Some(riemann.out.stats.seconds);
-        adaptive.emission = Some(emission.out.stats.seconds);
-        riemann.riemann = Some(riemann.out.stats.seconds);
-        riemann.emission = Some(emission.out.stats.seconds);
+        adaptive.riemann = Some(riemann.wall);
+        adaptive.emission = Some(emission.wall);
+        riemann.riemann = Some(riemann.wall);
+        riemann.emission = Some(emission.wall);
         if args.accuracy {
-            let truth = render(scene, None, Integrator::Adaptive, TRUTH_TOL, threads)?;
+            let (truth, _) = render(scene, None, Integrator::Adaptive, TRUTH_TOL, threads)?;
             adaptive.max_error = Some(max_difference(&adaptive.out, &truth));
             riemann.max_error = Some(max_difference(&riemann.out, &truth));
         }
@@ -319,12 +325,13 @@ fn table(rows: &[Row]) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{:<18} {:<18} {:>5} {:>9} {:>9} {:>10} {:>8} {:>9} {:>9} {:>10} {:>10}",
+        "{:<18} {:<18} {:>5} {:>9} {:>9} {:>8} {:>10} {:>8} {:>9} {:>9} {:>10} {:>10}",
         "workload",
         "renderer",
         "size",
         "spheres",
         "time s",
+        "setup s",
         "shadow/px",
         "Mrays/s",
         "/riemann",
@@ -336,19 +343,18 @@ fn table(rows: &[Row]) -> String {
         let st = &r.out.stats;
         let rays = st.primary_rays + st.shadow_rays;
         let ratio = |base: Option<f64>| {
-            base.map_or("-".to_string(), |b| {
-                format!("{:.3}", st.seconds / b.max(1e-9))
-            })
+            base.map_or("-".to_string(), |b| format!("{:.3}", r.wall / b.max(1e-9)))
         };
         let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.2e}"));
         let _ = writeln!(
             s,
-            "{:<18} {:<18} {:>5} {:>9} {:>9.2} {:>10.1} {:>8.2} {:>9} {:>9} {:>10} {:>10}",
+            "{:<18} {:<18} {:>5} {:>9} {:>9.2} {:>8.2} {:>10.1} {:>8.2} {:>9} {:>9} {:>10} {:>10}",
             r.workload,
             r.renderer,
             r.size,
             r.spheres,
-            st.seconds,
+            r.wall,
+            r.wall - st.seconds,
             st.shadow_rays as f64 / st.pixels.max(1) as f64,
             rays as f64 / st.seconds.max(1e-9) / 1e6,
             ratio(r.riemann),
@@ -356,6 +362,11 @@ fn table(rows: &[Row]) -> String {
             opt(st.max_error),
             opt(r.max_error),
         );
+    }
+    for r in rows {
+        if let Some(w) = super::render::unconverged_warning(&r.out.stats, TOL) {
+            let _ = writeln!(s, "warning: {} {}: {w}", r.workload, r.renderer);
+        }
     }
     if let Some(mib) = peak_memory_mib() {
         let _ = writeln!(s, "peak resident memory {mib:.0} MiB");

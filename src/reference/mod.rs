@@ -4,6 +4,7 @@
 pub mod opaque;
 pub mod quadrature;
 pub mod riemann;
+pub mod shadow;
 pub mod volume;
 
 use crate::error::{PgtError, Result};
@@ -23,6 +24,9 @@ pub struct Sample {
     pub error: DVec3,
     /// Shadow rays traced for this sample (for the rays-per-second figure).
     pub shadow_rays: u64,
+    /// The quadrature stopped before reaching `tol` (segment cap, or a segment that cannot be
+    /// split in f64, e.g. a ray through a point light inside gas): `error` is what it reached.
+    pub unconverged: bool,
 }
 
 /// Something that computes the radiance along camera rays: one per mode/model.
@@ -77,6 +81,10 @@ pub struct RenderStats {
     /// Largest and mean per-pixel, per-channel error estimate (`None` without estimates).
     pub max_error: Option<f64>,
     pub mean_error: Option<f64>,
+    /// Pixels where a sample did not reach `tol` (DESIGN.md §3: reported, not hidden).
+    pub unconverged: u64,
+    /// The unconverged pixel with the largest error estimate: (x, y, its largest channel).
+    pub worst_unconverged: Option<(u32, u32, f64)>,
 }
 
 /// A finished reference render.
@@ -156,6 +164,7 @@ pub fn render_with(
                     for px in tx * TILE..((tx + 1) * TILE).min(w) {
                         let mut radiance = DVec3::ZERO;
                         let mut error = DVec3::ZERO;
+                        let mut unconverged = false;
                         for sy in 0..k {
                             for sx in 0..k {
                                 let x = px as f64 + (sx as f64 + 0.5) / k as f64;
@@ -164,9 +173,10 @@ pub fn render_with(
                                 radiance += s.radiance;
                                 error += s.error;
                                 shadow_rays += s.shadow_rays;
+                                unconverged |= s.unconverged;
                             }
                         }
-                        out.push((px, py, radiance * inv_n, error * inv_n));
+                        out.push((px, py, radiance * inv_n, error * inv_n, unconverged));
                     }
                 }
                 if let Some(bar) = &bar {
@@ -190,12 +200,24 @@ pub fn render_with(
     let mut image = RgbImage::new(w, h);
     let mut err_image = RgbImage::new(w, h);
     let mut shadow_rays = 0;
+    let mut unconverged = 0;
+    let mut worst_unconverged: Option<(u32, u32, f64)> = None;
     for (tile, rays) in results {
         shadow_rays += rays;
-        for (px, py, rad, err) in tile {
+        for (px, py, rad, err, not_converged) in tile {
             let i = py as usize * w as usize + px as usize;
-            image.pixels[i] = rad.as_vec3().to_array();
-            err_image.pixels[i] = err.as_vec3().to_array();
+            let stored = rad.as_vec3();
+            image.pixels[i] = stored.to_array();
+            err_image.pixels[i] = stored_error(rad, stored, err);
+            if not_converged {
+                unconverged += 1;
+                let e = err.max_element();
+                // Ties keep the first in row-major order: the same for any thread count.
+                if worst_unconverged.is_none_or(|(x, y, w)| e > w || (e == w && (py, px) < (y, x)))
+                {
+                    worst_unconverged = Some((px, py, e));
+                }
+            }
         }
     }
     let pixels = w as u64 * h as u64;
@@ -216,6 +238,31 @@ pub fn render_with(
             seconds: start.elapsed().as_secs_f64(),
             max_error,
             mean_error,
+            unconverged,
+            worst_unconverged,
         },
     })
+}
+
+/// The `err` value stored for a pixel (DESIGN.md §3: err bounds |stored − true|): the estimate
+/// plus the rounding of the f64 radiance to the stored f32 (|f32(L) − L|, at most half an ulp),
+/// per channel, rounded up to the next f32 so that storing it cannot make it smaller.
+fn stored_error(radiance: DVec3, stored: glam::Vec3, error: DVec3) -> [f32; 3] {
+    let mut out = [0.0f32; 3];
+    for c in 0..3 {
+        let bound = error[c] + (stored[c] as f64 - radiance[c]).abs();
+        out[c] = round_up_f32(bound);
+    }
+    out
+}
+
+/// The smallest f32 ≥ v (v ≥ 0; NaN and +∞ pass through).
+fn round_up_f32(v: f64) -> f32 {
+    let f = v as f32;
+    if (f as f64) < v && f.is_finite() {
+        // Positive and finite here (v ≥ 0): the next representable f32 above.
+        f32::from_bits(f.to_bits() + 1)
+    } else {
+        f
+    }
 }

@@ -50,8 +50,9 @@
 //! inside a Θmax = 1 particle sees its colour (c = ∞). Several Θmax = 1 particles entered at the
 //! same point act as one (mean colour, largest c).
 
-use super::quadrature::{integrate_adaptive, Piece};
+use super::quadrature::{integrate_adaptive_with, Piece, Rule};
 use super::riemann::midpoint_sum;
+use super::shadow::Occluders;
 use super::{Integrator, RadianceEstimator, Sample};
 use crate::geometry::{Bvh, Hit, Ray};
 use crate::optics::emission::{composite, opacity};
@@ -62,6 +63,9 @@ use crate::optics::source::{
 };
 use crate::scene::{OpticalModel, Scene};
 use glam::DVec3;
+
+/// The Gauss–Kronrod pair of the lit and single-scatter integrals (see `integrate_per_light`).
+pub const QUADRATURE_RULE: Rule = Rule::K15;
 
 /// Segments per pixel and light at most; beyond it the remaining error estimate is reported as
 /// it stands (the pixel then may miss `tol`, and says so in its `err` value).
@@ -85,6 +89,8 @@ struct ShadowScratch {
     cut: IntervalScratch,
     lights: Vec<LightSample>,
     rays: u64,
+    /// Candidate occluders per interval of the camera ray, for the light being integrated.
+    occluders: Vec<Occluders>,
 }
 
 impl<'a> VolumeRenderer<'a> {
@@ -120,20 +126,32 @@ impl<'a> VolumeRenderer<'a> {
         };
         sh.rays += 1;
         self.bvh.all_hits(&ray, 0.0, inc.distance, &mut sh.hits);
+        Some(self.shadow_composite(inc.distance, inc.irradiance, skip, sh))
+    }
+
+    /// The emission model along a shadow ray of length `distance` whose hits are in `sh.hits`,
+    /// with the light's `irradiance` as background (DESIGN.md §2, lit model).
+    fn shadow_composite(
+        &self,
+        distance: f64,
+        irradiance: DVec3,
+        skip: impl Fn(u32) -> bool,
+        sh: &mut ShadowScratch,
+    ) -> LightSample {
         self.cutter.cut(
             &sh.hits,
             0.0,
-            inc.distance,
+            distance,
             skip,
             &mut sh.cut,
             &mut sh.intervals,
         );
-        let c = composite(&sh.intervals, inc.irradiance);
-        Some(LightSample {
+        let c = composite(&sh.intervals, irradiance);
+        LightSample {
             radiance: c.radiance,
-            irradiance: inc.irradiance,
+            irradiance,
             transmittance: c.transmittance,
-        })
+        }
     }
 
     /// Q(x) of the lit or single-scatter model (DESIGN.md §2) at a point inside interval `iv`.
@@ -159,12 +177,46 @@ impl<'a> VolumeRenderer<'a> {
         }
     }
 
-    /// The part of Q(x) that light `l` contributes (Q is linear in the lights, DESIGN.md §2):
-    /// lit w·L_l(x); single-scatter α(x)·E_l(x)·T_l(x)/4π.
-    fn light_source(&self, x: DVec3, iv: &Interval, l: usize, sh: &mut ShadowScratch) -> DVec3 {
-        let Some(s) = self.light_sample(x, l, |_| false, sh) else {
+    /// The part of Q(x) that light `l` contributes at x = ray.at(t) in interval `k` (Q is
+    /// linear in the lights, DESIGN.md §2): lit w·L_l(x); single-scatter α(x)·E_l(x)·T_l(x)/4π.
+    /// The shadow ray tests only the candidate occluders of interval `k` (`reference::shadow`),
+    /// gathered on first use.
+    fn light_source(
+        &self,
+        ray: &Ray,
+        t: f64,
+        (k, iv): (usize, &Interval),
+        l: usize,
+        sh: &mut ShadowScratch,
+    ) -> DVec3 {
+        let x = ray.at(t);
+        let light = &self.scene.lights[l];
+        let Some(inc) = light.incident_at(x) else {
             return DVec3::ZERO;
         };
+        if !inc.irradiance.is_finite() {
+            return DVec3::ZERO;
+        }
+        if sh.occluders.len() <= k {
+            sh.occluders.resize_with(k + 1, Occluders::default);
+        }
+        if !sh.occluders[k].covers(k, l, t) {
+            sh.occluders[k].gather(
+                &self.bvh,
+                self.cutter.particles(),
+                ray,
+                (k, l),
+                light,
+                (iv.t0, iv.t1),
+            );
+        }
+        let shadow_ray = Ray {
+            origin: x,
+            direction: inc.toward,
+        };
+        sh.rays += 1;
+        sh.occluders[k].hits(&shadow_ray, inc.distance, &mut sh.hits);
+        let s = self.shadow_composite(inc.distance, inc.irradiance, |_| false, sh);
         match self.scene.render.model {
             OpticalModel::SingleScatter => single_scatter_source(0.0, DVec3::ZERO, iv.albedo, &[s]),
             _ => lit_source(self.light_weight, &[s]),
@@ -182,10 +234,11 @@ impl<'a> VolumeRenderer<'a> {
         intervals: &[Interval],
         pieces: &[Piece],
         sh: &mut ShadowScratch,
-    ) -> (DVec3, DVec3) {
+    ) -> (DVec3, DVec3, bool) {
         let render = &self.scene.render;
         let mut value = DVec3::ZERO;
         let mut error = DVec3::ZERO;
+        let mut unconverged = false;
         if render.model == OpticalModel::SingleScatter {
             for p in pieces {
                 value +=
@@ -193,7 +246,7 @@ impl<'a> VolumeRenderer<'a> {
             }
         }
         let (Some(first), Some(last)) = (intervals.first(), intervals.last()) else {
-            return (value, error);
+            return (value, error, unconverged);
         };
         let m = self.scene.lights.len();
         let t_of = |k: usize, u: f64| {
@@ -246,17 +299,19 @@ impl<'a> VolumeRenderer<'a> {
                 let u = opacity(iv.sigma * (t - iv.t0));
                 (u > lo && u < hi).then_some(u)
             };
-            let r = integrate_adaptive(
+            let r = integrate_adaptive_with(
+                QUADRATURE_RULE,
                 &split,
                 render.tol / m as f64,
                 MAX_SEGMENTS,
-                |k, u| self.light_source(ray.at(t_of(k, u)), &intervals[k], l, sh),
+                |k, u| self.light_source(ray, t_of(k, u), (k, &intervals[k]), l, sh),
                 kink_in,
             );
             value += r.value;
             error += r.error;
+            unconverged |= !r.converged;
         }
-        (value, error)
+        (value, error, unconverged)
     }
 
     /// Q∞, the σ → ∞ limit of the source of a Θmax = 1 interval (module documentation).
@@ -349,6 +404,7 @@ impl RadianceEstimator for VolumeRenderer<'_> {
                 radiance: composite(&intervals, render.background).radiance,
                 error: DVec3::ZERO,
                 shadow_rays: 0,
+                unconverged: false,
             };
         }
         let mut sh = ShadowScratch::default();
@@ -375,7 +431,7 @@ impl RadianceEstimator for VolumeRenderer<'_> {
         }
         let background = transmittance * render.background;
         let intervals = &intervals[..finite];
-        let (value, error) = match self.integrator {
+        let (value, error, unconverged) = match self.integrator {
             Integrator::Riemann { samples } => {
                 let mut sum = DVec3::ZERO;
                 for p in &pieces {
@@ -385,7 +441,7 @@ impl RadianceEstimator for VolumeRenderer<'_> {
                             self.source(ray.at(t), iv, &mut sh)
                         });
                 }
-                (sum, DVec3::ZERO)
+                (sum, DVec3::ZERO, false)
             }
             Integrator::Adaptive => self.integrate_per_light(ray, intervals, &pieces, &mut sh),
         };
@@ -393,6 +449,7 @@ impl RadianceEstimator for VolumeRenderer<'_> {
             radiance: background + end + value,
             error,
             shadow_rays: sh.rays,
+            unconverged: unconverged || !(value + end).is_finite(),
         }
     }
 
