@@ -1,102 +1,31 @@
 // pgt prelude (DESIGN.md §4): the scene buffers, the camera of DESIGN.md §1, ray–sphere
-// intersection, BVH traversal (all hits, first hit, any hit) and per-particle emission
+// intersection, one BVH traversal (all hits, first hit, any hit) and per-particle emission
 // compositing. Every method file, pgt's own and users' (docs/user-shaders.md), is appended to
 // this prelude and defines
 //     fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32>
 // Coordinates are camera-relative (world − camera position): the camera is at the origin.
-// The struct layouts are mirrored in src/approx/layout.rs; tests/gpu_layout.rs compares them.
+// The shared declarations are generated from Rust (see below); tests/gpu_layout.rs checks
+// their layout with naga.
 
-// Most particles one hit list holds. A ray that crosses more keeps the nearest MAX_HITS and the
-// pixel is counted in `stats.hit_overflows` (pgt reports it), never dropped silently.
-const MAX_HITS: u32 = 128u;
-// BVH traversal stack; pgt refuses a tree deeper than this (src/approx/mod.rs checks).
-const STACK_SIZE: u32 = 64u;
-// "No upper bound" for t. A finite stand-in for +∞ (WGSL may assume no infinities).
-const T_FAR: f32 = 3.0e38;
-// σ of a particle with Θmax = 1 (σ = +∞), see particle_transmittance.
-const SIGMA_INFINITE: f32 = -1.0;
-const PI: f32 = 3.14159265358979;
-const LIGHT_DIRECTIONAL: u32 = 0u;
-const LIGHT_POINT: u32 = 1u;
-const FALLOFF_INVERSE_SQUARE: u32 = 0u;
+// The constants (MAX_HITS, STACK_SIZE, T_FAR, SIGMA_INFINITE, NO_PARTICLE, PI, the light and
+// falloff codes, LOOP_LIMIT, LOOP_LIMIT_REPORT, WORKGROUP_SIDE, PARAM_SLOTS), the structs
+// Particle, BvhNode, Light, Frame, Stats and the bindings frame, particles, nodes,
+// leaf_indices, lights, output, stats are generated from src/approx/contract.rs and
+// src/approx/layout.rs and prepended to this file: their values and docs live there.
 
-struct Particle {
-    center: vec3<f32>,
-    radius: f32,
-    color: vec3<f32>,
-    sigma: f32,
-    albedo: vec3<f32>,
-    ks: f32,
-    shininess: f32,
-    _pad0: f32,
-    _pad1: f32,
-    _pad2: f32,
+// A method's parameter by slot; the slots are named by generated constants PARAM_<NAME>
+// (e.g. method_param(PARAM_SAMPLES)).
+fn method_param(slot: u32) -> u32 {
+    return frame.params[slot / 4u][slot % 4u];
 }
-
-struct BvhNode {
-    min: vec3<f32>,
-    first: u32,
-    max: vec3<f32>,
-    count: u32,
-}
-
-struct Light {
-    // Directional: unit direction of travel. Point: camera-relative position.
-    vector: vec3<f32>,
-    kind: u32,
-    // Directional: irradiance E. Point: intensity I.
-    power: vec3<f32>,
-    falloff: u32,
-}
-
-struct Frame {
-    forward: vec3<f32>,
-    tan_half_fov: f32,
-    right: vec3<f32>,
-    width: u32,
-    up: vec3<f32>,
-    height: u32,
-    background: vec3<f32>,
-    light_count: u32,
-    particle_count: u32,
-    samples: u32,
-    n_exact: u32,
-    light_weight: f32,
-    ambient: f32,
-    lit: u32,
-    pair_begin: u32,
-    pair_end: u32,
-    camera_position: vec3<f32>,
-    _pad2: u32,
-}
-
-struct Stats {
-    hit_overflows: atomic<u32>,
-    loop_limited: atomic<u32>,
-    more_work: atomic<u32>,
-    max_loop_iterations: atomic<u32>,
-}
-
-@group(0) @binding(0) var<uniform> frame: Frame;
-@group(0) @binding(1) var<storage, read> particles: array<Particle>;
-@group(0) @binding(2) var<storage, read> nodes: array<BvhNode>;
-@group(0) @binding(3) var<storage, read> leaf_indices: array<u32>;
-@group(0) @binding(4) var<storage, read> lights: array<Light>;
-@group(0) @binding(5) var<storage, read_write> output: array<vec4<f32>>;
-@group(0) @binding(6) var<storage, read_write> stats: Stats;
 
 // Set when any hit list of this invocation overflowed; the entry point counts the pixel.
 var<private> pixel_overflowed: bool = false;
 
-// lavapipe (llvmpipe) ends all loops of an invocation after 65535 iterations *in total*
-// (LP_MAX_TGSI_LOOP_ITERATIONS, shared by every loop of a shader) and carries on with wrong
-// values. pgt's loops count their iterations here; the entry point reports pixels that reached
-// the limit, and the thesis method splits its work into passes to stay below it.
-const LOOP_LIMIT: u32 = 65535u;
-// Pixels that counted this many are reported: lavapipe counts every loop (users' too) for a group
-// of 8 SIMD lanes together, each loop as long as its slowest lane, so its count runs ahead of
-// ours (measured: its limit struck when ours read 43,000); half the limit leaves that margin.
-const LOOP_LIMIT_REPORT: u32 = 32768u;
+// lavapipe (llvmpipe) ends all loops of an invocation after LOOP_LIMIT iterations *in total*
+// and carries on with wrong values. pgt's loops count their iterations here; the entry point
+// reports pixels that reached LOOP_LIMIT_REPORT (see src/approx/contract.rs for the margin),
+// and the thesis method splits its work into passes to stay below it.
 var<private> loop_iterations: u32 = 0u;
 // Set by a method when this pixel has work beyond the pass's [pair_begin, pair_end).
 var<private> pixel_more_work: bool = false;
@@ -246,42 +175,6 @@ fn hit_list_insert(list: ptr<private, HitList>, index: u32, chord: Chord) {
     (*list).index[slot] = index;
 }
 
-// Every particle whose chord overlaps (t_min, t_max), sorted by entry, into `list` (BVH
-// traversal with an explicit stack). Chords are not clipped: callers clip to their interval.
-fn collect_hits(ray: Ray, t_min: f32, t_max: f32, list: ptr<private, HitList>) {
-    (*list).count = 0u;
-    (*list).overflowed = false;
-    if (frame.particle_count == 0u) {
-        return;
-    }
-    let inv = safe_inverse(ray.direction);
-    traversal_stack[0] = 0u;
-    var sp = 1u;
-    while (sp > 0u) {
-        count_iteration();
-        sp = sp - 1u;
-        let node = nodes[traversal_stack[sp]];
-        if (!ray_box(ray.origin, inv, node.min, node.max, t_min, t_max)) {
-            continue;
-        }
-        if (node.count > 0u) {
-            for (var k = 0u; k < node.count; k = k + 1u) {
-                count_iteration();
-                let i = leaf_indices[node.first + k];
-                let p = particles[i];
-                let c = intersect_sphere(ray, p.center, p.radius);
-                if (c.hit && c.t_exit > t_min && c.t_enter < t_max) {
-                    hit_list_insert(list, i, c);
-                }
-            }
-        } else if (sp + 2u <= STACK_SIZE) {
-            traversal_stack[sp] = node.first;
-            traversal_stack[sp + 1u] = node.first + 1u;
-            sp = sp + 2u;
-        }
-    }
-}
-
 // The nearest surface crossing with t in (t_min, t_max): which particle, where, and whether the
 // ray enters it there (false: it leaves it, the origin being inside). Ties: lower index.
 struct SurfaceHit {
@@ -291,8 +184,22 @@ struct SurfaceHit {
     hit: bool,
 }
 
-fn first_hit(ray: Ray, t_min: f32, t_max: f32) -> SurfaceHit {
+// What `traverse` does with each particle whose chord overlaps (t_min, t_max).
+// Collect: insert it into the hit list. First: keep the nearest surface crossing (and prune
+// boxes beyond it). Any: stop at the first one.
+const TRAVERSE_COLLECT: u32 = 0u;
+const TRAVERSE_FIRST: u32 = 1u;
+const TRAVERSE_ANY: u32 = 2u;
+
+// The one BVH traversal (explicit stack). Particle `skip` is left out (NO_PARTICLE: none).
+// `list` is written only in TRAVERSE_COLLECT mode (WGSL has no optional pointers: the other
+// modes pass any hit list, untouched). Returns the hit found in the First and Any modes.
+fn traverse(ray: Ray, t_min: f32, t_max: f32, mode: u32, skip: u32, list: ptr<private, HitList>) -> SurfaceHit {
     var best = SurfaceHit(0u, t_max, false, false);
+    if (mode == TRAVERSE_COLLECT) {
+        (*list).count = 0u;
+        (*list).overflowed = false;
+    }
     if (frame.particle_count == 0u) {
         return best;
     }
@@ -303,47 +210,8 @@ fn first_hit(ray: Ray, t_min: f32, t_max: f32) -> SurfaceHit {
         count_iteration();
         sp = sp - 1u;
         let node = nodes[traversal_stack[sp]];
+        // best.t stays t_max except in the First mode, where it prunes boxes beyond the hit.
         if (!ray_box(ray.origin, inv, node.min, node.max, t_min, best.t)) {
-            continue;
-        }
-        if (node.count > 0u) {
-            for (var k = 0u; k < node.count; k = k + 1u) {
-                count_iteration();
-                let i = leaf_indices[node.first + k];
-                let p = particles[i];
-                let c = intersect_sphere(ray, p.center, p.radius);
-                if (!c.hit || c.t_exit <= t_min) {
-                    continue;
-                }
-                let entering = c.t_enter > t_min;
-                let t = select(c.t_exit, c.t_enter, entering);
-                if (t < best.t || (t == best.t && best.hit && i < best.index)) {
-                    best = SurfaceHit(i, t, entering, true);
-                }
-            }
-        } else if (sp + 2u <= STACK_SIZE) {
-            traversal_stack[sp] = node.first;
-            traversal_stack[sp + 1u] = node.first + 1u;
-            sp = sp + 2u;
-        }
-    }
-    return best;
-}
-
-// Whether any particle other than `skip` has a chord overlapping (t_min, t_max) (hard shadows).
-// Pass skip = 0xffffffffu to skip none.
-fn any_hit(ray: Ray, t_min: f32, t_max: f32, skip: u32) -> bool {
-    if (frame.particle_count == 0u) {
-        return false;
-    }
-    let inv = safe_inverse(ray.direction);
-    traversal_stack[0] = 0u;
-    var sp = 1u;
-    while (sp > 0u) {
-        count_iteration();
-        sp = sp - 1u;
-        let node = nodes[traversal_stack[sp]];
-        if (!ray_box(ray.origin, inv, node.min, node.max, t_min, t_max)) {
             continue;
         }
         if (node.count > 0u) {
@@ -355,8 +223,20 @@ fn any_hit(ray: Ray, t_min: f32, t_max: f32, skip: u32) -> bool {
                 }
                 let p = particles[i];
                 let c = intersect_sphere(ray, p.center, p.radius);
-                if (c.hit && c.t_exit > t_min && c.t_enter < t_max) {
-                    return true;
+                if (!c.hit || c.t_exit <= t_min) {
+                    continue;
+                }
+                if (mode == TRAVERSE_FIRST) {
+                    let entering = c.t_enter > t_min;
+                    let t = select(c.t_exit, c.t_enter, entering);
+                    if (t < best.t || (t == best.t && best.hit && i < best.index)) {
+                        best = SurfaceHit(i, t, entering, true);
+                    }
+                } else if (c.t_enter < t_max) {
+                    if (mode == TRAVERSE_ANY) {
+                        return SurfaceHit(i, c.t_enter, true, true);
+                    }
+                    hit_list_insert(list, i, c);
                 }
             }
         } else if (sp + 2u <= STACK_SIZE) {
@@ -365,13 +245,29 @@ fn any_hit(ray: Ray, t_min: f32, t_max: f32, skip: u32) -> bool {
             sp = sp + 2u;
         }
     }
-    return false;
+    return best;
+}
+
+// Every particle whose chord overlaps (t_min, t_max), sorted by entry, into `list`. Chords are
+// not clipped: callers clip to their interval.
+fn collect_hits(ray: Ray, t_min: f32, t_max: f32, list: ptr<private, HitList>) {
+    traverse(ray, t_min, t_max, TRAVERSE_COLLECT, NO_PARTICLE, list);
+}
+
+fn first_hit(ray: Ray, t_min: f32, t_max: f32) -> SurfaceHit {
+    return traverse(ray, t_min, t_max, TRAVERSE_FIRST, NO_PARTICLE, &shadow_hits);
+}
+
+// Whether any particle other than `skip` has a chord overlapping (t_min, t_max) (hard shadows).
+// Pass skip = NO_PARTICLE to skip none.
+fn any_hit(ray: Ray, t_min: f32, t_max: f32, skip: u32) -> bool {
+    return traverse(ray, t_min, t_max, TRAVERSE_ANY, skip, &shadow_hits).hit;
 }
 
 // The emission model along (t_min, t_max) of a ray with `background` behind t_max, one particle
 // at a time, back to front (DESIGN.md §4: overlaps ignored; exact where particles are disjoint).
 fn emission_along(ray: Ray, t_min: f32, t_max: f32, background: vec3<f32>) -> vec3<f32> {
-    return emission_along_skipping(ray, t_min, t_max, background, 0xffffffffu);
+    return emission_along_skipping(ray, t_min, t_max, background, NO_PARTICLE);
 }
 
 // emission_along with particle `skip` left out (a ray leaving that particle's surface).

@@ -1,7 +1,7 @@
 // pgt entry point, appended after the method file: one invocation per pixel, one ray through
 // the pixel centre (DESIGN.md §1), the method's `shade`, the result into `output` (pass 0
 // writes, later passes of a multi-pass method add), and the counters of `stats`.
-@compute @workgroup_size(8, 8, 1)
+@compute @workgroup_size(WORKGROUP_SIDE, WORKGROUP_SIDE, 1)
 fn pgt_main(@builtin(global_invocation_id) gid: vec3<u32>) {
     if (gid.x >= frame.width || gid.y >= frame.height) {
         return;

@@ -13,7 +13,7 @@
 // Σ over samples j in [j_begin, j_end) of Q(x_j)·σ·e^{−σ(t_j − t0)}·Δt, t_j = t0 + (j + ½)Δt,
 // Δt = (t1 − t0)/samples: the midpoint rule for ∫ Q·σ·T dt (the σ factor of DESIGN.md §8).
 fn lit_samples(ray: Ray, p: Particle, t0: f32, t1: f32, j_begin: u32, j_end: u32) -> vec3<f32> {
-    let n = max(frame.samples, 1u);
+    let n = max(method_param(PARAM_SAMPLES), 1u);
     let dt = (t1 - t0) / f32(n);
     var sum = vec3<f32>(0.0);
     for (var j = j_begin; j < j_end; j = j + 1u) {
@@ -28,10 +28,10 @@ fn lit_samples(ray: Ray, p: Particle, t0: f32, t1: f32, j_begin: u32, j_end: u32
 fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {
     collect_hits(ray, 0.0, T_FAR, &camera_hits);
     let first_pass = frame.pair_begin == 0u;
-    let samples = max(frame.samples, 1u);
+    let samples = max(method_param(PARAM_SAMPLES), 1u);
     var n_lit = 0u;
     if (frame.lit == 1u) {
-        n_lit = min(frame.n_exact, camera_hits.count);
+        n_lit = min(method_param(PARAM_N_EXACT), camera_hits.count);
     }
     var radiance = vec3<f32>(0.0);
     // P_i, the transmittance in front of the particle at hand.

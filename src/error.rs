@@ -1,7 +1,7 @@
 //! Library error type. Every error that reaches the user names the file, the line (or byte offset)
 //! and the problem (DESIGN.md §6, §7); the CLI maps all of them to exit code 2.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 /// Where in an input a problem is.
 #[derive(Debug, Clone, PartialEq, Eq)]
@@ -36,6 +36,13 @@ pub enum PgtError {
     /// The GPU side failed (no adapter, shader errors, limits).
     #[error("{0}")]
     Gpu(String),
+    /// An error of one step of a longer job, prefixed with the step (e.g. a sweep's run label).
+    #[error("{context}: {source}")]
+    Context {
+        context: String,
+        #[source]
+        source: Box<PgtError>,
+    },
 }
 
 fn display_location(path: &std::path::Path, location: &Location) -> String {
@@ -80,6 +87,86 @@ impl PgtError {
             source,
         }
     }
+
+    /// This error prefixed with the step it happened in ("thesis samples=4 n_exact=1: …").
+    pub fn context(self, context: impl Into<String>) -> Self {
+        PgtError::Context {
+            context: context.into(),
+            source: Box::new(self),
+        }
+    }
+}
+
+/// The 1-based line of byte offset `offset` in `text` (offsets past the end give the last line).
+pub fn line_of(text: &str, offset: usize) -> usize {
+    text.as_bytes()[..offset.min(text.len())]
+        .iter()
+        .filter(|&&b| b == b'\n')
+        .count()
+        + 1
+}
+
+/// A TOML syntax or type error in the file `path` (whose contents are `text`) as an error that
+/// names the file and line (DESIGN.md §6 "Bad input"), quoting the offending line, since serde's
+/// message alone ("invalid length 2") does not name the field. Errors without a position (rare
+/// in toml 0.8) name the file only.
+pub fn toml_error(path: &Path, text: &str, e: &toml::de::Error) -> PgtError {
+    let message = e.message().trim().to_string();
+    let Some(span) = e.span() else {
+        return PgtError::in_file(path, message);
+    };
+    let line = line_of(text, span.start);
+    PgtError::at_line(path, line, with_quoted_line(message, text, line))
+}
+
+/// `message (in `the text of line`)`, the line trimmed and cut at 100 characters; the message
+/// alone where the line is blank.
+pub fn with_quoted_line(message: String, text: &str, line: usize) -> String {
+    match text
+        .lines()
+        .nth(line.saturating_sub(1))
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+    {
+        Some(source_line) => {
+            let quoted: String = source_line.chars().take(100).collect();
+            format!("{message} (in `{quoted}`)")
+        }
+        None => message,
+    }
 }
 
 pub type Result<T, E = PgtError> = std::result::Result<T, E>;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn error_lines_are_one_based() {
+        assert_eq!(line_of("a\nb\nc", 0), 1);
+        assert_eq!(line_of("a\nb\nc", 2), 2);
+        assert_eq!(line_of("a\nb\nc", 99), 3);
+    }
+
+    #[test]
+    fn toml_errors_name_the_file_line_and_text() {
+        #[derive(Debug, serde::Deserialize)]
+        #[serde(deny_unknown_fields)]
+        #[allow(dead_code)]
+        struct T {
+            a: u32,
+        }
+        let text = "a = 1\nb = 2\n";
+        let e = toml::from_str::<T>(text).unwrap_err();
+        let err = toml_error(Path::new("x.toml"), text, &e).to_string();
+        assert!(err.starts_with("x.toml:2: "), "{err}");
+        assert!(err.contains("(in `b = 2`)"), "{err}");
+    }
+
+    #[test]
+    fn context_prefixes_the_message() {
+        let e = PgtError::Usage("bad".into()).context("run 1");
+        assert_eq!(e.to_string(), "run 1: bad");
+    }
+}

@@ -6,6 +6,7 @@
 
 pub mod approx;
 pub mod cli;
+pub mod color;
 pub mod error;
 pub mod formats;
 pub mod geometry;
@@ -15,6 +16,7 @@ pub mod optics;
 pub mod reference;
 pub mod report;
 pub mod scene;
+pub mod sweep;
 
 pub use error::{PgtError, Result};
 pub use scene::{Scene, SceneLoadOptions};

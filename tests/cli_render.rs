@@ -277,3 +277,40 @@ fn an_unwritable_output_exits_2() {
     ]);
     assert_eq!(out.status.code(), Some(2));
 }
+
+#[test]
+fn model_names_come_from_the_registry() {
+    let dir = tmp();
+    let exr = dir.path().join("m.exr");
+    let out = pgt(&[
+        "render",
+        &example("inside.toml"),
+        "-o",
+        s(&exr),
+        "--model",
+        "glowing",
+    ]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    for name in pgt::optics::models::ALL.iter().map(|m| m.name()) {
+        assert!(err.contains(name), "'{name}' not listed in: {err}");
+    }
+    assert!(!exr.exists());
+    for model in pgt::optics::models::ALL {
+        let out = pgt(&[
+            "render",
+            &example("inside.toml"),
+            "-o",
+            s(&exr),
+            "--model",
+            model.name(),
+            "--size",
+            "8x6",
+            "--tol",
+            "1e-3",
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(out.status.success(), "{model}: {err}");
+        assert!(exr.exists(), "{model}");
+    }
+}

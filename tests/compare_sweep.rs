@@ -72,20 +72,52 @@ fn riemann_sweep_reports_and_caches_the_reference() {
 }
 
 #[test]
-fn thesis_sweep_on_the_gpu_converges_with_samples() {
-    if let Err(e) = pgt::approx::GpuContext::new(None) {
-        if std::env::var("CI").is_ok_and(|v| v == "true") {
-            panic!("CI=true and no GPU adapter: {e}");
-        }
-        eprintln!("skipping: {e}");
-        return;
-    }
+fn a_baseline_run_is_compared_in_the_references_place() {
     let dir = tempfile::tempdir().unwrap();
-    // Disjoint spheres, lit model: the thesis's per-particle scheme converges to the reference
-    // as samples grow when n_exact covers every particle (DESIGN.md §4).
-    let scene = dir.path().join("disjoint.toml");
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/shadows.toml");
+    let exp = dir.path().join("exp.toml");
     std::fs::write(
-        &scene,
+        &exp,
+        format!(
+            "scene = {:?}\nsize = [48, 32]\n[reference]\nspp = 2\n[[approximations]]\nmethod = \"riemann\"\nsamples = 4\nspp = [1, 2]\nbaseline = {{ spp = 2 }}\n",
+            scene.to_string_lossy()
+        ),
+    )
+    .unwrap();
+    let rep = dir.path().join("rep");
+    let o = sweep(&exp, &rep);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let runs: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(rep.join("sweep.json")).unwrap()).unwrap();
+    let at = |spp: u64| {
+        runs.as_array()
+            .unwrap()
+            .iter()
+            .find(|r| r["params"]["spp"] == spp)
+            .unwrap()
+    };
+    // The spp = 2 run is the reference bit for bit (opaque mode), so the spp = 1 run's error
+    // against its baseline is its error against the reference, and the baseline against
+    // itself is exact.
+    assert_eq!(at(1)["baseline"]["run"], "riemann samples=4 spp=2");
+    assert_eq!(at(1)["baseline"]["rmse"], at(1)["rmse"]);
+    assert!(at(1)["baseline"]["ssim"]["mean"].as_f64().unwrap() < 1.0);
+    assert_eq!(at(2)["baseline"]["ssim"]["mean"], 1.0);
+    assert_eq!(at(2)["baseline"]["rmse"]["mean"], 0.0);
+    assert!(rep.join("dssim_baseline.svg").is_file());
+    let html = std::fs::read_to_string(rep.join("index.html")).unwrap();
+    assert!(html.contains("against the baseline run"), "{html}");
+}
+
+/// The disjoint lit scene of the GPU tests, written into `dir`.
+fn disjoint_scene(dir: &Path) {
+    std::fs::write(
+        dir.join("disjoint.toml"),
         r#"[camera]
 position = [0.0, 0.0, -8.0]
 look_at = [0.0, 0.0, 0.0]
@@ -118,6 +150,29 @@ opacity = 0.5
 "#,
     )
     .unwrap();
+}
+
+/// Whether a GPU adapter exists; under CI=true its absence fails the test.
+fn have_gpu() -> bool {
+    if let Err(e) = pgt::approx::GpuContext::new(None) {
+        if std::env::var("CI").is_ok_and(|v| v == "true") {
+            panic!("CI=true and no GPU adapter: {e}");
+        }
+        eprintln!("skipping: {e}");
+        return false;
+    }
+    true
+}
+
+#[test]
+fn thesis_sweep_on_the_gpu_converges_with_samples() {
+    if !have_gpu() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    // Disjoint spheres, lit model: the thesis's per-particle scheme converges to the reference
+    // as samples grow when n_exact covers every particle (DESIGN.md §4).
+    disjoint_scene(dir.path());
     let exp = dir.path().join("exp.toml");
     std::fs::write(
         &exp,
@@ -144,6 +199,42 @@ opacity = 0.5
         "RMSE not falling with samples: {r1} {r4} {r64}"
     );
     assert!(rep.join("thesis_samples_64_n_exact_100.png").is_file());
+}
+
+#[test]
+fn n_exact_all_is_a_category_and_a_baseline() {
+    if !have_gpu() {
+        return;
+    }
+    let dir = tempfile::tempdir().unwrap();
+    disjoint_scene(dir.path());
+    let exp = dir.path().join("exp.toml");
+    std::fs::write(
+        &exp,
+        "scene = \"disjoint.toml\"\nsize = [32, 24]\n[[approximations]]\nmethod = \"thesis\"\nsamples = 4\nn_exact = [1, \"all\"]\nbaseline = { n_exact = \"all\" }\n",
+    )
+    .unwrap();
+    let rep = dir.path().join("rep");
+    let o = sweep(&exp, &rep);
+    let err = String::from_utf8_lossy(&o.stderr).into_owned();
+    assert_eq!(o.status.code(), Some(0), "{err}");
+    assert!(err.contains("thesis samples=4 n_exact=all:"), "{err}");
+    assert!(rep.join("thesis_samples_4_n_exact_all.png").is_file());
+    let runs: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(rep.join("sweep.json")).unwrap()).unwrap();
+    assert_eq!(runs[1]["params"]["n_exact"], "all");
+    assert_eq!(runs[0]["baseline"]["run"], "thesis samples=4 n_exact=all");
+    assert_eq!(runs[1]["baseline"]["ssim"]["mean"], 1.0);
+    // n_exact is the x axis (two values against one), drawn as categories.
+    let svg = std::fs::read_to_string(rep.join("dssim.svg")).unwrap();
+    assert!(
+        svg.contains("against n_exact") && svg.contains("all"),
+        "{svg}"
+    );
+    assert!(
+        !svg.contains("4294967295") && !svg.contains("4.29"),
+        "{svg}"
+    );
 }
 
 #[test]
@@ -174,5 +265,21 @@ fn bad_experiments_exit_2() {
     let o = sweep(&exp, &rep);
     assert_eq!(o.status.code(), Some(2));
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(err.contains("exp.toml") && err.contains("bogus"), "{err}");
+    assert!(
+        err.contains("exp.toml:5:") && err.contains("bogus"),
+        "{err}"
+    );
+    assert!(err.contains("its parameters are samples, spp"), "{err}");
+    std::fs::write(
+        &exp,
+        "scene = \"x.toml\"\n[[approximations]]\nmethod = \"magic\"\n",
+    )
+    .unwrap();
+    let o = sweep(&exp, &rep);
+    assert_eq!(o.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.contains("exp.toml:3: unknown method \"magic\"") && err.contains("riemann"),
+        "{err}"
+    );
 }

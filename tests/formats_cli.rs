@@ -25,9 +25,7 @@ fn json(out: &Output) -> serde_json::Value {
 
 #[test]
 fn info_json_of_a_pdb_file() {
-    let Some(p) = shared("pdb/1uun_opm_oriented.pdb") else {
-        return;
-    };
+    let p = shared_or_skip!("pdb/1uun_opm_oriented.pdb");
     let v = json(&pgt(&["info", p.to_str().expect("utf8"), "--json"]));
     assert_eq!(v["particles"], 11032);
     assert_eq!(v["format"], "pdb");
@@ -60,9 +58,7 @@ fn info_json_of_a_pdb_file() {
 
 #[test]
 fn info_json_of_an_mmpld_file() {
-    let Some(p) = shared("mmpld/testspheres_old_v100.mmpld") else {
-        return;
-    };
+    let p = shared_or_skip!("mmpld/testspheres_old_v100.mmpld");
     let v = json(&pgt(&["info", p.to_str().expect("utf8"), "--json"]));
     assert_eq!(v["particles"], 15);
     assert_eq!(v["details"]["version"], "1.0");
@@ -71,9 +67,7 @@ fn info_json_of_an_mmpld_file() {
 
 #[test]
 fn info_of_a_scene_with_an_include() {
-    let Some(p) = shared("pdb/1uun_opm_oriented.pdb") else {
-        return;
-    };
+    let p = shared_or_skip!("pdb/1uun_opm_oriented.pdb");
     let dir = tempfile::tempdir().expect("tmp");
     let scene = dir.path().join("s.toml");
     std::fs::write(
@@ -308,4 +302,133 @@ fn scene_include_can_force_the_format() {
     let out = pgt(&["info", scene.to_str().expect("utf8")]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("s.toml"));
+}
+
+/// Runs `render`, `approx` and `info` on `input` and checks that each exits 2, that stderr
+/// contains every one of `want` (the file and the reason), and that no output was written.
+fn every_command_refuses(input: &Path, want: &[&str]) {
+    let out_png = input.with_extension("out.png");
+    let (ps, os) = (
+        input.to_str().expect("utf8"),
+        out_png.to_str().expect("utf8"),
+    );
+    for args in [
+        vec!["render", ps, "-o", os, "--mode", "opaque", "--size", "8x8"],
+        vec!["approx", ps, "-o", os, "--size", "8x8"],
+        vec!["info", ps],
+        vec!["info", ps, "--json"],
+    ] {
+        let out = pgt(&args);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        for w in want {
+            assert!(err.contains(w), "{args:?}: wanted '{w}' in: {err}");
+        }
+        assert!(!err.contains("panicked"), "{args:?}: {err}");
+        assert!(out.stdout.is_empty(), "{args:?}: printed {:?}", out.stdout);
+        assert!(!out_png.exists(), "{args:?}");
+    }
+}
+
+/// Issue 13 item 1: a particle file that holds no particles (a truncated download, a wrong
+/// path) is an error naming the file in every command, for every format.
+#[test]
+fn a_particle_file_without_particles_is_an_error() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let d = dir.path();
+    // Bytes ≥ 0x80 and newlines: no ATOM/HETATM record can start a line.
+    let binary: Vec<u8> = (0..4096u32)
+        .map(|i| {
+            if i % 97 == 0 {
+                b'\n'
+            } else {
+                0x80 | (i * 37 % 128) as u8
+            }
+        })
+        .collect();
+    let mut no_frames = b"MMPLD\0".to_vec();
+    no_frames.extend_from_slice(&102u16.to_le_bytes());
+    no_frames.extend_from_slice(&0u32.to_le_bytes());
+    no_frames.extend_from_slice(&[0u8; 48]);
+    no_frames.extend_from_slice(&68u64.to_le_bytes());
+    let cases: [(&str, &[u8], &str); 8] = [
+        ("zero.pdb", b"", "empty (0 bytes)"),
+        ("binary.pdb", &binary, "no ATOM or HETATM records"),
+        ("header.csv", b"x,y,z,radius\n", "no data rows"),
+        ("comments.csv", b"# nothing\n\n", "no data rows"),
+        ("nothing.wrl", b"#VRML V2.0 utf8\nGroup { }\n", "no Sphere"),
+        ("zero.xyz", b"0\nno atoms\n", "no atoms"),
+        (
+            "noatoms.cif",
+            b"data_x\n_cell.length_a 1.0\n",
+            "no _atom_site rows",
+        ),
+        ("noframes.mmpld", &no_frames, "no frames"),
+    ];
+    for (name, bytes, reason) in cases {
+        let p = d.join(name);
+        std::fs::write(&p, bytes).expect("write");
+        every_command_refuses(&p, &[name, "holds no particles", reason]);
+    }
+}
+
+/// Issue 13 item 1: an include whose filters remove every atom names the file and the filter;
+/// a scene without any particles stays valid (background and a warning: cli_render).
+#[test]
+fn an_include_emptied_by_its_filters_names_the_filter() {
+    let dir = tempfile::tempdir().expect("tmp");
+    let d = dir.path();
+    let water = "HETATM    1  O   HOH A   1      10.000  10.000  10.000  1.00  0.00           O  \n\
+                 HETATM    2  H1  HOH A   1      10.500  10.000  10.000  1.00  0.00           H  \n\
+                 HETATM    3  O   HOH B   2      12.000  10.000  10.000  1.00  0.00           O  \n";
+    std::fs::write(d.join("water.pdb"), water).expect("write");
+    let hydrogens =
+        "ATOM      1  H   ALA A   1       1.000   2.000   3.000  1.00  0.00           H  \n";
+    std::fs::write(d.join("hydrogens.pdb"), hydrogens).expect("write");
+    for (scene, include, filter) in [
+        (
+            "water.toml",
+            "path = \"water.pdb\"\nskip_water = true",
+            "`skip_water = true`",
+        ),
+        (
+            "chains_then_water.toml",
+            "path = \"water.pdb\"\nchains = [\"B\"]\nskip_water = true",
+            "`chains = [\"B\"]` keeps 1, and `skip_water = true` removes all",
+        ),
+        (
+            "nochains.toml",
+            "path = \"water.pdb\"\nchains = []",
+            "`chains = []`",
+        ),
+        (
+            "hydrogen.toml",
+            "path = \"hydrogens.pdb\"\nskip_hydrogen = true",
+            "`skip_hydrogen = true`",
+        ),
+    ] {
+        let p = d.join(scene);
+        std::fs::write(&p, format!("[[include]]\n{include}\n")).expect("write");
+        let data = if scene == "hydrogen.toml" {
+            "hydrogens.pdb"
+        } else {
+            "water.pdb"
+        };
+        every_command_refuses(&p, &[data, "holds no particles", filter]);
+    }
+    std::fs::write(
+        d.join("frames.xyz"),
+        "1\nfirst\nC 0 0 0\n0\nsecond, empty\n",
+    )
+    .expect("write");
+    let p = d.join("frame.toml");
+    std::fs::write(&p, "[[include]]\npath = \"frames.xyz\"\nframe = 1\n").expect("write");
+    every_command_refuses(&p, &["frames.xyz", "`frame = 1` holds no particles"]);
+    // Without the filter the same include loads.
+    let p = d.join("ok.toml");
+    std::fs::write(&p, "[[include]]\npath = \"water.pdb\"\n").expect("write");
+    assert_eq!(
+        json(&pgt(&["info", p.to_str().expect("utf8"), "--json"]))["particles"],
+        3
+    );
 }

@@ -57,9 +57,7 @@ fn f32_at(b: &[u8], at: usize) -> f64 {
 
 #[test]
 fn xyzr_rgba_byte_particles_match_the_bytes() {
-    let Some(p) = shared("mmpld/test_xyzr_float_rgba_byte.mmpld") else {
-        return;
-    };
+    let p = shared_or_skip!("mmpld/test_xyzr_float_rgba_byte.mmpld");
     let b = std::fs::read(&p).expect("read");
     let l = load(&p);
     // Header 60 + seek table 2×8 = 76; timestamp 4, list count 4, types 2, count 8 → data at 94,
@@ -82,9 +80,7 @@ fn xyzr_rgba_byte_particles_match_the_bytes() {
 
 #[test]
 fn v103_writer_bug_file_uses_global_radius_and_colour() {
-    let Some(p) = shared("mmpld/part_rnk000000_v103.mmpld") else {
-        return;
-    };
+    let p = shared_or_skip!("mmpld/part_rnk000000_v103.mmpld");
     let b = std::fs::read(&p).expect("read");
     let l = load(&p);
     // No timestamp: list count at 76, types at 80, global radius at 82, RGBA at 86.
@@ -112,9 +108,7 @@ fn v103_writer_bug_file_uses_global_radius_and_colour() {
 
 #[test]
 fn frames_are_selected() {
-    let Some(p) = shared("mmpld/testspheres_old_v100.mmpld") else {
-        return;
-    };
+    let p = shared_or_skip!("mmpld/testspheres_old_v100.mmpld");
     let a = load(&p);
     let z = load_with(&p, |s| s.frame = Some(99)).expect("frame 99");
     assert_eq!(z.records.len(), 15);
@@ -130,9 +124,7 @@ fn frames_are_selected() {
 
 #[test]
 fn bad_mmpld_input_is_an_error_with_a_byte_offset() {
-    let Some(p) = shared("mmpld/test_xyzr_float_rgba_byte.mmpld") else {
-        return;
-    };
+    let p = shared_or_skip!("mmpld/test_xyzr_float_rgba_byte.mmpld");
     let good = std::fs::read(&p).expect("read");
     let dir = tempfile::tempdir().expect("tmp");
     let q = dir.path().join("bad.mmpld");
@@ -170,9 +162,7 @@ fn bad_mmpld_input_is_an_error_with_a_byte_offset() {
 
 #[test]
 fn uniform_colour_applies_to_every_format() {
-    let Some(p) = shared("mmpld/test_xyzr_float_rgba_byte.mmpld") else {
-        return;
-    };
+    let p = shared_or_skip!("mmpld/test_xyzr_float_rgba_byte.mmpld");
     let l = load_with(&p, |s| s.color_by = pgt::scene::ColorBy::Uniform).expect("loads");
     assert_eq!(l.records.len(), 4);
     assert!(l.records.iter().all(|r| r.color.is_none()));
@@ -182,8 +172,7 @@ mod round_trip {
     //! Files written here, independently of pgt, from the layout in SOURCES.md, for every
     //! version, vertex type and colour type; pgt must read back what was written.
     use super::common::close3;
-    use pgt::formats::{load_bytes, Format};
-    use pgt::scene::IncludeSpec;
+    use pgt::formats::{load_bytes, Format, IncludeSpec};
     use proptest::prelude::*;
 
     #[derive(Debug, Clone)]
@@ -292,8 +281,15 @@ mod round_trip {
         fn reads_back_what_was_written(version in 100u16..=103, lists in prop::collection::vec(list(), 0..4)) {
             let bytes = write(version, &lists);
             let spec = IncludeSpec::bare(std::path::Path::new("rt.mmpld"));
-            let got = load_bytes(&spec, Format::Mmpld, &bytes).expect("reads");
+            let format = Format::named("mmpld").expect("mmpld");
             let want: Vec<_> = lists.iter().flat_map(|l| l.points.iter().map(move |p| (l, p))).collect();
+            if want.is_empty() {
+                // Issue 13: a frame without particles is an error, not an empty scene.
+                let e = load_bytes(&spec, format, &bytes).expect_err("empty frame").to_string();
+                prop_assert!(e.contains("rt.mmpld") && e.contains("holds no particles"), "{}", e);
+                return Ok(());
+            }
+            let got = load_bytes(&spec, format, &bytes).expect("reads");
             prop_assert_eq!(got.records.len(), want.len());
             for (r, (l, (p, rad, c))) in got.records.iter().zip(want) {
                 prop_assert!(close3(r.center, p.map(f64::from), 0.0));

@@ -47,9 +47,7 @@ fn every_structure_file_loads_with_the_right_count() {
 
 #[test]
 fn uun_chains_a_and_b_are_the_thesis_count() {
-    let Some(p) = shared("pdb/1uun_opm_oriented.pdb") else {
-        return;
-    };
+    let p = shared_or_skip!("pdb/1uun_opm_oriented.pdb");
     let l = load_with(&p, |s| s.chains = Some(vec!["A".into(), "B".into()])).expect("loads");
     assert_eq!(l.records.len(), 2758);
     let e = load_with(&p, |s| s.chains = Some(vec!["Z".into()]))
@@ -63,9 +61,7 @@ fn uun_chains_a_and_b_are_the_thesis_count() {
 
 #[test]
 fn positions_radii_colours_match_the_text() {
-    let Some(p) = shared("pdb/1aon.pdb") else {
-        return;
-    };
+    let p = shared_or_skip!("pdb/1aon.pdb");
     let l = load(&p);
     // Line of the first ATOM record and its columns, read here from the text.
     let atoms = lines_where(&p, |l| l.starts_with("ATOM  ") || l.starts_with("HETATM"));
@@ -94,9 +90,7 @@ fn positions_radii_colours_match_the_text() {
 
 #[test]
 fn calcium_ion_gets_its_own_radius() {
-    let Some(p) = shared("pdb/1rx1.pdb") else {
-        return;
-    };
+    let p = shared_or_skip!("pdb/1rx1.pdb");
     let l = load(&p);
     let ca = lines_where(&p, |l| {
         l.starts_with("HETATM") && l.get(76..78) == Some("CA")
@@ -137,18 +131,14 @@ fn old_style_and_md_files_infer_elements() {
 
 #[test]
 fn waters_can_be_skipped() {
-    let Some(p) = shared("pdb/1tii.pdb") else {
-        return;
-    };
+    let p = shared_or_skip!("pdb/1tii.pdb");
     let l = load_with(&p, |s| s.skip_water = true).expect("loads");
     assert_eq!(l.records.len(), 5684 - 215);
 }
 
 #[test]
 fn alternate_locations_keep_the_highest_occupancy() {
-    let Some(p) = shared("pdb/3al1.pdb") else {
-        return;
-    };
+    let p = shared_or_skip!("pdb/3al1.pdb");
     let l = load(&p);
     let find = |alt: char, name: &str, res: &str| {
         let v = lines_where(&p, |l| {
@@ -170,9 +160,7 @@ fn alternate_locations_keep_the_highest_occupancy() {
 
 #[test]
 fn colour_by_chain_and_uniform() {
-    let Some(p) = shared("pdb/1uun_opm_oriented.pdb") else {
-        return;
-    };
+    let p = shared_or_skip!("pdb/1uun_opm_oriented.pdb");
     let l = load_with(&p, |s| s.color_by = ColorBy::Chain).expect("loads");
     // 8 chains × 1379 atoms in file order: the colour changes exactly at the chain boundaries.
     let distinct: std::collections::BTreeSet<String> =
@@ -186,9 +174,7 @@ fn colour_by_chain_and_uniform() {
 
 #[test]
 fn radius_scale_applies_once() {
-    let Some(p) = shared("pdb/1rx1.pdb") else {
-        return;
-    };
+    let p = shared_or_skip!("pdb/1rx1.pdb");
     let a = load(&p);
     let b = load_with(&p, |s| s.radius_scale = 0.5).expect("loads");
     assert!(a
@@ -200,9 +186,7 @@ fn radius_scale_applies_once() {
 
 #[test]
 fn mmcif_matches_its_text() {
-    let Some(p) = shared("pdb/3SN6.cif") else {
-        return;
-    };
+    let p = shared_or_skip!("pdb/3SN6.cif");
     let l = load(&p);
     let rows = lines_where(&p, |l| l.starts_with("ATOM ") || l.starts_with("HETATM "));
     assert_eq!(rows.len(), l.records.len());

@@ -28,9 +28,7 @@ fn every_vrml_file_loads_with_the_right_count() {
 
 #[test]
 fn castle_proto_nodes_six_unit_spheres() {
-    let Some(p) = shared("vrml/castle_proto_nodes.wrl") else {
-        return;
-    };
+    let p = shared_or_skip!("vrml/castle_proto_nodes.wrl");
     let l = load(&p);
     let xs: Vec<f64> = l.records.iter().map(|r| r.center.x).collect();
     assert_eq!(xs, vec![5.0, 10.0, 15.0, 20.0, 25.0, 30.0]);
@@ -52,9 +50,7 @@ fn castle_proto_nodes_six_unit_spheres() {
 
 #[test]
 fn castle_proto_redefinition_and_radii() {
-    let Some(p) = shared("vrml/castle_proto_ultra_simple.wrl") else {
-        return;
-    };
+    let p = shared_or_skip!("vrml/castle_proto_ultra_simple.wrl");
     let l = load(&p);
     let got: Vec<(f64, f64)> = l.records.iter().map(|r| (r.center.x, r.radius)).collect();
     assert_eq!(
@@ -75,9 +71,7 @@ fn castle_proto_redefinition_and_radii() {
 
 #[test]
 fn drawxtl_radii_and_rotated_frame() {
-    let Some(p) = shared("vrml/drawxtl_be4oteo6.wrl") else {
-        return;
-    };
+    let p = shared_or_skip!("vrml/drawxtl_be4oteo6.wrl");
     let l = load(&p);
     let mut radii: Vec<f64> = l.records.iter().map(|r| r.radius).collect();
     radii.sort_by(f64::total_cmp);
@@ -95,27 +89,23 @@ fn drawxtl_radii_and_rotated_frame() {
 }
 
 /// PDB atoms of 1rx1.pdb (position, element), in file order.
-fn rx1_atoms() -> Option<Vec<(DVec3, String)>> {
-    let p = shared("pdb/1rx1.pdb")?;
-    Some(
-        lines_where(&p, |l| l.starts_with("ATOM  ") || l.starts_with("HETATM"))
-            .into_iter()
-            .map(|(_, t)| {
-                let c = |a: usize, b: usize| t[a - 1..b].trim().parse::<f64>().expect("n");
-                (
-                    DVec3::new(c(31, 38), c(39, 46), c(47, 54)),
-                    t[76..78].trim().to_string(),
-                )
-            })
-            .collect(),
-    )
+fn rx1_atoms(p: &std::path::Path) -> Vec<(DVec3, String)> {
+    lines_where(p, |l| l.starts_with("ATOM  ") || l.starts_with("HETATM"))
+        .into_iter()
+        .map(|(_, t)| {
+            let c = |a: usize, b: usize| t[a - 1..b].trim().parse::<f64>().expect("n");
+            (
+                DVec3::new(c(31, 38), c(39, 46), c(47, 54)),
+                t[76..78].trim().to_string(),
+            )
+        })
+        .collect()
 }
 
 #[test]
 fn pymol_spheres_are_the_pdb_atoms() {
-    let (Some(p), Some(atoms)) = (shared("vrml/pymol_1rx1_spheres.wrl"), rx1_atoms()) else {
-        return;
-    };
+    let p = shared_or_skip!("vrml/pymol_1rx1_spheres.wrl");
+    let atoms = rx1_atoms(&shared_or_skip!("pdb/1rx1.pdb"));
     let l = load(&p);
     assert_eq!(l.records.len(), atoms.len());
     // SOURCES.md: translation = PDB xyz − (27.400, 44.000, 13.301); vdW C 1.70 N 1.55 O 1.52 S 1.80.
@@ -147,9 +137,8 @@ fn pymol_spheres_are_the_pdb_atoms() {
 
 #[test]
 fn jmol_mesh_spheres_are_the_pdb_atoms() {
-    let (Some(p), Some(atoms)) = (shared("vrml/jmol_1rx1_spacefill.wrl"), rx1_atoms()) else {
-        return;
-    };
+    let p = shared_or_skip!("vrml/jmol_1rx1_spacefill.wrl");
+    let atoms = rx1_atoms(&shared_or_skip!("pdb/1rx1.pdb"));
     let l = load(&p);
     assert_eq!(l.records.len(), atoms.len());
     // Transform{scale 10 10 10 children[Transform{translation -26.926 -44.427498 -12.8755 …
@@ -348,7 +337,7 @@ fn format_can_be_forced() {
         .expect_err("unknown extension")
         .to_string()
         .contains("unsupported"));
-    let l = load_with(&p, |s| s.format = Some(pgt::formats::Format::Vrml)).expect("forced");
+    let l = load_with(&p, |s| s.format = pgt::formats::Format::named("vrml")).expect("forced");
     assert_eq!(l.records[0].radius, 3.0);
 }
 
@@ -379,9 +368,7 @@ fn deep_use_chains_are_an_error_not_a_stack_overflow() {
 
 #[test]
 fn pymol_colours_are_the_decoded_diffuse_colours_of_the_text() {
-    let Some(p) = shared("vrml/pymol_1rx1_spheres.wrl") else {
-        return;
-    };
+    let p = shared_or_skip!("vrml/pymol_1rx1_spheres.wrl");
     let l = load(&p);
     // Every `diffuseColor r g b` of the file, in order, one per sphere.
     let colours: Vec<[f64; 3]> = lines_where(&p, |t| t.contains("diffuseColor"))

@@ -10,9 +10,10 @@
 mod gpu_common;
 
 use glam::DVec3;
-use pgt::approx::{render_approx_with, ApproxParams, Method, Timing, N_EXACT_ALL};
+use pgt::approx::{render_approx_with, ApproxParams, Timing, N_EXACT_ALL};
 use pgt::geometry::Camera;
-use pgt::scene::{OpticalModel, RenderMode};
+use pgt::optics::models;
+use pgt::scene::RenderMode;
 
 fn env_or(name: &str, default: &str) -> String {
     std::env::var(name).unwrap_or_else(|_| default.to_string())
@@ -66,7 +67,7 @@ fn thesis_timings_on_random_particles() {
             particles,
             pgt::scene::thesis_lights(),
             RenderMode::Volume,
-            OpticalModel::Lit,
+            models::LIT,
         );
         // From −z, framing the cube (its bounding sphere) with fov_y 40°, like the default camera.
         let distance = 0.5 * cube * 3f64.sqrt() / (20f64.to_radians().sin());
@@ -79,20 +80,12 @@ fn thesis_timings_on_random_particles() {
             side,
         );
         // Warm-up: lavapipe compiles the shader at its first dispatch, inside the first timing.
-        let warm = ApproxParams {
-            method: Some(Method::Thesis),
-            samples: 1,
-            n_exact: 1,
-            adapter: None,
-        };
+        let warm = ApproxParams::for_method("thesis", &[("samples", 1), ("n_exact", 1)]).unwrap();
         render_approx_with(ctx, &s, &warm).unwrap();
         for n_exact in n_exacts.iter().copied() {
-            let params = ApproxParams {
-                method: Some(Method::Thesis),
-                samples,
-                n_exact,
-                adapter: None,
-            };
+            let params =
+                ApproxParams::for_method("thesis", &[("samples", samples), ("n_exact", n_exact)])
+                    .unwrap();
             let wall = std::time::Instant::now();
             let out = render_approx_with(ctx, &s, &params).unwrap();
             let wall = wall.elapsed().as_secs_f64();

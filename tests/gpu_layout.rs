@@ -1,9 +1,11 @@
-//! The Rust structs of `src/approx/layout.rs` and the WGSL structs of `shaders/common.wgsl` must
-//! agree byte for byte (DESIGN.md §4). naga computes the WGSL layout; this compares every named
-//! member's offset and every struct's size with `offset_of!` and `size_of`. No GPU needed.
+//! The Rust structs of `src/approx/layout.rs` and the WGSL structs generated from them
+//! (`pgt::approx::contract::wgsl_declarations`, prepended to `shaders/common.wgsl`) must agree
+//! byte for byte (DESIGN.md §4): generating the text does not make WGSL's alignment rules
+//! Rust's. naga computes the WGSL layout; this compares every named member's offset and every
+//! struct's size with `offset_of!` and `size_of`. No GPU needed.
 
 use pgt::approx::layout::{GpuBvhNode, GpuFrame, GpuLight, GpuParticle, GpuStats};
-use pgt::approx::shader::COMMON_WGSL;
+use pgt::approx::shader::prelude_source;
 use std::mem::{offset_of, size_of};
 
 /// (member name, offset) of a WGSL struct, and its size, as naga lays it out.
@@ -19,7 +21,7 @@ fn wgsl_layout(module: &naga::Module, name: &str) -> (Vec<(String, u32)>, u32) {
             }
         }
     }
-    panic!("struct {name} not found in shaders/common.wgsl");
+    panic!("struct {name} not found in the prelude");
 }
 
 /// Compares the named (non-padding) members and the size; padding members must exist on both
@@ -62,7 +64,7 @@ fn particle_members() -> Vec<(&'static str, usize)> {
 
 #[test]
 fn rust_and_wgsl_struct_layouts_agree() {
-    let module = naga::front::wgsl::parse_str(COMMON_WGSL).expect("common.wgsl parses");
+    let module = naga::front::wgsl::parse_str(&prelude_source()).expect("the prelude parses");
     check(
         &module,
         "Particle",
@@ -105,14 +107,13 @@ fn rust_and_wgsl_struct_layouts_agree() {
             ("background", offset_of!(GpuFrame, background)),
             ("light_count", offset_of!(GpuFrame, light_count)),
             ("particle_count", offset_of!(GpuFrame, particle_count)),
-            ("samples", offset_of!(GpuFrame, samples)),
-            ("n_exact", offset_of!(GpuFrame, n_exact)),
             ("light_weight", offset_of!(GpuFrame, light_weight)),
             ("ambient", offset_of!(GpuFrame, ambient)),
             ("lit", offset_of!(GpuFrame, lit)),
+            ("camera_position", offset_of!(GpuFrame, camera_position)),
             ("pair_begin", offset_of!(GpuFrame, pair_begin)),
             ("pair_end", offset_of!(GpuFrame, pair_end)),
-            ("camera_position", offset_of!(GpuFrame, camera_position)),
+            ("params", offset_of!(GpuFrame, params)),
         ],
     );
     check(
@@ -135,11 +136,12 @@ fn rust_and_wgsl_struct_layouts_agree() {
 fn the_check_catches_a_shifted_member() {
     // The subtle mismatch: padding moved in front of `shininess`. Same size, same member order,
     // only one offset differs (52 instead of 48); the check must still fail.
-    let wrong = COMMON_WGSL.replace(
+    let prelude = prelude_source();
+    let wrong = prelude.replace(
         "    shininess: f32,\n    _pad0: f32,",
         "    _pad0: f32,\n    shininess: f32,",
     );
-    assert_ne!(wrong, COMMON_WGSL, "the replacement must apply");
+    assert_ne!(wrong, prelude, "the replacement must apply");
     let module = naga::front::wgsl::parse_str(&wrong).expect("still valid WGSL");
     assert_eq!(
         wgsl_layout(&module, "Particle").1 as usize,

@@ -6,14 +6,26 @@ mod gpu_common;
 use glam::DVec3;
 use gpu_common::*;
 use pgt::approx::{render_approx_with, ApproxParams, Method, N_EXACT_ALL};
+use pgt::optics::models;
 use pgt::reference::{self, RenderOptions};
-use pgt::scene::{Light, OpticalModel, RenderMode};
+use pgt::scene::{Light, RenderMode};
+use std::path::PathBuf;
 
-fn params(method: Method, samples: u32, n_exact: u32) -> ApproxParams {
+/// A built-in method with no parameters chosen (its defaults).
+fn plain(name: &str) -> ApproxParams {
+    ApproxParams::for_method(name, &[]).unwrap()
+}
+
+/// The thesis method with these parameters.
+fn thesis(samples: u32, n_exact: u32) -> ApproxParams {
+    ApproxParams::for_method("thesis", &[("samples", samples), ("n_exact", n_exact)]).unwrap()
+}
+
+/// A user shader with these parameters.
+fn user(shader: PathBuf, samples: u32, n_exact: u32) -> ApproxParams {
     ApproxParams {
-        method: Some(method),
-        samples,
-        n_exact,
+        method: Some(Method::User(shader)),
+        values: vec![("samples".into(), samples), ("n_exact".into(), n_exact)],
         adapter: None,
     }
 }
@@ -25,10 +37,10 @@ fn emission_matches_the_exact_answer_on_disjoint_particles() {
         disjoint_particles(),
         vec![],
         RenderMode::Volume,
-        OpticalModel::Emission,
+        models::EMISSION,
     );
     let bvh = s.build_bvh();
-    let gpu = render_approx_with(ctx, &s, &params(Method::Emission, 1, 0)).unwrap();
+    let gpu = render_approx_with(ctx, &s, &plain("emission")).unwrap();
     assert_eq!(gpu.hit_overflow_pixels, 0);
     let oracle = cpu_image(&s.camera, |r| {
         emission_per_particle(&s, &bvh, r, 0.0, f64::INFINITY, s.render.background)
@@ -58,10 +70,10 @@ fn thesis_on_an_emission_scene_is_the_emission_method() {
         disjoint_particles(),
         lights(),
         RenderMode::Volume,
-        OpticalModel::Emission,
+        models::EMISSION,
     );
-    let a = render_approx_with(ctx, &s, &params(Method::Emission, 1, 0)).unwrap();
-    let b = render_approx_with(ctx, &s, &params(Method::Thesis, 16, N_EXACT_ALL)).unwrap();
+    let a = render_approx_with(ctx, &s, &plain("emission")).unwrap();
+    let b = render_approx_with(ctx, &s, &thesis(16, N_EXACT_ALL)).unwrap();
     // The thesis method composites front to back, emission back to front: rounding only.
     let e = rmse(&a.image, &b.image);
     assert!(e <= 1e-6, "{e}");
@@ -73,10 +85,10 @@ fn opaque_matches_the_reference_except_on_silhouettes() {
     let mut ps = disjoint_particles();
     ps[1].ks = 0.5;
     ps[1].shininess = 20.0;
-    let mut s = scene(ps, lights(), RenderMode::Opaque, OpticalModel::Lit);
+    let mut s = scene(ps, lights(), RenderMode::Opaque, models::LIT);
     s.render.ambient = 0.05;
     let bvh = s.build_bvh();
-    let gpu = render_approx_with(ctx, &s, &params(Method::Opaque, 1, 0)).unwrap();
+    let gpu = render_approx_with(ctx, &s, &plain("opaque")).unwrap();
     let reference = reference::render(&s, &RenderOptions::default()).unwrap();
     let mask = silhouette_mask(&s, &bvh);
     let mut worst = 0.0f64;
@@ -109,15 +121,14 @@ fn thesis_converges_to_the_lit_model_on_disjoint_particles() {
         disjoint_particles(),
         lights(),
         RenderMode::Volume,
-        OpticalModel::Lit,
+        models::LIT,
     );
     let bvh = s.build_bvh();
     let oracle = cpu_image(&s.camera, |r| lit_oracle(&s, &bvh, r, 2048));
     let reference = reference::render(&s, &RenderOptions::default()).unwrap();
     let mut previous = (f64::INFINITY, f64::INFINITY);
     for samples in [4, 16, 64, 256] {
-        let gpu =
-            render_approx_with(ctx, &s, &params(Method::Thesis, samples, N_EXACT_ALL)).unwrap();
+        let gpu = render_approx_with(ctx, &s, &thesis(samples, N_EXACT_ALL)).unwrap();
         let e = (
             rmse(&gpu.image, &reference.image),
             rmse(&gpu.image, &oracle),
@@ -151,11 +162,10 @@ fn thesis_on_overlapping_lit_particles_stays_away_from_the_reference() {
         particle([-0.6, 0.0, 0.0], 1.5, [1.0, 0.1, 0.1], 0.9),
         particle([0.6, 0.2, 0.8], 1.5, [0.1, 0.2, 1.0], 0.7),
     ];
-    let s = scene(ps, lights(), RenderMode::Volume, OpticalModel::Lit);
+    let s = scene(ps, lights(), RenderMode::Volume, models::LIT);
     let reference = reference::render(&s, &RenderOptions::default()).unwrap();
     let e = |samples| {
-        let out =
-            render_approx_with(ctx, &s, &params(Method::Thesis, samples, N_EXACT_ALL)).unwrap();
+        let out = render_approx_with(ctx, &s, &thesis(samples, N_EXACT_ALL)).unwrap();
         rmse(&out.image, &reference.image)
     };
     let (e64, e256) = (e(64), e(256));
@@ -172,13 +182,13 @@ fn thesis_with_fewer_exact_particles_is_further_from_the_lit_model() {
         disjoint_particles(),
         lights(),
         RenderMode::Volume,
-        OpticalModel::Lit,
+        models::LIT,
     );
     let bvh = s.build_bvh();
     let oracle = cpu_image(&s.camera, |r| lit_oracle(&s, &bvh, r, 1024));
     let e = |n_exact| {
         rmse(
-            &render_approx_with(ctx, &s, &params(Method::Thesis, 64, n_exact))
+            &render_approx_with(ctx, &s, &thesis(64, n_exact))
                 .unwrap()
                 .image,
             &oracle,
@@ -198,13 +208,13 @@ fn thesis_ignores_overlaps_and_differs_from_exact_intervals() {
         particle([-0.6, 0.0, 0.0], 1.5, [1.0, 0.1, 0.1], 0.9),
         particle([0.6, 0.2, 0.8], 1.5, [0.1, 0.2, 1.0], 0.7),
     ];
-    let s = scene(ps, vec![], RenderMode::Volume, OpticalModel::Emission);
+    let s = scene(ps, vec![], RenderMode::Volume, models::EMISSION);
     let bvh = s.build_bvh();
     let exact = cpu_image(&s.camera, |r| emission_exact_intervals(&s, &bvh, r));
     let per_particle = cpu_image(&s.camera, |r| {
         emission_per_particle(&s, &bvh, r, 0.0, f64::INFINITY, s.render.background)
     });
-    let gpu = render_approx_with(ctx, &s, &params(Method::Thesis, 16, N_EXACT_ALL)).unwrap();
+    let gpu = render_approx_with(ctx, &s, &thesis(16, N_EXACT_ALL)).unwrap();
     let e_exact = rmse(&gpu.image, &exact);
     let e_model = rmse(&gpu.image, &per_particle);
     eprintln!("overlap: thesis vs exact intervals RMSE {e_exact:.3e}, vs per-particle oracle {e_model:.3e}");
@@ -221,9 +231,9 @@ fn thesis_ignores_overlaps_and_differs_from_exact_intervals() {
 #[test]
 fn an_empty_scene_renders_the_background() {
     let Some(ctx) = gpu() else { return };
-    let s = scene(vec![], vec![], RenderMode::Volume, OpticalModel::Lit);
-    for method in [Method::Emission, Method::Thesis, Method::Opaque] {
-        let out = render_approx_with(ctx, &s, &params(method, 4, N_EXACT_ALL)).unwrap();
+    let s = scene(vec![], vec![], RenderMode::Volume, models::LIT);
+    for method in pgt::approx::METHODS {
+        let out = render_approx_with(ctx, &s, &plain(method.name())).unwrap();
         let bg = s.render.background.as_vec3().to_array();
         assert!(out.image.pixels.iter().all(|p| *p == bg));
     }
@@ -244,8 +254,8 @@ fn a_crowded_ray_reports_hit_list_overflow() {
             )
         })
         .collect();
-    let s = scene(ps, vec![], RenderMode::Volume, OpticalModel::Emission);
-    let out = render_approx_with(ctx, &s, &params(Method::Emission, 1, 0)).unwrap();
+    let s = scene(ps, vec![], RenderMode::Volume, models::EMISSION);
+    let out = render_approx_with(ctx, &s, &plain("emission")).unwrap();
     assert!(out.hit_overflow_pixels > 0);
     assert!(out.image.all_finite());
 }
@@ -264,11 +274,11 @@ fn a_point_light_inside_no_particle_lights_the_gas() {
         ps.clone(),
         vec![light(0.0)],
         RenderMode::Volume,
-        OpticalModel::Lit,
+        models::LIT,
     );
-    let far = scene(ps, vec![light(8.0)], RenderMode::Volume, OpticalModel::Lit);
-    let a = render_approx_with(ctx, &near, &params(Method::Thesis, 16, N_EXACT_ALL)).unwrap();
-    let b = render_approx_with(ctx, &far, &params(Method::Thesis, 16, N_EXACT_ALL)).unwrap();
+    let far = scene(ps, vec![light(8.0)], RenderMode::Volume, models::LIT);
+    let a = render_approx_with(ctx, &near, &thesis(16, N_EXACT_ALL)).unwrap();
+    let b = render_approx_with(ctx, &far, &thesis(16, N_EXACT_ALL)).unwrap();
     let centre = (SIDE / 2 * SIDE + SIDE / 2) as usize;
     assert!(a.image.pixels[centre][0] > b.image.pixels[centre][0] + 0.01);
 }
@@ -280,13 +290,13 @@ fn the_opaque_gas_limit_agrees_with_nearly_opaque_gas() {
     // the f64 oracle integrates the same particle with σ = 10⁴ /m (depth scale 0.1 mm on a
     // 0.7 m sphere) without any limit formula. They must agree.
     let ps = disjoint_particles();
-    let s_inf = scene(ps.clone(), lights(), RenderMode::Volume, OpticalModel::Lit);
+    let s_inf = scene(ps.clone(), lights(), RenderMode::Volume, models::LIT);
     assert!(s_inf.particles[2].sigma.is_infinite());
     let mut s_big = s_inf.clone();
     s_big.particles[2].sigma = 1e4;
     let bvh = s_big.build_bvh();
     let oracle = cpu_image(&s_big.camera, |r| lit_oracle(&s_big, &bvh, r, 2048));
-    let gpu = render_approx_with(ctx, &s_inf, &params(Method::Thesis, 256, N_EXACT_ALL)).unwrap();
+    let gpu = render_approx_with(ctx, &s_inf, &thesis(256, N_EXACT_ALL)).unwrap();
     let e = rmse(&gpu.image, &oracle);
     eprintln!("Θmax = 1 limit vs σ = 1e4: RMSE {e:.3e}");
     assert!(e < 1e-3, "{e}");
@@ -314,8 +324,8 @@ fn pixels_beyond_lavapipes_loop_limit_are_reported() {
             )
         })
         .collect();
-    let s = scene(ps, vec![], RenderMode::Volume, OpticalModel::Emission);
-    let out = render_approx_with(ctx, &s, &params(Method::User(shader), 1, 0)).unwrap();
+    let s = scene(ps, vec![], RenderMode::Volume, models::EMISSION);
+    let out = render_approx_with(ctx, &s, &user(shader, 1, 0)).unwrap();
     if ctx.adapter.is_cpu {
         assert!(out.loop_limited_pixels > 0);
     } else {
@@ -326,9 +336,9 @@ fn pixels_beyond_lavapipes_loop_limit_are_reported() {
         disjoint_particles(),
         lights(),
         RenderMode::Volume,
-        OpticalModel::Lit,
+        models::LIT,
     );
-    let out = render_approx_with(ctx, &s, &params(Method::Thesis, 400, N_EXACT_ALL)).unwrap();
+    let out = render_approx_with(ctx, &s, &thesis(400, N_EXACT_ALL)).unwrap();
     assert_eq!(out.loop_limited_pixels, 0);
     if ctx.adapter.is_cpu {
         assert!(out.passes > 1);
@@ -363,7 +373,7 @@ fn thesis_stays_right_on_a_crowded_random_scene() {
         ps,
         pgt::scene::thesis_lights(),
         RenderMode::Volume,
-        OpticalModel::Lit,
+        models::LIT,
     );
     s.camera = pgt::geometry::Camera::new(
         DVec3::new(0.0, 0.0, -3.0 * cube),
@@ -375,7 +385,7 @@ fn thesis_stays_right_on_a_crowded_random_scene() {
     );
     let bvh = s.build_bvh();
     let oracle = cpu_image(&s.camera, |r| lit_oracle(&s, &bvh, r, 512));
-    let out = render_approx_with(ctx, &s, &params(Method::Thesis, 64, N_EXACT_ALL)).unwrap();
+    let out = render_approx_with(ctx, &s, &thesis(64, N_EXACT_ALL)).unwrap();
     let e = rmse(&out.image, &oracle);
     eprintln!(
         "crowded random scene: RMSE {e:.3e} in {} passes",
@@ -393,16 +403,15 @@ fn the_example_user_methods_are_measurably_worse_than_the_thesis_method() {
         disjoint_particles(),
         lights(),
         RenderMode::Volume,
-        OpticalModel::Lit,
+        models::LIT,
     );
     let reference = reference::render(&s, &RenderOptions::default()).unwrap();
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
-    let thesis = render_approx_with(ctx, &s, &params(Method::Thesis, 64, N_EXACT_ALL)).unwrap();
+    let thesis = render_approx_with(ctx, &s, &thesis(64, N_EXACT_ALL)).unwrap();
     let e_thesis = rmse(&thesis.image, &reference.image);
     for example in ["centre_shadow", "no_shadows"] {
         let shader = root.join(format!("shaders/examples/{example}.wgsl"));
-        let out =
-            render_approx_with(ctx, &s, &params(Method::User(shader), 64, N_EXACT_ALL)).unwrap();
+        let out = render_approx_with(ctx, &s, &user(shader, 64, N_EXACT_ALL)).unwrap();
         let e = rmse(&out.image, &reference.image);
         eprintln!("{example}: RMSE vs lit reference {e:.3e} (thesis, 64 samples: {e_thesis:.3e})");
         assert!(out.image.all_finite());

@@ -12,9 +12,10 @@ mod volume_support;
 
 use glam::DVec3;
 use pgt::optics::extinction::sigma_from_opacity;
+use pgt::optics::models;
 use pgt::reference::volume::VolumeRenderer;
 use pgt::reference::{Integrator, RadianceEstimator, Sample};
-use pgt::scene::{default_camera, thesis_lights, OpticalModel};
+use pgt::scene::{default_camera, thesis_lights};
 use rayon::prelude::*;
 use std::time::Instant;
 use volume_support::*;
@@ -60,7 +61,7 @@ fn benchmark_adaptive_against_riemann() {
             )
         })
         .collect();
-    let mut s = scene(OpticalModel::Lit, particles, thesis_lights(), size);
+    let mut s = scene(models::LIT, particles, thesis_lights(), size);
     s.camera = default_camera(&s.particles, size, size);
     s.render.background = DVec3::ZERO;
     s.render.tol = 1e-8;

@@ -5,9 +5,10 @@
 mod volume_support;
 
 use glam::DVec3;
+use pgt::optics::{models, OpticalModel};
 use pgt::reference::volume::VolumeRenderer;
 use pgt::reference::{Integrator, RadianceEstimator, Sample};
-use pgt::scene::{OpticalModel, Scene};
+use pgt::scene::Scene;
 use volume_support::*;
 
 const SIZE: u32 = 32;
@@ -89,13 +90,13 @@ fn honest_at(model: OpticalModel, seed: u64) {
 #[test]
 fn error_estimate_is_honest_for_the_lit_model() {
     for seed in [11, 21, 31] {
-        honest_at(OpticalModel::Lit, seed);
+        honest_at(models::LIT, seed);
     }
 }
 
 #[test]
 fn error_estimate_is_honest_for_the_single_scatter_model() {
     for seed in [12, 22] {
-        honest_at(OpticalModel::SingleScatter, seed);
+        honest_at(models::SINGLE_SCATTER, seed);
     }
 }

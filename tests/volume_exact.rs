@@ -5,9 +5,10 @@ mod volume_support;
 use glam::DVec3;
 use pgt::geometry::Ray;
 use pgt::optics::extinction::sigma_from_opacity;
+use pgt::optics::models;
+use pgt::optics::{Falloff, Light};
 use pgt::reference::volume::VolumeRenderer;
 use pgt::reference::{render, render_with, Integrator, RadianceEstimator, RenderOptions};
-use pgt::scene::{Falloff, Light, OpticalModel};
 use proptest::prelude::*;
 use volume_support::Rng;
 use volume_support::*;
@@ -19,7 +20,7 @@ fn one_sphere_emission_is_the_closed_form_along_every_ray() {
     let (c, r, sigma) = (DVec3::new(0.3, -0.2, 0.5), 1.3, 0.9);
     let color = DVec3::new(1.0, 0.4, 0.1);
     let s = scene(
-        OpticalModel::Emission,
+        models::EMISSION,
         vec![particle(c, r, color, sigma)],
         vec![],
         41,
@@ -57,7 +58,7 @@ fn through_the_centre_transmittance_is_one_minus_opacity() {
     for opacity in [0.0, 1e-9, 0.25, 0.5, 0.9, 0.999_999, 1.0] {
         let r = 0.7;
         let mut s = scene(
-            OpticalModel::Emission,
+            models::EMISSION,
             vec![particle(
                 DVec3::ZERO,
                 r,
@@ -176,7 +177,7 @@ fn opaque_sphere_lit_model_is_the_sigma_to_infinity_limit() {
         irradiance: e,
     };
     let opaque = scene(
-        OpticalModel::Lit,
+        models::LIT,
         vec![particle(DVec3::ZERO, r, color, f64::INFINITY)],
         vec![light],
         15,
@@ -231,7 +232,7 @@ fn opaque_sphere_lit_model_is_the_sigma_to_infinity_limit() {
 fn eye_inside_a_particle_and_particles_behind_the_eye() {
     let (r, sigma, color) = (2.0, 0.6, DVec3::new(0.3, 0.9, 0.2));
     let mut s = scene(
-        OpticalModel::Emission,
+        models::EMISSION,
         vec![particle(DVec3::ZERO, r, color, sigma)],
         vec![],
         5,
@@ -267,7 +268,7 @@ fn eye_inside_a_particle_and_particles_behind_the_eye() {
 #[test]
 fn riemann_sums_converge_to_the_adaptive_reference() {
     let mut rng = Rng::new(5);
-    for model in [OpticalModel::Lit, OpticalModel::SingleScatter] {
+    for model in [models::LIT, models::SINGLE_SCATTER] {
         let mut s = scene(model, random_particles(&mut rng, 6), two_lights(), 8);
         s.render.tol = 1e-10;
         let reference = VolumeRenderer::new(&s, Integrator::Adaptive);
@@ -301,12 +302,7 @@ fn riemann_sums_converge_to_the_adaptive_reference() {
 #[test]
 fn image_is_identical_for_any_thread_count() {
     let mut rng = Rng::new(9);
-    let mut s = scene(
-        OpticalModel::Lit,
-        random_particles(&mut rng, 8),
-        two_lights(),
-        20,
-    );
+    let mut s = scene(models::LIT, random_particles(&mut rng, 8), two_lights(), 20);
     s.render.tol = 1e-5;
     let with = |threads| {
         let opts = RenderOptions {

@@ -3,10 +3,10 @@
 #![no_main]
 
 use libfuzzer_sys::fuzz_target;
-use pgt::formats::{load_bytes, Format};
-use pgt::scene::IncludeSpec;
+use pgt::formats::{load_bytes, Format, IncludeSpec};
 
 fuzz_target!(|data: &[u8]| {
+    let format = Format::named("mmcif").expect("a format of the table");
     let spec = IncludeSpec::bare(std::path::Path::new("fuzz.mmcif"));
-    let _ = load_bytes(&spec, Format::Mmcif, data);
+    let _ = load_bytes(&spec, format, data);
 });

@@ -1,26 +1,22 @@
-//! Uploading the scene, building the compute pipeline, one dispatch over the image, reading the
-//! image back, and timing it (timestamp queries where the adapter has them, wall time otherwise).
+//! Running a program on the GPU, in four parts: a [`Pipeline`] (the compiled method, built once
+//! and reusable for any number of scenes and parameter values, e.g. across a sweep), a scene
+//! upload ([`Upload`]), the pass schedule ([`PassSchedule`]: lavapipe's loop budget, pure logic
+//! with unit tests that need no GPU) and the read-back of the image. Timing by timestamp
+//! queries where the adapter has them, wall time otherwise.
 
 use super::context::GpuContext;
-use super::layout::{GpuFrame, GpuStats, SceneBuffers};
+use super::contract::{BindingKind, BINDINGS, LOOP_BUDGET, WORKGROUP_SIDE};
+use super::layout::{GpuBvhNode, GpuFrame, GpuLight, GpuParticle, GpuStats, SceneBuffers};
 use super::shader::{ShaderProgram, ENTRY_POINT};
 use crate::error::{PgtError, Result};
 use crate::image_io::RgbImage;
 use std::time::Instant;
 use wgpu::util::DeviceExt;
 
-/// Side of the square workgroup in `shaders/entry.wgsl` (`@workgroup_size(8, 8, 1)`).
-const WORKGROUP_SIDE: u32 = 8;
-
-/// (particle, sample) pairs of the thesis method per pass on a Cpu adapter (lavapipe): each
-/// pair costs one shadow ray per light, each shadow ray some hundred loop iterations in a large
-/// scene, and lavapipe allows 65535 per invocation in all.
+/// Work items (for `thesis`: (particle, sample) pairs) of the first pass on a Cpu adapter
+/// (lavapipe): each pair costs one shadow ray per light, each shadow ray some hundred loop
+/// iterations in a large scene, and lavapipe allows `LOOP_LIMIT` per invocation in all.
 pub const PAIRS_PER_PASS_CPU: u32 = 8;
-
-/// Loop iterations a pixel may count in one pass on a Cpu adapter before the pass is redone with
-/// fewer pairs: `LOOP_LIMIT_REPORT` of the prelude (half of lavapipe's 65535, a margin for
-/// lavapipe counting per group of 8 pixels).
-pub const LOOP_BUDGET: u32 = 32768;
 
 /// How the GPU time was measured.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -31,28 +27,157 @@ pub enum Timing {
     Wall,
 }
 
-/// What one dispatch produced.
+/// What one run produced.
 #[derive(Debug, Clone)]
 pub struct DispatchOutput {
     pub image: RgbImage,
     pub gpu_seconds: f64,
     pub timing: Timing,
-    /// Pixels whose hit list overflowed (`MAX_HITS` in the prelude), most in any pass.
+    /// Pixels whose hit list overflowed (`MAX_HITS`), most in any pass.
     pub hit_overflows: u32,
-    /// Pixels that reached lavapipe's loop limit in some pass (most in any pass).
+    /// Pixels that reached the loop budget in some pass (most in any pass).
     pub loop_limited: u32,
     /// Dispatches it took.
     pub passes: u32,
+}
+
+/// What to do after a pass.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PassVerdict {
+    /// The pass took too many loop iterations: restore the image and redo it with fewer items.
+    Redo,
+    /// Accept it and run the next range.
+    Next,
+    /// Accept it; the image is complete.
+    Done,
+}
+
+/// Which work items each pass computes. A method that splits its work (thesis: lit samples)
+/// raises `more_work`; the next pass takes the next range of items. On lavapipe (a Cpu adapter)
+/// all loops of an invocation together may run `LOOP_LIMIT` iterations, so a pass there takes a
+/// few items: a pass whose busiest pixel counted more than [`LOOP_BUDGET`] is undone and redone
+/// with half the items; a light pass (under a quarter of the budget) doubles them. A real GPU
+/// takes all items in one pass.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct PassSchedule {
+    pairs_per_pass: u32,
+    begin: u32,
+    adaptive: bool,
+}
+
+impl PassSchedule {
+    /// The schedule for a Cpu adapter (`cpu`: adaptive, from [`PAIRS_PER_PASS_CPU`]) or a GPU.
+    pub fn new(cpu: bool) -> PassSchedule {
+        PassSchedule {
+            pairs_per_pass: if cpu { PAIRS_PER_PASS_CPU } else { u32::MAX },
+            begin: 0,
+            adaptive: cpu,
+        }
+    }
+
+    /// [pair_begin, pair_end) of the next pass.
+    pub fn range(&self) -> (u32, u32) {
+        (self.begin, self.begin.saturating_add(self.pairs_per_pass))
+    }
+
+    /// Decides after a pass over [`Self::range`], from whether any pixel has more work and the
+    /// most loop iterations any pixel counted.
+    pub fn after_pass(&mut self, more_work: bool, max_loop_iterations: u32) -> PassVerdict {
+        let (begin, end) = self.range();
+        let split = more_work || begin > 0;
+        if self.adaptive {
+            if split && max_loop_iterations > LOOP_BUDGET && self.pairs_per_pass > 1 {
+                self.pairs_per_pass = (self.pairs_per_pass / 2).max(1);
+                return PassVerdict::Redo;
+            }
+            if max_loop_iterations < LOOP_BUDGET / 4 && self.pairs_per_pass < u32::MAX / 2 {
+                self.pairs_per_pass *= 2;
+            }
+        }
+        if !more_work || end == u32::MAX {
+            return PassVerdict::Done;
+        }
+        self.begin = end;
+        PassVerdict::Next
+    }
+}
+
+/// A compiled method: shader module, bind group layout (from [`BINDINGS`]) and compute
+/// pipeline. Build it once and [`run`] it on any number of scenes and parameter values.
+pub struct Pipeline {
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+}
+
+impl std::fmt::Debug for Pipeline {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Pipeline").finish_non_exhaustive()
+    }
+}
+
+impl Pipeline {
+    /// Compiles `program` (already validated with [`ShaderProgram::validate`]).
+    pub fn new(ctx: &GpuContext, program: &ShaderProgram) -> Result<Pipeline> {
+        let device = &ctx.device;
+        let module = ctx.checked("compiling the WGSL", || {
+            device.create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("pgt method"),
+                source: wgpu::ShaderSource::Wgsl(program.source().into()),
+            })
+        })?;
+        // An explicit layout: a user's method need not use every binding.
+        let entries: Vec<wgpu::BindGroupLayoutEntry> = BINDINGS
+            .iter()
+            .map(|b| wgpu::BindGroupLayoutEntry {
+                binding: b.index,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer {
+                    ty: match b.kind {
+                        BindingKind::Uniform => wgpu::BufferBindingType::Uniform,
+                        BindingKind::StorageRead => {
+                            wgpu::BufferBindingType::Storage { read_only: true }
+                        }
+                        BindingKind::StorageReadWrite => {
+                            wgpu::BufferBindingType::Storage { read_only: false }
+                        }
+                    },
+                    has_dynamic_offset: false,
+                    min_binding_size: None,
+                },
+                count: None,
+            })
+            .collect();
+        ctx.checked("creating the compute pipeline", || {
+            let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+                label: Some("pgt scene"),
+                entries: &entries,
+            });
+            let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+                label: Some("pgt"),
+                bind_group_layouts: &[Some(&layout)],
+                immediate_size: 0,
+            });
+            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("pgt method"),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(ENTRY_POINT),
+                compilation_options: Default::default(),
+                cache: None,
+            });
+            Pipeline { pipeline, layout }
+        })
+    }
 }
 
 /// Sizes of the storage buffers, checked against the device's limits before any allocation so
 /// that a scene that is too large is refused with a message, not a wgpu validation error.
 fn check_limits(ctx: &GpuContext, buffers: &[(&str, u64)]) -> Result<()> {
     let limits = ctx.device.limits();
-    let binding = limits.max_storage_buffer_binding_size;
-    let buffer = limits.max_buffer_size;
+    let allowed = limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size);
     for &(name, size) in buffers {
-        let allowed = binding.min(buffer);
         if size > allowed {
             return Err(PgtError::Gpu(format!(
                 "too large for {}: the {name} buffer needs {:.1} MiB, the adapter allows {:.1} MiB per storage buffer \
@@ -87,6 +212,138 @@ fn bytes<T>(n: usize) -> u64 {
     (n.max(1) * std::mem::size_of::<T>()) as u64
 }
 
+const STATS_BYTES: u64 = std::mem::size_of::<GpuStats>() as u64;
+const TIMESTAMP_BYTES: u64 = 16;
+
+/// A scene on the GPU: its buffers bound to a pipeline's layout, and the buffers a run writes
+/// and reads back.
+pub struct Upload {
+    bind_group: wgpu::BindGroup,
+    frame: wgpu::Buffer,
+    output: wgpu::Buffer,
+    stats: wgpu::Buffer,
+    /// Query set and resolve buffer, where the adapter has timestamp queries.
+    timestamps: Option<(wgpu::QuerySet, wgpu::Buffer)>,
+    out_read: wgpu::Buffer,
+    stats_read: wgpu::Buffer,
+    ts_read: wgpu::Buffer,
+    /// A copy of the image before each pass, for [`PassVerdict::Redo`] (Cpu adapters).
+    backup: Option<wgpu::Buffer>,
+    out_bytes: u64,
+    groups: (u32, u32),
+}
+
+impl Upload {
+    /// Checks the sizes against the adapter's limits and uploads the scene.
+    pub fn new(
+        ctx: &GpuContext,
+        pipeline: &Pipeline,
+        scene: &SceneBuffers,
+        frame: &GpuFrame,
+    ) -> Result<Upload> {
+        let out_bytes = bytes::<[f32; 4]>(frame.width as usize * frame.height as usize);
+        check_limits(
+            ctx,
+            &[
+                ("particle", bytes::<GpuParticle>(scene.particles.len())),
+                ("BVH node", bytes::<GpuBvhNode>(scene.nodes.len())),
+                ("BVH index", bytes::<u32>(scene.leaf_indices.len())),
+                ("light", bytes::<GpuLight>(scene.lights.len())),
+                ("output image", out_bytes),
+            ],
+        )?;
+        let groups = (
+            frame.width.div_ceil(WORKGROUP_SIDE),
+            frame.height.div_ceil(WORKGROUP_SIDE),
+        );
+        let max_groups = ctx.device.limits().max_compute_workgroups_per_dimension;
+        if groups.0 > max_groups || groups.1 > max_groups {
+            return Err(PgtError::Gpu(format!(
+                "image {}x{} needs {}x{} workgroups, the adapter allows {max_groups} per dimension",
+                frame.width, frame.height, groups.0, groups.1
+            )));
+        }
+        let device = &ctx.device;
+        let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        use wgpu::BufferUsages as U;
+        ctx.checked("uploading the scene", || {
+            let frame_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+                label: Some("pgt frame"),
+                contents: bytemuck::bytes_of(frame),
+                usage: U::UNIFORM | U::COPY_DST,
+            });
+            let output = buffer(
+                "pgt output",
+                out_bytes,
+                U::STORAGE | U::COPY_SRC | U::COPY_DST,
+            );
+            let stats = buffer(
+                "pgt stats",
+                STATS_BYTES,
+                U::STORAGE | U::COPY_SRC | U::COPY_DST,
+            );
+            let particles = storage(ctx, "pgt particles", &scene.particles);
+            let nodes = storage(ctx, "pgt bvh nodes", &scene.nodes);
+            let indices = storage(ctx, "pgt bvh indices", &scene.leaf_indices);
+            let lights = storage(ctx, "pgt lights", &scene.lights);
+            // In BINDINGS order: frame, particles, nodes, leaf_indices, lights, output, stats.
+            let resources = [
+                &frame_buf, &particles, &nodes, &indices, &lights, &output, &stats,
+            ];
+            let entries: Vec<wgpu::BindGroupEntry> = BINDINGS
+                .iter()
+                .zip(&resources)
+                .map(|(b, r)| wgpu::BindGroupEntry {
+                    binding: b.index,
+                    resource: r.as_entire_binding(),
+                })
+                .collect();
+            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("pgt scene"),
+                layout: &pipeline.layout,
+                entries: &entries,
+            });
+            let timestamps = ctx.timestamps.then(|| {
+                let set = device.create_query_set(&wgpu::QuerySetDescriptor {
+                    label: Some("pgt timestamps"),
+                    ty: wgpu::QueryType::Timestamp,
+                    count: 2,
+                });
+                let resolve = buffer(
+                    "pgt timestamp resolve",
+                    TIMESTAMP_BYTES,
+                    U::QUERY_RESOLVE | U::COPY_SRC,
+                );
+                (set, resolve)
+            });
+            let read = U::MAP_READ | U::COPY_DST;
+            Upload {
+                bind_group,
+                frame: frame_buf,
+                output,
+                stats,
+                timestamps,
+                out_read: buffer("pgt output read-back", out_bytes, read),
+                stats_read: buffer("pgt stats read-back", STATS_BYTES, read),
+                ts_read: buffer("pgt timestamps read-back", TIMESTAMP_BYTES, read),
+                backup: ctx
+                    .adapter
+                    .is_cpu
+                    .then(|| buffer("pgt output backup", out_bytes, U::COPY_SRC | U::COPY_DST)),
+                out_bytes,
+                groups,
+            }
+        })
+    }
+}
+
 /// Maps a MAP_READ buffer and copies its bytes out.
 fn read_back(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
     let (tx, rx) = std::sync::mpsc::channel();
@@ -107,302 +364,134 @@ fn read_back(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
     Ok(data)
 }
 
-/// Runs `program` (already validated with [`ShaderProgram::validate`]) over every pixel.
+/// Copies `from` to `to` on the GPU (`what` names the step in errors).
+fn copy(
+    ctx: &GpuContext,
+    what: &str,
+    from: &wgpu::Buffer,
+    to: &wgpu::Buffer,
+    size: u64,
+) -> Result<()> {
+    ctx.checked(what, || {
+        let mut encoder = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pgt") });
+        encoder.copy_buffer_to_buffer(from, 0, to, 0, size);
+        ctx.queue.submit([encoder.finish()]);
+    })
+}
+
+/// One dispatch over the image with `frame`; returns its counters and timestamp ticks.
+fn run_pass(
+    ctx: &GpuContext,
+    pipeline: &Pipeline,
+    up: &Upload,
+    frame: &GpuFrame,
+) -> Result<(GpuStats, Option<u64>)> {
+    ctx.queue
+        .write_buffer(&up.frame, 0, bytemuck::bytes_of(frame));
+    ctx.queue
+        .write_buffer(&up.stats, 0, bytemuck::bytes_of(&GpuStats::default()));
+    ctx.checked("running the compute pass", || {
+        let mut encoder = ctx
+            .device
+            .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pgt") });
+        if let Some(backup) = &up.backup {
+            encoder.copy_buffer_to_buffer(&up.output, 0, backup, 0, up.out_bytes);
+        }
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("pgt method"),
+                timestamp_writes: up.timestamps.as_ref().map(|(set, _)| {
+                    wgpu::ComputePassTimestampWrites {
+                        query_set: set,
+                        beginning_of_pass_write_index: Some(0),
+                        end_of_pass_write_index: Some(1),
+                    }
+                }),
+            });
+            pass.set_pipeline(&pipeline.pipeline);
+            pass.set_bind_group(0, &up.bind_group, &[]);
+            pass.dispatch_workgroups(up.groups.0, up.groups.1, 1);
+        }
+        if let Some((set, resolve)) = &up.timestamps {
+            encoder.resolve_query_set(set, 0..2, resolve, 0);
+            encoder.copy_buffer_to_buffer(resolve, 0, &up.ts_read, 0, TIMESTAMP_BYTES);
+        }
+        encoder.copy_buffer_to_buffer(&up.stats, 0, &up.stats_read, 0, STATS_BYTES);
+        ctx.queue.submit([encoder.finish()]);
+    })?;
+    let stats_data = read_back(ctx, &up.stats_read)?;
+    ctx.check_uncaptured("running the compute pass")?;
+    let stats: GpuStats = bytemuck::pod_read_unaligned(&stats_data[..STATS_BYTES as usize]);
+    let ticks = match up.timestamps {
+        Some(_) => {
+            let ts = read_back(ctx, &up.ts_read)?;
+            let t: [u64; 2] = bytemuck::pod_read_unaligned(&ts[..TIMESTAMP_BYTES as usize]);
+            Some(t[1].saturating_sub(t[0]))
+        }
+        None => None,
+    };
+    Ok((stats, ticks))
+}
+
+/// Reads the finished image back (RGB of the vec4 per pixel).
+fn read_image(ctx: &GpuContext, up: &Upload, width: u32, height: u32) -> Result<RgbImage> {
+    copy(
+        ctx,
+        "reading the image back",
+        &up.output,
+        &up.out_read,
+        up.out_bytes,
+    )?;
+    let data = read_back(ctx, &up.out_read)?;
+    ctx.check_uncaptured("reading the image back")?;
+    let pixels = width as usize * height as usize;
+    let floats: &[[f32; 4]] = bytemuck::try_cast_slice(&data[..pixels * 16])
+        .map_err(|e| PgtError::Gpu(format!("reading the result back: {e}")))?;
+    let mut image = RgbImage::new(width, height);
+    for (dst, src) in image.pixels.iter_mut().zip(floats) {
+        *dst = [src[0], src[1], src[2]];
+    }
+    Ok(image)
+}
+
+/// Uploads the scene and runs `pipeline` over every pixel, in as many passes as
+/// [`PassSchedule`] decides.
 pub fn run(
     ctx: &GpuContext,
-    program: &ShaderProgram,
+    pipeline: &Pipeline,
     scene: &SceneBuffers,
     frame: &GpuFrame,
 ) -> Result<DispatchOutput> {
-    let pixels = frame.width as usize * frame.height as usize;
-    let out_bytes = bytes::<[f32; 4]>(pixels);
-    check_limits(
-        ctx,
-        &[
-            (
-                "particle",
-                bytes::<super::layout::GpuParticle>(scene.particles.len()),
-            ),
-            (
-                "BVH node",
-                bytes::<super::layout::GpuBvhNode>(scene.nodes.len()),
-            ),
-            ("BVH index", bytes::<u32>(scene.leaf_indices.len())),
-            (
-                "light",
-                bytes::<super::layout::GpuLight>(scene.lights.len()),
-            ),
-            ("output image", out_bytes),
-        ],
-    )?;
-    let groups_x = frame.width.div_ceil(WORKGROUP_SIDE);
-    let groups_y = frame.height.div_ceil(WORKGROUP_SIDE);
-    let max_groups = ctx.device.limits().max_compute_workgroups_per_dimension;
-    if groups_x > max_groups || groups_y > max_groups {
-        return Err(PgtError::Gpu(format!(
-            "image {}x{} needs {groups_x}x{groups_y} workgroups, the adapter allows {max_groups} per dimension",
-            frame.width, frame.height
-        )));
-    }
-
-    let device = &ctx.device;
-    let module = ctx.checked("compiling the WGSL", || {
-        device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("pgt method"),
-            source: wgpu::ShaderSource::Wgsl(program.source().into()),
-        })
-    })?;
-    let storage_entry = |binding: u32, read_only: bool| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    };
-    let (pipeline, layout) = ctx.checked("creating the compute pipeline", || {
-        // An explicit layout: a user's method need not use every binding.
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("pgt scene"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: false,
-                        min_binding_size: None,
-                    },
-                    count: None,
-                },
-                storage_entry(1, true),
-                storage_entry(2, true),
-                storage_entry(3, true),
-                storage_entry(4, true),
-                storage_entry(5, false),
-                storage_entry(6, false),
-            ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("pgt"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("pgt method"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some(ENTRY_POINT),
-            compilation_options: Default::default(),
-            cache: None,
-        });
-        (pipeline, layout)
-    })?;
-
-    let (bind_group, frame_buf, output, stats, timestamps) =
-        ctx.checked("uploading the scene", || {
-            let frame_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("pgt frame"),
-                contents: bytemuck::bytes_of(frame),
-                usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-            });
-            let particles = storage(ctx, "pgt particles", &scene.particles);
-            let nodes = storage(ctx, "pgt bvh nodes", &scene.nodes);
-            let indices = storage(ctx, "pgt bvh indices", &scene.leaf_indices);
-            let lights = storage(ctx, "pgt lights", &scene.lights);
-            let output = device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some("pgt output"),
-                size: out_bytes,
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
-                mapped_at_creation: false,
-            });
-            let stats = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("pgt stats"),
-                contents: bytemuck::bytes_of(&GpuStats::default()),
-                usage: wgpu::BufferUsages::STORAGE
-                    | wgpu::BufferUsages::COPY_SRC
-                    | wgpu::BufferUsages::COPY_DST,
-            });
-            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("pgt scene"),
-                layout: &layout,
-                entries: &[
-                    wgpu::BindGroupEntry {
-                        binding: 0,
-                        resource: frame_buf.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 1,
-                        resource: particles.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 2,
-                        resource: nodes.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 3,
-                        resource: indices.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 4,
-                        resource: lights.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 5,
-                        resource: output.as_entire_binding(),
-                    },
-                    wgpu::BindGroupEntry {
-                        binding: 6,
-                        resource: stats.as_entire_binding(),
-                    },
-                ],
-            });
-            let timestamps = ctx.timestamps.then(|| {
-                let set = device.create_query_set(&wgpu::QuerySetDescriptor {
-                    label: Some("pgt timestamps"),
-                    ty: wgpu::QueryType::Timestamp,
-                    count: 2,
-                });
-                let resolve = device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some("pgt timestamp resolve"),
-                    size: 16,
-                    usage: wgpu::BufferUsages::QUERY_RESOLVE | wgpu::BufferUsages::COPY_SRC,
-                    mapped_at_creation: false,
-                });
-                (set, resolve)
-            });
-            (bind_group, frame_buf, output, stats, timestamps)
-        })?;
-
-    let readback = |label: &str, size: u64| {
-        device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some(label),
-            size,
-            usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        })
-    };
-    let (out_read, stats_read, ts_read) = ctx.checked("allocating read-back buffers", || {
-        (
-            readback("pgt output read-back", out_bytes),
-            readback(
-                "pgt stats read-back",
-                std::mem::size_of::<GpuStats>() as u64,
-            ),
-            readback("pgt timestamps read-back", 16),
-        )
-    })?;
-
-    // Passes: a method that splits its work (thesis: lit samples) raises `more_work`; the next
-    // pass takes the next range of (particle, sample) pairs. On lavapipe (a Cpu adapter) all
-    // loops of an invocation together may run 65535 iterations, so a pass there takes a few
-    // pairs: a pass whose busiest pixel counted more than LOOP_BUDGET is undone (the image is
-    // restored from a copy) and redone with half the pairs; a light pass doubles them. A real
-    // GPU takes all pairs in one pass.
-    let cpu = ctx.adapter.is_cpu;
-    let mut pairs_per_pass = if cpu { PAIRS_PER_PASS_CPU } else { u32::MAX };
-    let backup = cpu.then(|| {
-        device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("pgt output backup"),
-            size: out_bytes,
-            usage: wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        })
-    });
+    let up = Upload::new(ctx, pipeline, scene, frame)?;
+    let mut schedule = PassSchedule::new(ctx.adapter.is_cpu);
     let start = Instant::now();
-    let mut gpu_ticks: Option<f64> = timestamps.as_ref().map(|_| 0.0);
-    let mut hit_overflows = 0u32;
-    let mut loop_limited = 0u32;
-    let mut pass_frame = *frame;
-    pass_frame.pair_begin = 0;
-    let mut passes = 0u32;
+    let mut gpu_ticks: Option<f64> = up.timestamps.as_ref().map(|_| 0.0);
+    let (mut hit_overflows, mut loop_limited, mut passes) = (0u32, 0u32, 0u32);
     loop {
-        pass_frame.pair_end = pass_frame.pair_begin.saturating_add(pairs_per_pass);
-        ctx.queue
-            .write_buffer(&frame_buf, 0, bytemuck::bytes_of(&pass_frame));
-        ctx.queue
-            .write_buffer(&stats, 0, bytemuck::bytes_of(&GpuStats::default()));
-        ctx.checked("running the compute pass", || {
-            let mut encoder = device
-                .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pgt") });
-            if let Some(backup) = &backup {
-                encoder.copy_buffer_to_buffer(&output, 0, backup, 0, out_bytes);
-            }
-            {
-                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-                    label: Some("pgt method"),
-                    timestamp_writes: timestamps.as_ref().map(|(set, _)| {
-                        wgpu::ComputePassTimestampWrites {
-                            query_set: set,
-                            beginning_of_pass_write_index: Some(0),
-                            end_of_pass_write_index: Some(1),
-                        }
-                    }),
-                });
-                pass.set_pipeline(&pipeline);
-                pass.set_bind_group(0, &bind_group, &[]);
-                pass.dispatch_workgroups(groups_x, groups_y, 1);
-            }
-            if let Some((set, resolve)) = &timestamps {
-                encoder.resolve_query_set(set, 0..2, resolve, 0);
-                encoder.copy_buffer_to_buffer(resolve, 0, &ts_read, 0, 16);
-            }
-            encoder.copy_buffer_to_buffer(
-                &stats,
-                0,
-                &stats_read,
-                0,
-                std::mem::size_of::<GpuStats>() as u64,
-            );
-            ctx.queue.submit([encoder.finish()]);
-        })?;
-        let stats_data = read_back(ctx, &stats_read)?;
-        ctx.check_uncaptured("running the compute pass")?;
-        let pass_stats: GpuStats =
-            bytemuck::pod_read_unaligned(&stats_data[..std::mem::size_of::<GpuStats>()]);
-        if let Some(total) = gpu_ticks.as_mut() {
-            let ts = read_back(ctx, &ts_read)?;
-            let t: [u64; 2] = bytemuck::pod_read_unaligned(&ts[..16]);
-            *total += t[1].saturating_sub(t[0]) as f64;
+        let mut pass_frame = *frame;
+        (pass_frame.pair_begin, pass_frame.pair_end) = schedule.range();
+        let (stats, ticks) = run_pass(ctx, pipeline, &up, &pass_frame)?;
+        if let (Some(total), Some(t)) = (gpu_ticks.as_mut(), ticks) {
+            *total += t as f64;
         }
         passes += 1;
-        let split = pass_stats.more_work > 0 || pass_frame.pair_begin > 0;
-        if let Some(backup) = &backup {
-            if split && pass_stats.max_loop_iterations > LOOP_BUDGET && pairs_per_pass > 1 {
-                // Undo and redo this pass with fewer pairs.
-                ctx.checked("restoring the image", || {
-                    let mut encoder =
-                        device.create_command_encoder(&wgpu::CommandEncoderDescriptor {
-                            label: Some("pgt"),
-                        });
-                    encoder.copy_buffer_to_buffer(backup, 0, &output, 0, out_bytes);
-                    ctx.queue.submit([encoder.finish()]);
-                })?;
-                pairs_per_pass = (pairs_per_pass / 2).max(1);
-                continue;
+        let verdict = schedule.after_pass(stats.more_work > 0, stats.max_loop_iterations);
+        if verdict == PassVerdict::Redo {
+            if let Some(backup) = &up.backup {
+                copy(ctx, "restoring the image", backup, &up.output, up.out_bytes)?;
             }
-            if pass_stats.max_loop_iterations < LOOP_BUDGET / 4 && pairs_per_pass < u32::MAX / 2 {
-                pairs_per_pass *= 2;
-            }
+            continue;
         }
-        hit_overflows = hit_overflows.max(pass_stats.hit_overflows);
-        loop_limited = loop_limited.max(pass_stats.loop_limited);
-        if pass_stats.more_work == 0 || pass_frame.pair_end == u32::MAX {
+        hit_overflows = hit_overflows.max(stats.hit_overflows);
+        loop_limited = loop_limited.max(stats.loop_limited);
+        if verdict == PassVerdict::Done {
             break;
         }
-        pass_frame.pair_begin = pass_frame.pair_end;
     }
-    ctx.checked("reading the image back", || {
-        let mut encoder =
-            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pgt") });
-        encoder.copy_buffer_to_buffer(&output, 0, &out_read, 0, out_bytes);
-        ctx.queue.submit([encoder.finish()]);
-    })?;
-    let out_data = read_back(ctx, &out_read)?;
+    let image = read_image(ctx, &up, frame.width, frame.height)?;
     let wall = start.elapsed().as_secs_f64();
-    ctx.check_uncaptured("reading the image back")?;
     let period_ns = ctx.queue.get_timestamp_period() as f64;
     let (gpu_seconds, timing) = match gpu_ticks {
         // A zero reading means the adapter's timestamps are not usable.
@@ -411,13 +500,6 @@ pub fn run(
         }
         _ => (wall, Timing::Wall),
     };
-
-    let floats: &[[f32; 4]] = bytemuck::try_cast_slice(&out_data[..pixels * 16])
-        .map_err(|e| PgtError::Gpu(format!("reading the result back: {e}")))?;
-    let mut image = RgbImage::new(frame.width, frame.height);
-    for (dst, src) in image.pixels.iter_mut().zip(floats) {
-        *dst = [src[0], src[1], src[2]];
-    }
     Ok(DispatchOutput {
         image,
         gpu_seconds,
@@ -426,4 +508,60 @@ pub fn run(
         loop_limited,
         passes,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_gpu_takes_all_work_in_one_pass() {
+        let mut s = PassSchedule::new(false);
+        assert_eq!(s.range(), (0, u32::MAX));
+        // Even a pass far over the budget is accepted: only lavapipe has the limit.
+        assert_eq!(s.after_pass(true, 10 * LOOP_BUDGET), PassVerdict::Done);
+    }
+
+    #[test]
+    fn a_single_pass_method_takes_one_pass_on_lavapipe() {
+        let mut s = PassSchedule::new(true);
+        assert_eq!(s.after_pass(false, 2 * LOOP_BUDGET), PassVerdict::Done);
+    }
+
+    #[test]
+    fn light_passes_double_the_range_and_continue_where_the_last_ended() {
+        let mut s = PassSchedule::new(true);
+        assert_eq!(s.range(), (0, PAIRS_PER_PASS_CPU));
+        assert_eq!(s.after_pass(true, 10), PassVerdict::Next);
+        assert_eq!(s.range(), (8, 24));
+        assert_eq!(s.after_pass(true, LOOP_BUDGET / 2), PassVerdict::Next);
+        assert_eq!(s.range(), (24, 40), "a medium pass keeps its size");
+        assert_eq!(s.after_pass(false, 10), PassVerdict::Done);
+    }
+
+    #[test]
+    fn a_heavy_pass_is_redone_with_half_the_range_down_to_one() {
+        let mut s = PassSchedule::new(true);
+        assert_eq!(s.after_pass(true, LOOP_BUDGET + 1), PassVerdict::Redo);
+        assert_eq!(s.range(), (0, 4));
+        assert_eq!(s.after_pass(true, LOOP_BUDGET + 1), PassVerdict::Redo);
+        assert_eq!(s.after_pass(true, LOOP_BUDGET + 1), PassVerdict::Redo);
+        assert_eq!(s.range(), (0, 1));
+        // One item that is still too heavy cannot be split further: accept it (it is reported).
+        assert_eq!(s.after_pass(true, LOOP_BUDGET + 1), PassVerdict::Next);
+        assert_eq!(s.range().0, 1);
+    }
+
+    #[test]
+    fn the_schedule_ends_when_the_range_reaches_the_end_of_u32() {
+        let mut s = PassSchedule::new(true);
+        for _ in 0..64 {
+            match s.after_pass(true, 0) {
+                PassVerdict::Done => return,
+                PassVerdict::Next => {}
+                PassVerdict::Redo => panic!("a light pass is never redone"),
+            }
+        }
+        panic!("no end after 64 doublings: {s:?}");
+    }
 }

@@ -1,132 +1,185 @@
 //! The scene as the GPU sees it (DESIGN.md §4): one Rust definition of every struct that the
-//! WGSL prelude `shaders/common.wgsl` declares, with explicit padding, so that `bytemuck` can
-//! upload them byte for byte. `tests/gpu_layout.rs` parses the WGSL with naga and compares every
-//! member offset and struct size with these definitions, so a mismatch fails a test instead of
+//! WGSL prelude uses, with explicit padding, so that `bytemuck` can upload them byte for byte.
+//! The WGSL declarations are *generated* from these definitions ([`gpu_struct!`] records each
+//! field's WGSL type, [`super::contract::wgsl_declarations`] writes them); `tests/gpu_layout.rs`
+//! parses the result with naga and compares every member offset and struct size with these
+//! definitions, so a Rust layout that WGSL would pad differently fails a test instead of
 //! silently scrambling the scene.
 //!
 //! Coordinates are **camera-relative** (world position − camera position, computed in f64 and
 //! then rounded to f32): the camera sits at the origin, so f32 keeps its precision where the
 //! image is, however far the scene is from the world origin.
 
+use super::contract::{
+    FALLOFF_INVERSE_SQUARE, FALLOFF_NONE, LIGHT_DIRECTIONAL, LIGHT_POINT, PARAM_SLOTS,
+    SIGMA_INFINITE,
+};
 use crate::geometry::Bvh;
-use crate::scene::{Falloff, Light, LightWeight, Scene};
+use crate::scene::{Falloff, Light, Scene};
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
 
-/// σ = +∞ (Θmax = 1) has no reliable f32 encoding in WGSL (implementations may assume no
-/// infinities), so it travels as this sentinel; `particle_transmittance` in the prelude maps it
-/// back to a transmittance of 0.
-pub const SIGMA_INFINITE: f32 = -1.0;
-
-/// `struct Particle` of `common.wgsl`, 64 bytes.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-pub struct GpuParticle {
-    /// Camera-relative centre (m).
-    pub center: [f32; 3],
-    /// Radius (m).
-    pub radius: f32,
-    /// Linear RGB colour C.
-    pub color: [f32; 3],
-    /// Extinction σ (1/m), or [`SIGMA_INFINITE`].
-    pub sigma: f32,
-    /// Single-scatter albedo.
-    pub albedo: [f32; 3],
-    /// Blinn–Phong specular weight.
-    pub ks: f32,
-    /// Blinn–Phong exponent.
-    pub shininess: f32,
-    pub _pad: [f32; 3],
+/// A Rust struct that has a WGSL twin generated from it.
+pub trait WgslStruct {
+    /// The WGSL struct's name.
+    const WGSL_NAME: &'static str;
+    /// (member name, WGSL type) in declaration order, padding included.
+    const WGSL_FIELDS: &'static [(&'static str, &'static str)];
 }
 
-/// `struct BvhNode` of `common.wgsl`, 32 bytes: the foundation's [`crate::geometry::BvhNode`]
-/// in f32 (camera-relative). `count > 0`: a leaf holding `leaf_indices[first..first+count]`;
-/// `count == 0`: an inner node with children `first` and `first + 1`.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-pub struct GpuBvhNode {
-    pub min: [f32; 3],
-    pub first: u32,
-    pub max: [f32; 3],
-    pub count: u32,
+/// The WGSL type of a Rust field type (only the types the contract uses; another one is a
+/// compile error here, not a silent mismatch).
+macro_rules! wgsl_type {
+    (atomic u32) => {
+        "atomic<u32>"
+    };
+    ($kind:ident u32) => {
+        "u32"
+    };
+    ($kind:ident f32) => {
+        "f32"
+    };
+    ($kind:ident [f32; 3]) => {
+        "vec3<f32>"
+    };
+    ($kind:ident [[u32; 4]; $n:literal]) => {
+        concat!("array<vec4<u32>, ", stringify!($n), ">")
+    };
 }
 
-/// Light kinds in `GpuLight::kind`.
-pub const LIGHT_DIRECTIONAL: u32 = 0;
-pub const LIGHT_POINT: u32 = 1;
-/// Point-light falloffs in `GpuLight::falloff`.
-pub const FALLOFF_INVERSE_SQUARE: u32 = 0;
-pub const FALLOFF_NONE: u32 = 1;
+/// Declares a `#[repr(C)]` Pod struct and its [`WgslStruct`] description from one field list.
+/// `plain` structs map `u32` to `u32`, `atomic` ones (counters the shaders raise) to
+/// `atomic<u32>`.
+macro_rules! gpu_struct {
+    (
+        $(#[$meta:meta])*
+        $kind:ident $wgsl:literal pub struct $name:ident {
+            $($(#[$fmeta:meta])* pub $field:ident : $ty:tt,)*
+        }
+    ) => {
+        $(#[$meta])*
+        #[repr(C)]
+        #[derive(Debug, Clone, Copy, PartialEq, Default, Pod, Zeroable)]
+        pub struct $name {
+            $($(#[$fmeta])* pub $field: $ty,)*
+        }
 
-/// `struct Light` of `common.wgsl`, 32 bytes (DESIGN.md §1).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-pub struct GpuLight {
-    /// Directional: the unit direction the light travels. Point: camera-relative position.
-    pub vector: [f32; 3],
-    /// [`LIGHT_DIRECTIONAL`] or [`LIGHT_POINT`].
-    pub kind: u32,
-    /// Directional: irradiance E (W/m²). Point: intensity I (W/sr).
-    pub power: [f32; 3],
-    /// [`FALLOFF_INVERSE_SQUARE`] or [`FALLOFF_NONE`] (point lights).
-    pub falloff: u32,
+        impl WgslStruct for $name {
+            const WGSL_NAME: &'static str = $wgsl;
+            const WGSL_FIELDS: &'static [(&'static str, &'static str)] =
+                &[$((stringify!($field), wgsl_type!($kind $ty)),)*];
+        }
+    };
 }
 
-/// `struct Frame` of `common.wgsl` (the uniform buffer), 112 bytes: camera, background and the
-/// method's parameters.
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Pod, Zeroable)]
-pub struct GpuFrame {
-    /// Camera frame f, r, u of DESIGN.md §1 (the camera is at the origin).
-    pub forward: [f32; 3],
-    /// tan(fov_y / 2).
-    pub tan_half_fov: f32,
-    pub right: [f32; 3],
-    pub width: u32,
-    pub up: [f32; 3],
-    pub height: u32,
-    /// L_bg, linear RGB.
-    pub background: [f32; 3],
-    pub light_count: u32,
-    pub particle_count: u32,
-    /// `thesis`: midpoint-rule samples per particle chord.
-    pub samples: u32,
-    /// `thesis`: how many particles from the eye use the lit model.
-    pub n_exact: u32,
-    /// Lit model light weight w (1/m or 1).
-    pub light_weight: f32,
-    /// Opaque-mode ambient factor.
-    pub ambient: f32,
-    /// 1 when the scene's model is `lit` (the `thesis` method lights the first `n_exact`
-    /// particles only then), 0 otherwise.
-    pub lit: u32,
-    /// `thesis`: this pass computes the (particle, sample) pairs with index in
-    /// [pair_begin, pair_end), pair = k·samples + j for the k-th particle from the eye and its
-    /// j-th sample. Work is split into passes because lavapipe ends every loop of an invocation
-    /// after 65535 iterations in total (see `dispatch`). Pass 0 also adds everything that is not
-    /// a lit sample; later passes add to the image.
-    pub pair_begin: u32,
-    pub pair_end: u32,
-    /// World position of the camera (f32; for user shaders that need world coordinates:
-    /// world = camera-relative + camera_position).
-    pub camera_position: [f32; 3],
-    pub _pad2: u32,
+gpu_struct! {
+    /// WGSL `struct Particle`, 64 bytes.
+    plain "Particle" pub struct GpuParticle {
+        /// Camera-relative centre (m).
+        pub center: [f32; 3],
+        /// Radius (m).
+        pub radius: f32,
+        /// Linear RGB colour C.
+        pub color: [f32; 3],
+        /// Extinction σ (1/m), or [`SIGMA_INFINITE`].
+        pub sigma: f32,
+        /// Single-scatter albedo.
+        pub albedo: [f32; 3],
+        /// Blinn–Phong specular weight.
+        pub ks: f32,
+        /// Blinn–Phong exponent.
+        pub shininess: f32,
+        pub _pad0: f32,
+        pub _pad1: f32,
+        pub _pad2: f32,
+    }
 }
 
-/// `struct Stats` of `common.wgsl`: counters the shaders raise (atomics).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Default, Pod, Zeroable)]
-pub struct GpuStats {
-    /// Hit lists that were full: the farthest hits were dropped (see `MAX_HITS`).
-    pub hit_overflows: u32,
-    /// Pixels whose shader ran at least `LOOP_LIMIT_REPORT` (32768) loop iterations (counted in
-    /// the prelude's and pgt's loops): on lavapipe, which ends all loops of a group of 8 pixels
-    /// after 65535 iterations, such a pixel may have been cut short.
-    pub loop_limited: u32,
-    /// Pixels that have (particle, sample) pairs beyond this pass's range: another pass follows.
-    pub more_work: u32,
-    /// The most loop iterations any pixel counted in this pass.
-    pub max_loop_iterations: u32,
+gpu_struct! {
+    /// WGSL `struct BvhNode`, 32 bytes: the foundation's [`crate::geometry::BvhNode`] in f32
+    /// (camera-relative). `count > 0`: a leaf holding `leaf_indices[first..first+count]`;
+    /// `count == 0`: an inner node with children `first` and `first + 1`.
+    plain "BvhNode" pub struct GpuBvhNode {
+        pub min: [f32; 3],
+        pub first: u32,
+        pub max: [f32; 3],
+        pub count: u32,
+    }
+}
+
+gpu_struct! {
+    /// WGSL `struct Light`, 32 bytes (DESIGN.md §1).
+    plain "Light" pub struct GpuLight {
+        /// Directional: the unit direction the light travels. Point: camera-relative position.
+        pub vector: [f32; 3],
+        /// [`LIGHT_DIRECTIONAL`] or [`LIGHT_POINT`].
+        pub kind: u32,
+        /// Directional: irradiance E (W/m²). Point: intensity I (W/sr).
+        pub power: [f32; 3],
+        /// [`FALLOFF_INVERSE_SQUARE`] or [`FALLOFF_NONE`] (point lights).
+        pub falloff: u32,
+    }
+}
+
+gpu_struct! {
+    /// WGSL `struct Frame` (the uniform buffer), 144 bytes: camera, background, render settings
+    /// and the method's parameters.
+    plain "Frame" pub struct GpuFrame {
+        /// Camera frame f, r, u of DESIGN.md §1 (the camera is at the origin).
+        pub forward: [f32; 3],
+        /// tan(fov_y / 2).
+        pub tan_half_fov: f32,
+        pub right: [f32; 3],
+        pub width: u32,
+        pub up: [f32; 3],
+        pub height: u32,
+        /// L_bg, linear RGB.
+        pub background: [f32; 3],
+        pub light_count: u32,
+        pub particle_count: u32,
+        /// Lit model light weight w (DESIGN.md §2: 1/m or 1), from
+        /// [`crate::optics::source::light_weight`].
+        pub light_weight: f32,
+        /// Opaque-mode ambient factor.
+        pub ambient: f32,
+        /// 1 when the scene's model is `lit` (the `thesis` method lights the first `n_exact`
+        /// particles only then), 0 otherwise.
+        pub lit: u32,
+        /// World position of the camera (f32; for user shaders that need world coordinates:
+        /// world = camera-relative + camera_position).
+        pub camera_position: [f32; 3],
+        /// A multi-pass method (`thesis`) computes the work items with index in
+        /// [pair_begin, pair_end) in this pass (for `thesis`: pair = k·samples + j for the k-th
+        /// particle from the eye and its j-th sample). Work is split into passes because
+        /// lavapipe ends every loop of an invocation after `LOOP_LIMIT` iterations in total
+        /// (see `dispatch::PassSchedule`). Pass 0 writes the image, later passes add to it.
+        pub pair_begin: u32,
+        pub pair_end: u32,
+        pub _pad0: u32,
+        pub _pad1: u32,
+        pub _pad2: u32,
+        /// The method's parameters, slot k at `params[k / 4][k % 4]` (the prelude's
+        /// `method_param(slot)`; slots are named by generated `PARAM_<NAME>` constants).
+        pub params: [[u32; 4]; 2],
+    }
+}
+
+// The frame's parameter array has exactly PARAM_SLOTS slots.
+const _: () = assert!(std::mem::size_of::<[[u32; 4]; 2]>() / 4 == PARAM_SLOTS);
+
+gpu_struct! {
+    /// WGSL `struct Stats`: counters the shaders raise (atomics).
+    atomic "Stats" pub struct GpuStats {
+        /// Hit lists that were full: the farthest hits were dropped (see `MAX_HITS`).
+        pub hit_overflows: u32,
+        /// Pixels whose shader ran at least `LOOP_BUDGET` loop iterations (counted in the
+        /// prelude's and pgt's loops): on lavapipe such a pixel may have been cut short.
+        pub loop_limited: u32,
+        /// Pixels that have work items beyond this pass's range: another pass follows.
+        pub more_work: u32,
+        /// The most loop iterations any pixel counted in this pass.
+        pub max_loop_iterations: u32,
+    }
 }
 
 /// The scene converted for upload.
@@ -180,7 +233,7 @@ impl SceneBuffers {
                 albedo: p.albedo.as_vec3().to_array(),
                 ks: p.ks as f32,
                 shininess: p.shininess as f32,
-                _pad: [0.0; 3],
+                ..GpuParticle::default()
             })
             .collect();
         let nodes = bvh
@@ -257,10 +310,14 @@ pub fn bvh_depth(bvh: &Bvh) -> u32 {
 }
 
 impl GpuFrame {
-    /// The frame uniform of a scene: camera of DESIGN.md §1 and the render settings.
-    pub fn new(scene: &Scene, samples: u32, n_exact: u32) -> GpuFrame {
+    /// The frame uniform of a scene: camera of DESIGN.md §1, the render settings and the
+    /// method's parameter values by slot (at most [`PARAM_SLOTS`]; the caller validates).
+    pub fn new(scene: &Scene, params: &[u32]) -> GpuFrame {
         let cam = &scene.camera;
-        let m = scene.lights.len().max(1) as f32;
+        let mut slots = [[0u32; 4]; 2];
+        for (k, v) in params.iter().take(PARAM_SLOTS).enumerate() {
+            slots[k / 4][k % 4] = *v;
+        }
         GpuFrame {
             forward: cam.forward.as_vec3().to_array(),
             tan_half_fov: cam.tan_half_fov as f32,
@@ -271,18 +328,17 @@ impl GpuFrame {
             background: scene.render.background.as_vec3().to_array(),
             light_count: scene.lights.len() as u32,
             particle_count: scene.particles.len() as u32,
-            samples,
-            n_exact,
-            light_weight: match scene.render.light_weight {
-                LightWeight::Mean => 1.0 / m,
-                LightWeight::Sum => 1.0,
-            },
+            light_weight: crate::optics::source::light_weight(
+                scene.render.light_weight,
+                scene.lights.len(),
+            ) as f32,
             ambient: scene.render.ambient as f32,
-            lit: (scene.render.model == crate::scene::OpticalModel::Lit) as u32,
+            lit: (scene.render.model == crate::optics::models::LIT) as u32,
+            camera_position: cam.position.as_vec3().to_array(),
             pair_begin: 0,
             pair_end: u32::MAX,
-            camera_position: cam.position.as_vec3().to_array(),
-            _pad2: 0,
+            params: slots,
+            ..GpuFrame::default()
         }
     }
 }

@@ -3,24 +3,32 @@
 //! this module runs them.
 //!
 //! * [`context`]: adapter, device, error scopes (no panics, a clear message without an adapter).
-//! * [`layout`]: the structs shared with `shaders/common.wgsl`, byte for byte.
-//! * [`shader`]: prelude + method + entry point, validated with naga, errors by file and line.
-//! * [`methods`]: `emission`, `opaque`, `thesis` and their parameters.
+//! * [`contract`]: the constants and bindings shared with WGSL, and the WGSL generated from them.
+//! * [`layout`]: the structs shared with WGSL, byte for byte.
+//! * [`shader`]: generated contract + prelude + method + entry point, validated with naga,
+//!   errors by file and line.
+//! * [`methods`]: the [`ApproxMethod`] trait and the registry of built-in methods, one file each.
+//! * [`params`]: parameter specs, the chosen method and its parameter values.
 //! * [`user_shader`]: users' own methods (docs/user-shaders.md).
-//! * [`dispatch`]: upload, dispatch, read-back, timing.
+//! * [`dispatch`]: pipeline, upload, pass schedule, read-back, timing.
 //!
-//! [`render_approx`] is the library entry point that `pgt approx` and `pgt sweep` share.
+//! [`render_approx`] is the library entry point that `pgt approx` and `pgt sweep` share;
+//! [`ApproxPipeline`] keeps a compiled method for many renders.
 
 pub mod context;
+pub mod contract;
 pub mod dispatch;
 pub mod layout;
 pub mod methods;
+pub mod params;
 pub mod shader;
 pub mod user_shader;
 
 pub use context::{GpuContext, NO_ADAPTER};
+pub use contract::{MAX_HITS, STACK_DEPTH};
 pub use dispatch::Timing;
-pub use methods::{ApproxParams, Method, N_EXACT_ALL};
+pub use methods::{find_method, ApproxMethod, METHODS};
+pub use params::{ApproxParams, Method, ParamSpec, N_EXACT_ALL};
 
 use crate::error::{PgtError, Result};
 use crate::image_io::RgbImage;
@@ -38,11 +46,14 @@ pub struct ApproxOutput {
     pub adapter_name: String,
     /// The method that ran.
     pub method: Method,
-    /// Pixels where a ray crossed more than `MAX_HITS` (128) particles: the farthest were
+    /// Its parameters with the values used (chosen or default), in slot order.
+    pub params: Vec<(String, u32)>,
+    /// Pixels where a ray crossed more than [`MAX_HITS`] particles: the farthest were
     /// dropped for that ray. Non-zero means the image is not what the method would give.
     pub hit_overflow_pixels: u32,
-    /// Pixels whose loops reached 65535 iterations: lavapipe cuts them short there, so on a Cpu
-    /// adapter these pixels are wrong (pgt splits the thesis method into passes to avoid it).
+    /// Pixels whose loops reached the loop budget (`contract::LOOP_BUDGET`): lavapipe cuts loops
+    /// short at `contract::LOOP_LIMIT`, so on a Cpu adapter these pixels may be wrong (pgt
+    /// splits the thesis method into passes to avoid it).
     pub loop_limited_pixels: u32,
     /// Dispatches the method took (the thesis method on lavapipe takes several).
     pub passes: u32,
@@ -51,9 +62,9 @@ pub struct ApproxOutput {
 /// Opens a GPU context ([`GpuContext::new`] with `params.adapter`) and renders the scene.
 /// The method's WGSL is checked first, so a broken shader is reported even without a GPU.
 pub fn render_approx(scene: &Scene, params: &ApproxParams) -> Result<ApproxOutput> {
-    let (method, program) = prepare(scene, params)?;
+    let (method, values, program) = prepare(scene, params)?;
     let ctx = GpuContext::new(params.adapter.as_deref())?;
-    run(&ctx, scene, params, method, &program)
+    ApproxPipeline::from_program(&ctx, method, &values, &program)?.render(&ctx, scene, params)
 }
 
 /// Renders with an open context (a sweep opens one and renders many parameter sets).
@@ -63,61 +74,105 @@ pub fn render_approx_with(
     scene: &Scene,
     params: &ApproxParams,
 ) -> Result<ApproxOutput> {
-    let (method, program) = prepare(scene, params)?;
-    run(ctx, scene, params, method, &program)
+    let (method, values, program) = prepare(scene, params)?;
+    ApproxPipeline::from_program(ctx, method, &values, &program)?.render(ctx, scene, params)
 }
 
+/// A method ready to compile: the method, its parameter values in slot order, its program.
+type Prepared = (Method, Vec<(String, u32)>, shader::ShaderProgram);
+
 /// Resolves the method, checks it against the scene and the parameters, validates its WGSL.
-fn prepare(scene: &Scene, params: &ApproxParams) -> Result<(Method, shader::ShaderProgram)> {
+fn prepare(scene: &Scene, params: &ApproxParams) -> Result<Prepared> {
     let method = params
         .method
         .clone()
         .unwrap_or_else(|| Method::default_for(scene));
     method.check_scene(scene)?;
-    if params.samples == 0 {
-        return Err(PgtError::Usage("--samples must be at least 1".into()));
-    }
-    let program = method.program()?;
+    let values = params.resolve(&method)?;
+    let program = method.program(&values)?;
     program.validate()?;
-    Ok((method, program))
+    Ok((method, values, program))
 }
 
-fn run(
-    ctx: &GpuContext,
-    scene: &Scene,
-    params: &ApproxParams,
+/// A method compiled for one context: build it once, render any scene with any values of its
+/// parameters (the sweep's runs of one method share one).
+#[derive(Debug)]
+pub struct ApproxPipeline {
     method: Method,
-    program: &shader::ShaderProgram,
-) -> Result<ApproxOutput> {
-    let bvh = scene.build_bvh();
-    let buffers = layout::SceneBuffers::new(scene, &bvh);
-    if buffers.bvh_depth > STACK_DEPTH {
-        return Err(PgtError::Gpu(format!(
-            "the BVH is {} levels deep, the shaders' traversal stack holds {STACK_DEPTH}",
-            buffers.bvh_depth
-        )));
-    }
-    let frame = layout::GpuFrame::new(scene, params.samples, params.n_exact);
-    let out = dispatch::run(ctx, program, &buffers, &frame)?;
-    Ok(ApproxOutput {
-        image: out.image,
-        gpu_seconds: out.gpu_seconds,
-        timing: out.timing,
-        adapter_name: ctx.adapter.name.clone(),
-        method,
-        hit_overflow_pixels: out.hit_overflows,
-        loop_limited_pixels: if ctx.adapter.is_cpu {
-            out.loop_limited
-        } else {
-            0
-        },
-        passes: out.passes,
-    })
+    /// The parameter names the program was generated with, in slot order.
+    names: Vec<String>,
+    pipeline: dispatch::Pipeline,
 }
 
-/// Deepest BVH the WGSL traversal handles: `STACK_SIZE` (64) in `shaders/common.wgsl` minus
-/// one, since a node's two children are pushed together.
-pub const STACK_DEPTH: u32 = 63;
+impl ApproxPipeline {
+    /// Validates and compiles `method` with the parameter names `params` resolves to.
+    pub fn new(ctx: &GpuContext, method: &Method, params: &ApproxParams) -> Result<ApproxPipeline> {
+        let values = params.resolve(method)?;
+        let program = method.program(&values)?;
+        program.validate()?;
+        ApproxPipeline::from_program(ctx, method.clone(), &values, &program)
+    }
 
-/// Most hits one ray list holds: `MAX_HITS` in `shaders/common.wgsl`.
-pub const MAX_HITS: u32 = 128;
+    fn from_program(
+        ctx: &GpuContext,
+        method: Method,
+        values: &[(String, u32)],
+        program: &shader::ShaderProgram,
+    ) -> Result<ApproxPipeline> {
+        Ok(ApproxPipeline {
+            method,
+            names: values.iter().map(|(n, _)| n.clone()).collect(),
+            pipeline: dispatch::Pipeline::new(ctx, program)?,
+        })
+    }
+
+    /// The method it runs.
+    pub fn method(&self) -> &Method {
+        &self.method
+    }
+
+    /// Renders `scene` with `params`' values (`params.method` is ignored: this pipeline's
+    /// method runs).
+    pub fn render(
+        &self,
+        ctx: &GpuContext,
+        scene: &Scene,
+        params: &ApproxParams,
+    ) -> Result<ApproxOutput> {
+        self.method.check_scene(scene)?;
+        let values = params.resolve(&self.method)?;
+        if values.iter().map(|(n, _)| n).ne(self.names.iter()) {
+            return Err(PgtError::Usage(format!(
+                "{}: this pipeline was built for the parameters {:?}",
+                self.method.name(),
+                self.names
+            )));
+        }
+        let bvh = scene.build_bvh();
+        let buffers = layout::SceneBuffers::new(scene, &bvh);
+        if buffers.bvh_depth > STACK_DEPTH {
+            return Err(PgtError::Gpu(format!(
+                "the BVH is {} levels deep, the shaders' traversal stack holds {STACK_DEPTH}",
+                buffers.bvh_depth
+            )));
+        }
+        let slots: Vec<u32> = values.iter().map(|(_, v)| *v).collect();
+        let frame = layout::GpuFrame::new(scene, &slots);
+        let out = dispatch::run(ctx, &self.pipeline, &buffers, &frame)?;
+        Ok(ApproxOutput {
+            image: out.image,
+            gpu_seconds: out.gpu_seconds,
+            timing: out.timing,
+            adapter_name: ctx.adapter.name.clone(),
+            method: self.method.clone(),
+            params: values,
+            hit_overflow_pixels: out.hit_overflows,
+            loop_limited_pixels: if ctx.adapter.is_cpu {
+                out.loop_limited
+            } else {
+                0
+            },
+            passes: out.passes,
+        })
+    }
+}

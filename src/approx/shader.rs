@@ -1,6 +1,7 @@
-//! WGSL programs: the prelude `shaders/common.wgsl`, one method file and the entry point
-//! `shaders/entry.wgsl`, concatenated, then parsed and validated with naga before any pipeline
-//! exists (DESIGN.md §4). Errors name the file the offending line came from and its line in
+//! WGSL programs: the declarations generated from the CPU–GPU contract
+//! ([`super::contract::wgsl_declarations`]), the method's parameter slot names, the prelude
+//! `shaders/common.wgsl`, one method file and the entry point `shaders/entry.wgsl`,
+//! concatenated, then parsed and validated with naga before any pipeline exists (DESIGN.md §4). Errors name the file the offending line came from and its line in
 //! *that* file, so a user's mistake points at the user's line, not at the concatenation.
 
 use crate::error::{PgtError, Result};
@@ -12,6 +13,32 @@ pub const COMMON_WGSL: &str = include_str!("../../shaders/common.wgsl");
 pub const ENTRY_WGSL: &str = include_str!("../../shaders/entry.wgsl");
 /// Name of the compute entry point.
 pub const ENTRY_POINT: &str = "pgt_main";
+
+/// How messages name the generated declarations (an error there is pgt's bug, not the user's).
+pub const GENERATED_CONTRACT: &str = "<generated from src/approx/contract.rs>";
+/// How messages name the generated parameter slot constants.
+pub const GENERATED_PARAMS: &str = "<generated parameter slots>";
+
+/// The generated contract followed by `shaders/common.wgsl`: everything a method can use.
+pub fn prelude_parts() -> Vec<ShaderPart> {
+    vec![
+        ShaderPart {
+            name: GENERATED_CONTRACT.into(),
+            text: Cow::Owned(super::contract::wgsl_declarations()),
+        },
+        ShaderPart {
+            name: "shaders/common.wgsl".into(),
+            text: Cow::Borrowed(COMMON_WGSL),
+        },
+    ]
+}
+
+/// The prelude as one text (generated contract + `shaders/common.wgsl`), e.g. for naga.
+pub fn prelude_source() -> String {
+    ShaderProgram::from_parts(prelude_parts())
+        .source()
+        .to_string()
+}
 
 /// One source file of a program.
 #[derive(Debug, Clone)]
@@ -39,19 +66,23 @@ pub struct SourcePosition {
 }
 
 impl ShaderProgram {
-    /// prelude + `method` + entry point.
-    pub fn with_method(method: ShaderPart) -> ShaderProgram {
-        ShaderProgram::from_parts(vec![
-            ShaderPart {
-                name: "shaders/common.wgsl".into(),
-                text: Cow::Borrowed(COMMON_WGSL),
-            },
-            method,
-            ShaderPart {
-                name: "shaders/entry.wgsl".into(),
-                text: Cow::Borrowed(ENTRY_WGSL),
-            },
-        ])
+    /// Generated contract + parameter slots + prelude + `method` + entry point.
+    /// `param_names`: the method's parameters in slot order (`PARAM_<NAME>` constants).
+    pub fn with_method<'a>(
+        method: ShaderPart,
+        param_names: impl IntoIterator<Item = &'a str>,
+    ) -> ShaderProgram {
+        let mut parts = prelude_parts();
+        parts.push(ShaderPart {
+            name: GENERATED_PARAMS.into(),
+            text: Cow::Owned(super::contract::param_declarations(param_names)),
+        });
+        parts.push(method);
+        parts.push(ShaderPart {
+            name: "shaders/entry.wgsl".into(),
+            text: Cow::Borrowed(ENTRY_WGSL),
+        });
+        ShaderProgram::from_parts(parts)
     }
 
     /// Concatenates parts, each ending with a newline so lines never merge across files.
@@ -203,10 +234,16 @@ mod tests {
 
     #[test]
     fn shipped_methods_validate() {
+        for method in crate::approx::methods::METHODS {
+            let prog = ShaderProgram::with_method(
+                part(method.name(), method.wgsl()),
+                method.params().iter().map(|p| p.name),
+            );
+            if let Err(e) = prog.validate() {
+                panic!("{}: {e}", method.name());
+            }
+        }
         for (name, text) in [
-            ("emission", crate::approx::methods::EMISSION_WGSL),
-            ("opaque", crate::approx::methods::OPAQUE_WGSL),
-            ("thesis", crate::approx::methods::THESIS_WGSL),
             (
                 "examples/centre_shadow",
                 include_str!("../../shaders/examples/centre_shadow.wgsl"),
@@ -216,7 +253,8 @@ mod tests {
                 include_str!("../../shaders/examples/no_shadows.wgsl"),
             ),
         ] {
-            let prog = ShaderProgram::with_method(part(name, text));
+            let names = crate::approx::params::USER_PARAMS.iter().map(|p| p.name);
+            let prog = ShaderProgram::with_method(part(name, text), names);
             if let Err(e) = prog.validate() {
                 panic!("{name}: {e}");
             }
@@ -228,7 +266,7 @@ mod tests {
         let prog = ShaderProgram::with_method(part(
             "mine.wgsl",
             "// line 1\nfn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {\n    return vec3<f32>(undefined_thing);\n}\n",
-        ));
+        ), []);
         let err = prog.validate().unwrap_err().to_string();
         assert!(err.starts_with("mine.wgsl:3:"), "{err}");
         assert!(err.contains("undefined_thing"), "{err}");
@@ -239,7 +277,7 @@ mod tests {
         let prog = ShaderProgram::with_method(part(
             "mine.wgsl",
             "fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {\n    let a = 1.0;\n    return a;\n}\n",
-        ));
+        ), []);
         let err = prog.validate().unwrap_err().to_string();
         assert!(err.contains("mine.wgsl:"), "{err}");
     }

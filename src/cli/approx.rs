@@ -1,45 +1,46 @@
 //! `pgt approx SCENE --method thesis --samples 100 --n-exact 5 -o OUT` (DESIGN.md §4, §7): the
-//! GPU approximation, or a user's method with `--shader FILE.wgsl`.
+//! GPU approximation, or a user's method with `--shader FILE.wgsl`. The methods and their
+//! parameters come from the registry (`crate::approx::methods`); `--list-methods` prints it.
 
 use super::Outcome;
-use crate::approx::{self, ApproxParams, Method, Timing, N_EXACT_ALL};
+use crate::approx::{self, methods, ApproxParams, Method, Timing, N_EXACT_ALL};
 use crate::image_io::write_image;
 use crate::scene::{OpticalModel, RenderMode, SceneLoadOptions};
-use clap::{Args, ValueEnum};
+use clap::builder::PossibleValuesParser;
+use clap::Args;
 use std::path::PathBuf;
-
-/// The built-in methods by name (`--method`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum MethodName {
-    /// Per-particle compositing with the emission model's closed form.
-    Emission,
-    /// Opaque spheres: first hit, Lambert + Blinn–Phong, hard shadows.
-    Opaque,
-    /// The thesis's scheme (chapter 5): lit model for the first --n-exact particles.
-    Thesis,
-}
 
 /// `pgt approx` (DESIGN.md §7).
 #[derive(Debug, Args)]
 pub struct ApproxArgs {
     /// Scene file (.toml) or a bare particle file.
-    pub scene: PathBuf,
+    #[arg(required_unless_present = "list_methods")]
+    pub scene: Option<PathBuf>,
     /// Output image; the format follows the extension (.exr or .png).
-    #[arg(short, long)]
-    pub output: PathBuf,
-    /// Approximation method [default: opaque for opaque scenes, thesis otherwise].
-    #[arg(long, value_enum, conflicts_with = "shader")]
-    pub method: Option<MethodName>,
+    #[arg(short, long, required_unless_present = "list_methods")]
+    pub output: Option<PathBuf>,
+    /// Approximation method (see --list-methods) [default: opaque for opaque scenes, thesis
+    /// otherwise].
+    #[arg(long, value_parser = PossibleValuesParser::new(methods::names()), conflicts_with = "shader")]
+    pub method: Option<String>,
+    /// Print the methods and their parameters (a Markdown table) and exit.
+    #[arg(long)]
+    pub list_methods: bool,
     /// A WGSL file defining `fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32>`
     /// (docs/user-shaders.md).
     #[arg(long)]
     pub shader: Option<PathBuf>,
-    /// thesis: midpoint-rule samples per particle chord.
-    #[arg(long, default_value_t = 100)]
-    pub samples: u32,
-    /// thesis: particles from the eye that get the lit model (a number or "all").
-    #[arg(long, default_value = "all", value_parser = parse_n_exact)]
-    pub n_exact: u32,
+    /// The method's parameter `samples` (thesis: midpoint-rule samples per particle chord);
+    /// short for --param samples=N.
+    #[arg(long)]
+    pub samples: Option<u32>,
+    /// The method's parameter `n_exact` (thesis: particles from the eye that get the lit model;
+    /// a number or "all"); short for --param n_exact=N.
+    #[arg(long, value_parser = parse_count)]
+    pub n_exact: Option<u32>,
+    /// Any parameter of the method, NAME=VALUE (repeatable; VALUE a number or "all").
+    #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_param)]
+    pub params: Vec<(String, u32)>,
     /// Use the adapter whose name contains this (case-insensitive).
     #[arg(long)]
     pub adapter: Option<String>,
@@ -55,7 +56,8 @@ pub struct ApproxArgs {
     pub exposure: f32,
 }
 
-fn parse_n_exact(s: &str) -> Result<u32, String> {
+/// A parameter value: a non-negative integer or "all" ([`N_EXACT_ALL`]).
+fn parse_count(s: &str) -> Result<u32, String> {
     if s.eq_ignore_ascii_case("all") {
         return Ok(N_EXACT_ALL);
     }
@@ -63,31 +65,73 @@ fn parse_n_exact(s: &str) -> Result<u32, String> {
         .map_err(|_| format!("expected a non-negative integer or 'all', got '{s}'"))
 }
 
+fn parse_param(s: &str) -> Result<(String, u32), String> {
+    let (name, value) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected NAME=VALUE, got '{s}'"))?;
+    Ok((name.trim().to_string(), parse_count(value.trim())?))
+}
+
+impl ApproxArgs {
+    /// The method and parameter values the arguments choose.
+    fn params(&self) -> anyhow::Result<ApproxParams> {
+        let method = match (&self.shader, &self.method) {
+            (Some(path), _) => Some(Method::User(path.clone())),
+            (None, Some(name)) => Some(Method::named(name)?),
+            (None, None) => None,
+        };
+        let mut values = Vec::new();
+        if let Some(v) = self.samples {
+            values.push(("samples".to_string(), v));
+        }
+        if let Some(v) = self.n_exact {
+            values.push(("n_exact".to_string(), v));
+        }
+        values.extend(self.params.iter().cloned());
+        Ok(ApproxParams {
+            method,
+            values,
+            adapter: self.adapter.clone(),
+        })
+    }
+}
+
+/// "(samples 8, n_exact all)" for the summary; empty without parameters.
+fn describe_params(method: &Method, values: &[(String, u32)]) -> String {
+    if values.is_empty() {
+        return String::new();
+    }
+    let specs = method.specs();
+    let shown: Vec<String> = values
+        .iter()
+        .map(|(n, v)| match specs.iter().find(|s| s.name == n) {
+            Some(s) => format!("{n} {}", s.show(*v)),
+            None => format!("{n} {v}"),
+        })
+        .collect();
+    format!(" ({})", shown.join(", "))
+}
+
 /// Loads the scene, runs the approximation (DESIGN.md §4), writes the image and prints the
 /// one-line summary with the adapter and the GPU time (DESIGN.md §7).
 pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
+    if args.list_methods {
+        print!("{}", methods::markdown_table());
+        return Ok(Outcome::Success);
+    }
+    let (Some(scene_path), Some(output)) = (&args.scene, &args.output) else {
+        anyhow::bail!("pgt approx needs a SCENE and -o OUTPUT (or --list-methods)");
+    };
     let options = SceneLoadOptions {
         size: args.size,
         mode: args.mode,
         model: args.model,
         tol: None,
     };
-    let scene = super::load_scene_for(&args.scene, &options, &args.output, args.exposure)?;
-    let method = match (&args.shader, args.method) {
-        (Some(path), _) => Some(Method::User(path.clone())),
-        (None, Some(MethodName::Emission)) => Some(Method::Emission),
-        (None, Some(MethodName::Opaque)) => Some(Method::Opaque),
-        (None, Some(MethodName::Thesis)) => Some(Method::Thesis),
-        (None, None) => None,
-    };
-    let params = ApproxParams {
-        method,
-        samples: args.samples,
-        n_exact: args.n_exact,
-        adapter: args.adapter.clone(),
-    };
+    let scene = super::load_scene_for(scene_path, &options, output, args.exposure)?;
+    let params = args.params()?;
     let out = approx::render_approx(&scene, &params)?;
-    write_image(&args.output, &out.image, &[], args.exposure)?;
+    write_image(output, &out.image, &[], args.exposure)?;
     if out.hit_overflow_pixels > 0 {
         eprintln!(
             "warning: {} pixels crossed more than {} particles; their farthest particles were dropped",
@@ -97,22 +141,11 @@ pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
     }
     if out.loop_limited_pixels > 0 {
         eprintln!(
-            "warning: {} pixels reached lavapipe's limit of 65535 loop iterations per pixel; lavapipe cuts such loops short, so these pixels are wrong (use fewer samples or a real GPU)",
-            out.loop_limited_pixels
+            "warning: {} pixels reached lavapipe's limit of {} loop iterations per pixel; lavapipe cuts such loops short, so these pixels are wrong (use fewer samples or a real GPU)",
+            out.loop_limited_pixels,
+            approx::contract::LOOP_LIMIT
         );
     }
-    let n_exact = if args.n_exact == N_EXACT_ALL {
-        "all".to_string()
-    } else {
-        args.n_exact.to_string()
-    };
-    // Only the thesis method (and user shaders, which may read them) use the parameters.
-    let parameters = match out.method {
-        Method::Thesis | Method::User(_) => {
-            format!(" (samples {}, n_exact {n_exact})", args.samples)
-        }
-        Method::Emission | Method::Opaque => String::new(),
-    };
     let passes = if out.passes == 1 {
         "1 pass".to_string()
     } else {
@@ -120,13 +153,14 @@ pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
     };
     let pixels = scene.camera.width as f64 * scene.camera.height as f64;
     eprintln!(
-        "approximated {} ({}x{}, {} spheres, {} lights) with {}{parameters} on {}: {:.3} s GPU ({}, {passes}), {:.3} Mpixels/s",
-        args.output.display(),
+        "approximated {} ({}x{}, {} spheres, {} lights) with {}{} on {}: {:.3} s GPU ({}, {passes}), {:.3} Mpixels/s",
+        output.display(),
         scene.camera.width,
         scene.camera.height,
         scene.particles.len(),
         scene.lights.len(),
         out.method.name(),
+        describe_params(&out.method, &out.params),
         out.adapter_name,
         out.gpu_seconds,
         match out.timing {

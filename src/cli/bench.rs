@@ -19,6 +19,8 @@
 use super::Outcome;
 use crate::formats::random::{generate, RandomSpec, SplitMix64, THESIS_COUNT};
 use crate::optics::extinction::sigma_from_opacity;
+use crate::optics::model::LightNeed;
+use crate::optics::models;
 use crate::reference::{self, Integrator, RenderOptions, RenderOutput};
 use crate::scene::{
     default_camera, thesis_lights, OpticalModel, Particle, RenderSettings, Scene, SceneLoadOptions,
@@ -154,7 +156,7 @@ fn bench_scene(name: &str, scene: &Scene, args: &BenchArgs) -> anyhow::Result<Ve
         emission: None,
         max_error: None,
     };
-    let lit = scene.render.model != OpticalModel::Emission;
+    let lit = scene.render.model.light_need() != LightNeed::None;
     if !lit {
         let out = render(scene, None, Integrator::Adaptive, TOL, threads)?;
         return Ok(vec![row("emission", out)]);
@@ -173,7 +175,7 @@ fn bench_scene(name: &str, scene: &Scene, args: &BenchArgs) -> anyhow::Result<Ve
             "emission",
             render(
                 scene,
-                Some(OpticalModel::Emission),
+                Some(models::EMISSION),
                 Integrator::Adaptive,
                 TOL,
                 threads,
@@ -230,7 +232,7 @@ fn workload_scene(w: Workload, size: u32, data: &Path) -> anyhow::Result<(String
         Workload::Million | Workload::MillionLit => {
             let mut s = bare_scene(random_set(MILLION), size);
             if w == Workload::Million {
-                s.render.model = OpticalModel::Emission;
+                s.render.model = models::EMISSION;
             }
             Ok(("random 1,000,000".into(), s))
         }

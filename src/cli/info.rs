@@ -3,8 +3,8 @@
 //! validated with [`Scene::load`], so its includes count too).
 
 use super::Outcome;
-use crate::formats::{load_particles, Format};
-use crate::scene::{IncludeSpec, Scene, SceneLoadOptions};
+use crate::formats::{format_of, load_bytes, read_input, Format, IncludeSpec, FORMATS};
+use crate::scene::{Scene, SceneLoadOptions};
 use clap::Args;
 use glam::DVec3;
 use std::collections::HashMap;
@@ -13,11 +13,30 @@ use std::path::PathBuf;
 /// Options of `pgt info`.
 #[derive(Debug, Args)]
 pub struct InfoArgs {
-    /// A particle file (.pdb, .cif, .wrl, .mmpld, .xyz, .csv) or a scene file (.toml).
+    /// A particle file or a scene file (.toml).
+    #[arg(long_help = file_help())]
     pub file: PathBuf,
     /// Print JSON on stdout instead of text.
     #[arg(long)]
     pub json: bool,
+}
+
+/// `pgt info --help` for FILE, from the table of formats.
+fn file_help() -> String {
+    let mut help = String::from(
+        "A particle file or a scene file (.toml). Particle formats (the name for `format` in an \
+         [[include]], the extensions, the format):",
+    );
+    for f in FORMATS {
+        let ext: Vec<String> = f.extensions.iter().map(|e| format!(".{e}")).collect();
+        help.push_str(&format!(
+            "\n  {:<6} {:<13} {}",
+            f.name,
+            ext.join(" "),
+            f.description
+        ));
+    }
+    help
 }
 
 /// How many of the most common colours the summary lists.
@@ -145,50 +164,9 @@ pub fn summarize(
     }
 }
 
-/// The format-specific facts of [`Info::details`].
-fn details(
-    path: &std::path::Path,
-    format: Format,
-) -> crate::Result<serde_json::Map<String, serde_json::Value>> {
-    use serde_json::json;
-    let mut d = serde_json::Map::new();
-    let atoms = match format {
-        Format::Pdb => {
-            Some(crate::formats::pdb::read_atoms(path, &crate::formats::read_input(path)?)?.0)
-        }
-        Format::Mmcif => {
-            Some(crate::formats::mmcif::read_atoms(path, &crate::formats::read_input(path)?)?.0)
-        }
-        Format::Mmpld => {
-            let h = crate::formats::mmpld::header(path, &crate::formats::read_input(path)?)?;
-            d.insert(
-                "version".into(),
-                json!(format!("{}.{}", h.version / 100, h.version % 100)),
-            );
-            d.insert("frames".into(), json!(h.frames));
-            None
-        }
-        _ => None,
-    };
-    if let Some(atoms) = atoms {
-        let mut models: Vec<i64> = Vec::new();
-        for a in &atoms {
-            if !models.contains(&a.model) {
-                models.push(a.model);
-            }
-        }
-        let mut chains = serde_json::Map::new();
-        for a in atoms.iter().filter(|a| Some(&a.model) == models.first()) {
-            let n = chains.get(&a.chain).and_then(|v| v.as_u64()).unwrap_or(0);
-            chains.insert(a.chain.clone(), json!(n + 1));
-        }
-        d.insert("models".into(), json!(models));
-        d.insert("chains".into(), serde_json::Value::Object(chains));
-    }
-    Ok(d)
-}
-
-/// Loads a file and summarises it.
+/// Loads a file and summarises it: a scene (`.toml`) through [`Scene::load`], a particle file
+/// through the one loading path of [`crate::formats`] (so an empty file is refused here too),
+/// with the format's name and [`Format::details`] from the table of formats.
 pub fn info_of(path: &std::path::Path) -> crate::Result<Info> {
     let is_toml = path
         .extension()
@@ -201,22 +179,18 @@ pub fn info_of(path: &std::path::Path) -> crate::Result<Info> {
             .particles
             .iter()
             .map(|p| (p.center, p.radius, Some(p.color)));
-        Ok(summarize(name, "scene".into(), it, scene.warnings.clone()))
-    } else {
-        let loaded = load_particles(&IncludeSpec::bare(path))?;
-        let format = Format::from_path(path).map_or("unknown".to_string(), |f| {
-            serde_json::to_value(f)
-                .ok()
-                .and_then(|v| v.as_str().map(String::from))
-                .unwrap_or_default()
-        });
-        let it = loaded.records.iter().map(|r| (r.center, r.radius, r.color));
-        let mut info = summarize(name, format, it, loaded.warnings);
-        if let Some(f) = Format::from_path(path) {
-            info.details = details(path, f)?;
-        }
-        Ok(info)
+        return Ok(summarize(name, "scene".into(), it, scene.warnings.clone()));
     }
+    let spec = IncludeSpec::bare(path);
+    let format: &Format = format_of(&spec)?;
+    let bytes = read_input(path)?;
+    let loaded = load_bytes(&spec, format, &bytes)?;
+    let it = loaded.records.iter().map(|r| (r.center, r.radius, r.color));
+    let mut info = summarize(name, format.name.to_string(), it, loaded.warnings);
+    if let Some(details) = format.details {
+        info.details = details(path, &bytes)?;
+    }
+    Ok(info)
 }
 
 /// Runs `pgt info`.

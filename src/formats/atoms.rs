@@ -4,8 +4,8 @@
 
 use super::elements::{element_color, element_radius, srgb8_hex_to_linear, Element};
 use super::LoadedParticles;
+use super::{ColorBy, IncludeSpec, ParticleRecord};
 use crate::error::{Location, PgtError, Result};
-use crate::scene::{ColorBy, IncludeSpec, ParticleRecord};
 use glam::DVec3;
 use std::collections::{BTreeSet, HashMap};
 
@@ -85,23 +85,44 @@ pub fn infer_element(name: &str, hetatm: bool) -> Option<Element> {
 }
 
 /// Applies the selections of `spec` to `atoms` (all models, all alternate locations) and makes
-/// particles: radius = van der Waals radius × `radius_scale` is applied later by the caller.
+/// particles with van der Waals radii; `radius_scale` is applied later by
+/// [`super::load_bytes`]. A file without atoms gives no records (the caller refuses it); a
+/// selection that leaves none is an error naming the selection.
 pub fn atoms_to_particles(
     spec: &IncludeSpec,
     atoms: Vec<Atom>,
     mut warnings: Vec<String>,
 ) -> Result<LoadedParticles> {
-    let path = &spec.path;
-    // Model: the requested one, or the first that appears.
-    let models: Vec<i64> = {
-        let mut seen = Vec::new();
-        for a in &atoms {
-            if !seen.contains(&a.model) {
-                seen.push(a.model);
-            }
+    if atoms.is_empty() {
+        return Ok(LoadedParticles {
+            records: Vec::new(),
+            warnings,
+        });
+    }
+    let model = select_model(spec, &atoms, &mut warnings)?;
+    check_chains_present(spec, &atoms, model)?;
+    let kept = resolve_alternate_locations(&spec.path, atoms, model, &mut warnings);
+    let kept = apply_filters(spec, kept, model)?;
+    let records = make_records(spec, kept, &mut warnings);
+    Ok(LoadedParticles { records, warnings })
+}
+
+/// The model numbers in order of first appearance.
+fn models_of(atoms: &[Atom]) -> Vec<i64> {
+    let mut seen = Vec::new();
+    for a in atoms {
+        if !seen.contains(&a.model) {
+            seen.push(a.model);
         }
-        seen
-    };
+    }
+    seen
+}
+
+/// `model = N`: the requested model (an error if the file lacks it), or the first that appears
+/// (with a warning where there are several).
+fn select_model(spec: &IncludeSpec, atoms: &[Atom], warnings: &mut Vec<String>) -> Result<i64> {
+    let path = &spec.path;
+    let models = models_of(atoms);
     let model = match spec.model {
         Some(m) => {
             let m = i64::try_from(m).unwrap_or(i64::MAX);
@@ -126,31 +147,47 @@ pub fn atoms_to_particles(
             models.len()
         ));
     }
-    if let Some(chains) = &spec.chains {
-        let present: BTreeSet<&str> = atoms
-            .iter()
-            .filter(|a| a.model == model)
-            .map(|a| a.chain.as_str())
-            .collect();
-        let missing: Vec<&String> = chains
-            .iter()
-            .filter(|c| !present.contains(c.as_str()))
-            .collect();
-        if !missing.is_empty() {
-            return Err(PgtError::in_file(
-                path,
-                format!(
-                    "chain{} {} not in model {model} (it has chains {})",
-                    if missing.len() == 1 { " is" } else { "s are" },
-                    list(missing.iter()),
-                    list(present.iter())
-                ),
-            ));
-        }
-    }
+    Ok(model)
+}
 
-    // Alternate locations: per (chain, residue, atom name), keep the highest occupancy; ties go
-    // to altLoc 'A', then to the first in the file. The kept atom takes the place of the first.
+/// `chains = [...]`: every chain asked for must exist in the model (a typo is an error, not an
+/// empty selection).
+fn check_chains_present(spec: &IncludeSpec, atoms: &[Atom], model: i64) -> Result<()> {
+    let Some(chains) = &spec.chains else {
+        return Ok(());
+    };
+    let present: BTreeSet<&str> = atoms
+        .iter()
+        .filter(|a| a.model == model)
+        .map(|a| a.chain.as_str())
+        .collect();
+    let missing: Vec<&String> = chains
+        .iter()
+        .filter(|c| !present.contains(c.as_str()))
+        .collect();
+    if missing.is_empty() {
+        return Ok(());
+    }
+    Err(PgtError::in_file(
+        &spec.path,
+        format!(
+            "chain{} {} not in model {model} (it has chains {})",
+            if missing.len() == 1 { " is" } else { "s are" },
+            list(missing.iter()),
+            list(present.iter())
+        ),
+    ))
+}
+
+/// The atoms of `model` with alternate locations resolved: per (chain, residue, atom name), the
+/// highest occupancy wins; ties go to altLoc 'A', then to the first in the file. The kept atom
+/// takes the place of the first.
+fn resolve_alternate_locations(
+    path: &std::path::Path,
+    atoms: Vec<Atom>,
+    model: i64,
+    warnings: &mut Vec<String>,
+) -> Vec<Atom> {
     let mut kept: Vec<Atom> = Vec::new();
     let mut group: HashMap<(String, String, String), usize> = HashMap::new();
     let mut alt_groups = 0usize;
@@ -185,23 +222,59 @@ pub fn atoms_to_particles(
             path.display()
         ));
     }
+    kept
+}
 
+/// The include's filters in order (`chains`, `skip_water`, `skip_hydrogen`). One that removes
+/// every atom still left is an error naming it (issue 13: an include that yields nothing is
+/// nearly always a mistake), with the count each earlier filter kept.
+fn apply_filters(spec: &IncludeSpec, mut atoms: Vec<Atom>, model: i64) -> Result<Vec<Atom>> {
+    let atom_s = |n: usize| if n == 1 { "atom" } else { "atoms" };
+    let mut story = format!("model {model} has {} {}", atoms.len(), atom_s(atoms.len()));
+    let mut stage = |atoms: &mut Vec<Atom>, filter: String, keep: &dyn Fn(&Atom) -> bool| {
+        atoms.retain(|a| keep(a));
+        if atoms.is_empty() {
+            return Err(PgtError::in_file(
+                &spec.path,
+                format!(
+                    "the include holds no particles: {story}, and `{filter}` removes all of them"
+                ),
+            ));
+        }
+        story.push_str(&format!(", `{filter}` keeps {}", atoms.len()));
+        Ok(())
+    };
+    if let Some(chains) = &spec.chains {
+        stage(&mut atoms, format!("chains = {chains:?}"), &|a| {
+            chains.contains(&a.chain)
+        })?;
+    }
+    if spec.skip_water {
+        stage(&mut atoms, "skip_water = true".into(), &|a| {
+            !is_water(&a.residue_name)
+        })?;
+    }
+    if spec.skip_hydrogen {
+        stage(&mut atoms, "skip_hydrogen = true".into(), &|a| {
+            !a.element.is_some_and(Element::is_hydrogen)
+        })?;
+    }
+    Ok(atoms)
+}
+
+/// Spheres of the selected atoms: van der Waals radius of the element, colour by `color_by`
+/// (chain colours in order of first appearance), with warnings for unknown elements and
+/// elements without a tabulated radius.
+fn make_records(
+    spec: &IncludeSpec,
+    atoms: Vec<Atom>,
+    warnings: &mut Vec<String>,
+) -> Vec<ParticleRecord> {
     let mut chain_index: HashMap<String, usize> = HashMap::new();
     let mut fallback_radius: BTreeSet<String> = BTreeSet::new();
     let mut unknown_element = 0usize;
-    let mut records = Vec::with_capacity(kept.len());
-    for a in kept {
-        if let Some(chains) = &spec.chains {
-            if !chains.contains(&a.chain) {
-                continue;
-            }
-        }
-        if spec.skip_water && is_water(&a.residue_name) {
-            continue;
-        }
-        if spec.skip_hydrogen && a.element.is_some_and(Element::is_hydrogen) {
-            continue;
-        }
+    let mut records = Vec::with_capacity(atoms.len());
+    for a in atoms {
         match a.element {
             None => unknown_element += 1,
             Some(e) if e.vdw_radius().is_none() => {
@@ -209,14 +282,8 @@ pub fn atoms_to_particles(
             }
             Some(_) => {}
         }
-        let ci = match chain_index.get(&a.chain) {
-            Some(&i) => i,
-            None => {
-                let n = chain_index.len();
-                chain_index.insert(a.chain.clone(), n);
-                n
-            }
-        };
+        let next = chain_index.len();
+        let ci = *chain_index.entry(a.chain.clone()).or_insert(next);
         let color = match spec.color_by {
             ColorBy::Element => Some(element_color(a.element)),
             ColorBy::Chain => Some(srgb8_hex_to_linear(
@@ -235,22 +302,37 @@ pub fn atoms_to_particles(
             location: Location::Line(a.line),
         });
     }
+    let path = spec.path.display();
     if unknown_element > 0 {
         warnings.push(format!(
-            "{}: {unknown_element} atoms have no recognisable element; they get radius {} Å",
-            path.display(),
+            "{path}: {unknown_element} atoms have no recognisable element; they get radius {} Å",
             super::elements::FALLBACK_RADIUS
         ));
     }
     if !fallback_radius.is_empty() {
         warnings.push(format!(
-            "{}: no tabulated van der Waals radius for {}; used {} Å",
-            path.display(),
+            "{path}: no tabulated van der Waals radius for {}; used {} Å",
             list(fallback_radius.iter()),
             super::elements::FALLBACK_RADIUS
         ));
     }
-    Ok(LoadedParticles { records, warnings })
+    records
+}
+
+/// `pgt info` facts of PDB and mmCIF ([`super::Details`]): the model numbers, and the atom
+/// records per chain in the first model (before alternate locations are resolved).
+pub fn details(atoms: &[Atom]) -> serde_json::Map<String, serde_json::Value> {
+    use serde_json::json;
+    let models = models_of(atoms);
+    let mut chains = serde_json::Map::new();
+    for a in atoms.iter().filter(|a| Some(&a.model) == models.first()) {
+        let n = chains.get(&a.chain).and_then(|v| v.as_u64()).unwrap_or(0);
+        chains.insert(a.chain.clone(), json!(n + 1));
+    }
+    let mut d = serde_json::Map::new();
+    d.insert("models".into(), json!(models));
+    d.insert("chains".into(), serde_json::Value::Object(chains));
+    d
 }
 
 fn list<T: std::fmt::Display>(items: impl Iterator<Item = T>) -> String {

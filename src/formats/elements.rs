@@ -162,18 +162,9 @@ pub fn element_radius(element: Option<Element>) -> f64 {
         .unwrap_or(FALLBACK_RADIUS)
 }
 
-/// IEC 61966-2-1 sRGB decoding of one channel in [0, 1] to linear.
-pub fn srgb_to_linear(c: f64) -> f64 {
-    if c <= 0.04045 {
-        c / 12.92
-    } else {
-        ((c + 0.055) / 1.055).powf(2.4)
-    }
-}
-
-/// 0xRRGGBB (8-bit sRGB) to linear RGB.
+/// 0xRRGGBB (8-bit sRGB) to linear RGB ([`crate::color::srgb_to_linear`]).
 pub fn srgb8_hex_to_linear(hex: u32) -> glam::DVec3 {
-    let ch = |shift: u32| srgb_to_linear(f64::from((hex >> shift) & 0xFF) / 255.0);
+    let ch = |shift: u32| crate::color::srgb_to_linear(f64::from((hex >> shift) & 0xFF) / 255.0);
     glam::DVec3::new(ch(16), ch(8), ch(0))
 }
 
@@ -203,8 +194,6 @@ mod tests {
 
     #[test]
     fn srgb_decoding() {
-        assert_eq!(srgb_to_linear(0.0), 0.0);
-        assert!((srgb_to_linear(1.0) - 1.0).abs() < 1e-12);
         // 0x90 = 144: (144/255 + 0.055)/1.055)^2.4 ≈ 0.2789
         let c = Element::from_symbol("C")
             .map(Element::color)

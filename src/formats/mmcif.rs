@@ -7,11 +7,34 @@
 //! `label_asym_id` (the chain, as PDB files name it), `auth_seq_id` / `label_seq_id`,
 //! `pdbx_PDB_ins_code`, `occupancy`, `group_PDB`, `pdbx_PDB_model_num`. `.` and `?` mean missing.
 
-use super::atoms::{infer_element, Atom};
+use super::atoms::{atoms_to_particles, infer_element, Atom};
 use super::elements::Element;
+use super::{Format, IncludeSpec, LoadedParticles};
 use crate::error::{PgtError, Result};
 use glam::DVec3;
 use std::path::Path;
+
+/// mmCIF in the table of formats ([`super::FORMATS`]).
+pub const FORMAT: Format = Format {
+    name: "mmcif",
+    extensions: &["cif", "mmcif"],
+    description: "mmCIF / PDBx",
+    particles: "_atom_site rows",
+    read,
+    details: Some(details),
+};
+
+/// The [`super::Reader`] of mmCIF: every `_atom_site` row, then the include's selections
+/// ([`atoms_to_particles`]).
+pub fn read(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
+    let (atoms, warnings) = read_atoms(&spec.path, bytes)?;
+    atoms_to_particles(spec, atoms, warnings)
+}
+
+/// The [`super::Details`] of mmCIF: models and chains ([`super::atoms::details`]).
+fn details(path: &Path, bytes: &[u8]) -> Result<serde_json::Map<String, serde_json::Value>> {
+    Ok(super::atoms::details(&read_atoms(path, bytes)?.0))
+}
 
 #[derive(Debug, Clone, PartialEq)]
 enum Tok<'a> {

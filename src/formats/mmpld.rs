@@ -26,12 +26,21 @@
 //!
 //! Every count is checked against the bytes that remain before anything is allocated.
 
-use super::elements::srgb_to_linear;
-use super::LoadedParticles;
+use super::{Format, IncludeSpec, LoadedParticles, ParticleRecord};
+use crate::color::srgb_to_linear;
 use crate::error::{Location, PgtError, Result};
-use crate::scene::{IncludeSpec, ParticleRecord};
 use glam::DVec3;
 use std::path::Path;
+
+/// MMPLD in the table of formats ([`super::FORMATS`]).
+pub const FORMAT: Format = Format {
+    name: "mmpld",
+    extensions: &["mmpld"],
+    description: "MegaMol MMPLD 1.0–1.3",
+    particles: "particles in the frame",
+    read,
+    details: Some(details),
+};
 
 const MAGIC: &[u8; 6] = b"MMPLD\0";
 const HEADER_BYTES: u64 = 60;
@@ -230,18 +239,32 @@ pub fn header(path: &Path, bytes: &[u8]) -> Result<Header> {
     header_and_table(path, bytes).map(|(h, _)| h)
 }
 
-/// Loads frame `spec.frame` (0-based, default 0) of an MMPLD file.
-pub fn load(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
+/// The [`super::Details`] of MMPLD: `version` ("1.2") and `frames`.
+fn details(path: &Path, bytes: &[u8]) -> Result<serde_json::Map<String, serde_json::Value>> {
+    use serde_json::json;
+    let h = header(path, bytes)?;
+    let mut d = serde_json::Map::new();
+    d.insert(
+        "version".into(),
+        json!(format!("{}.{}", h.version / 100, h.version % 100)),
+    );
+    d.insert("frames".into(), json!(h.frames));
+    Ok(d)
+}
+
+/// The [`super::Reader`] of MMPLD: frame `spec.frame` (0-based, default 0). A file without
+/// frames, or a selected frame without particles, is an error (issue 13).
+pub fn read(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
     let path = spec.path.as_path();
     let (h, table) = header_and_table(path, bytes)?;
     let mut warnings = Vec::new();
     let frame = spec.frame.unwrap_or(0);
     if h.frames == 0 {
-        warnings.push(format!("{}: the file has no frames", path.display()));
-        return Ok(LoadedParticles {
-            records: Vec::new(),
-            warnings,
-        });
+        return Err(PgtError::at_byte(
+            path,
+            10,
+            "the file has no frames, so it holds no particles",
+        ));
     }
     if frame >= h.frames as usize {
         return Err(PgtError::at_byte(
@@ -275,9 +298,225 @@ pub fn load(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
         }
         Err(e) => return Err(e),
     };
+    if records.is_empty() {
+        let which = if spec.frame.is_some() {
+            format!("`frame = {frame}`")
+        } else {
+            format!("frame {frame}")
+        };
+        return Err(PgtError::at_byte(
+            path,
+            start as u64,
+            format!(
+                "{which} holds no particles (the file has {} frame(s))",
+                h.frames
+            ),
+        ));
+    }
     Ok(LoadedParticles { records, warnings })
 }
 
+/// The header of one particle list: how its particles are laid out and coloured.
+struct ListHeader {
+    vertex_type: u8,
+    colour_type: u8,
+    /// Bytes of a particle's position (and radius), by vertex type.
+    vertex_bytes: usize,
+    /// Bytes of a particle's colour, by colour type.
+    colour_bytes: usize,
+    /// The list's radius (vertex types 1, 3, 4); 1 otherwise.
+    global_radius: f64,
+    /// The list's colour, linear (colour type 0); white otherwise.
+    global_color: DVec3,
+    /// The intensity range of colour types 3 and 7.
+    intensity_range: (f64, f64),
+    /// The announced number of particles, and its byte offset (for errors).
+    count: u64,
+    count_at: usize,
+}
+
+impl ListHeader {
+    /// Bytes per particle (0 for vertex type 0, whose list holds none).
+    fn stride(&self) -> usize {
+        if self.vertex_type == 0 {
+            0
+        } else {
+            self.vertex_bytes + self.colour_bytes
+        }
+    }
+}
+
+/// Reads a list header up to and including the list box of version 1.3.
+fn list_header(c: &mut Cursor<'_>, version: u16) -> Result<ListHeader> {
+    let vt_at = c.pos;
+    let vertex_type = c.u8("a vertex type")?;
+    let colour_type = c.u8("a colour type")?;
+    let vertex_bytes = match vertex_type {
+        0 => 0usize,
+        1 => 12,
+        2 => 16,
+        3 => 6,
+        4 => 24,
+        vt => return Err(c.err(vt_at, format!("unknown vertex type {vt} (expected 0–4)"))),
+    };
+    let colour_bytes = match colour_type {
+        0 => 0usize,
+        1 => 3,
+        2 | 3 => 4,
+        4 => 12,
+        5 => 16,
+        6 | 7 => 8,
+        ct => {
+            return Err(c.err(
+                vt_at + 1,
+                format!("unknown colour type {ct} (expected 0–7)"),
+            ))
+        }
+    };
+    let global_radius = if matches!(vertex_type, 1 | 3 | 4) {
+        f64::from(c.f32("the global radius")?)
+    } else {
+        1.0
+    };
+    let global_color = if colour_type == 0 {
+        let rgba = c.arr::<4>("the global RGBA colour")?;
+        display_to_linear(
+            DVec3::new(f64::from(rgba[0]), f64::from(rgba[1]), f64::from(rgba[2])) / 255.0,
+        )
+    } else {
+        DVec3::ONE
+    };
+    let intensity_range = if matches!(colour_type, 3 | 7) {
+        (
+            f64::from(c.f32("the intensity minimum")?),
+            f64::from(c.f32("the intensity maximum")?),
+        )
+    } else {
+        (0.0, 1.0)
+    };
+    let count_at = c.pos;
+    let count = c.u64("the particle count")?;
+    if version == 103 {
+        c.take(24, "the list bounding box")?;
+    }
+    Ok(ListHeader {
+        vertex_type,
+        colour_type,
+        vertex_bytes,
+        colour_bytes,
+        global_radius,
+        global_color,
+        intensity_range,
+        count,
+        count_at,
+    })
+}
+
+/// Centre and radius of one particle's bytes `p` (vertex types 1–4).
+fn particle_position(p: &[u8], h: &ListHeader) -> (DVec3, f64) {
+    match h.vertex_type {
+        1 => (
+            DVec3::new(le_f32(p, 0), le_f32(p, 4), le_f32(p, 8)),
+            h.global_radius,
+        ),
+        2 => (
+            DVec3::new(le_f32(p, 0), le_f32(p, 4), le_f32(p, 8)),
+            le_f32(p, 12),
+        ),
+        3 => (
+            DVec3::new(le_i16(p, 0), le_i16(p, 2), le_i16(p, 4)),
+            h.global_radius,
+        ),
+        _ => (
+            DVec3::new(le_f64(p, 0), le_f64(p, 8), le_f64(p, 16)),
+            h.global_radius,
+        ),
+    }
+}
+
+/// Linear colour of one particle's bytes `p` (the colour follows the position).
+fn particle_color(p: &[u8], h: &ListHeader) -> DVec3 {
+    let o = h.vertex_bytes;
+    let (imin, imax) = h.intensity_range;
+    match h.colour_type {
+        0 => h.global_color,
+        1 | 2 => display_to_linear(DVec3::new(byte(p, o), byte(p, o + 1), byte(p, o + 2)) / 255.0),
+        3 => intensity_color(le_f32(p, o), imin, imax),
+        4 | 5 => display_to_linear(DVec3::new(le_f32(p, o), le_f32(p, o + 4), le_f32(p, o + 8))),
+        6 => display_to_linear(
+            DVec3::new(le_u16(p, o), le_u16(p, o + 2), le_u16(p, o + 4)) / 65535.0,
+        ),
+        _ => intensity_color(le_f64(p, o), imin, imax),
+    }
+}
+
+/// Reads the particles of a list whose header is `h`, after checking that the announced count
+/// fits in the bytes left in the frame (before anything is allocated).
+fn read_list_particles(
+    c: &mut Cursor<'_>,
+    h: &ListHeader,
+    out: &mut Vec<ParticleRecord>,
+) -> Result<()> {
+    let stride = h.stride();
+    let left = c.end.saturating_sub(c.pos);
+    let Some(data_bytes) = (stride as u64)
+        .checked_mul(h.count)
+        .filter(|&n| n <= left as u64)
+    else {
+        return Err(c.err(
+            h.count_at,
+            format!(
+                "the list announces {} particles of {stride} bytes, more than the {left} bytes left in the frame",
+                h.count
+            ),
+        ));
+    };
+    let data_at = c.pos;
+    let data = c.take(data_bytes as usize, "the particle data")?;
+    if h.vertex_type == 0 {
+        return Ok(());
+    }
+    out.reserve(h.count as usize);
+    for (k, p) in data.chunks_exact(stride).enumerate() {
+        let (center, radius) = particle_position(p, h);
+        let color = particle_color(p, h);
+        let at = data_at + k * stride;
+        if !center.is_finite() || !color.is_finite() {
+            return Err(c.err(
+                at,
+                format!("particle {k} of the list has a non-finite position or colour"),
+            ));
+        }
+        out.push(ParticleRecord {
+            center,
+            radius,
+            color: Some(color),
+            opacity: None,
+            location: Location::Byte(at as u64),
+        });
+    }
+    Ok(())
+}
+
+/// Skips the cluster info that follows each list in version 1.1.
+fn skip_cluster_info(c: &mut Cursor<'_>) -> Result<()> {
+    c.u32("the cluster count")?;
+    let size_at = c.pos;
+    let size = c.u64("the cluster data size")?;
+    let size = usize::try_from(size)
+        .ok()
+        .filter(|&s| s <= c.end.saturating_sub(c.pos))
+        .ok_or_else(|| {
+            c.err(
+                size_at,
+                format!("cluster data of {size} bytes does not fit in the frame"),
+            )
+        })?;
+    c.take(size, "the cluster data")?;
+    Ok(())
+}
+
+/// Parses the frame in bytes `start..end`: its lists, which must end exactly at `end`.
 fn parse_frame(
     path: &Path,
     bytes: &[u8],
@@ -302,140 +541,10 @@ fn parse_frame(
     }
     let mut out = Vec::new();
     for _ in 0..lists {
-        let vt_at = c.pos;
-        let vt = c.u8("a vertex type")?;
-        let ct = c.u8("a colour type")?;
-        let vstride = match vt {
-            0 => 0usize,
-            1 => 12,
-            2 => 16,
-            3 => 6,
-            4 => 24,
-            _ => return Err(c.err(vt_at, format!("unknown vertex type {vt} (expected 0–4)"))),
-        };
-        let cstride = match ct {
-            0 => 0usize,
-            1 => 3,
-            2 | 3 => 4,
-            4 => 12,
-            5 => 16,
-            6 | 7 => 8,
-            _ => {
-                return Err(c.err(
-                    vt_at + 1,
-                    format!("unknown colour type {ct} (expected 0–7)"),
-                ))
-            }
-        };
-        let global_radius = if matches!(vt, 1 | 3 | 4) {
-            f64::from(c.f32("the global radius")?)
-        } else {
-            1.0
-        };
-        let global_color = if ct == 0 {
-            let rgba = c.arr::<4>("the global RGBA colour")?;
-            display_to_linear(
-                DVec3::new(f64::from(rgba[0]), f64::from(rgba[1]), f64::from(rgba[2])) / 255.0,
-            )
-        } else {
-            DVec3::ONE
-        };
-        let (imin, imax) = if matches!(ct, 3 | 7) {
-            (
-                f64::from(c.f32("the intensity minimum")?),
-                f64::from(c.f32("the intensity maximum")?),
-            )
-        } else {
-            (0.0, 1.0)
-        };
-        let count_at = c.pos;
-        let count = c.u64("the particle count")?;
-        if version == 103 {
-            c.take(24, "the list bounding box")?;
-        }
-        let stride = if vt == 0 { 0 } else { vstride + cstride };
-        let data_bytes = (stride as u64)
-            .checked_mul(count)
-            .filter(|&n| n <= (end.saturating_sub(c.pos)) as u64);
-        let Some(data_bytes) = data_bytes else {
-            return Err(c.err(
-                count_at,
-                format!(
-                    "the list announces {count} particles of {stride} bytes, more than the {} bytes left in the frame",
-                    end.saturating_sub(c.pos)
-                ),
-            ));
-        };
-        let data_at = c.pos;
-        let data = c.take(data_bytes as usize, "the particle data")?;
-        if vt != 0 {
-            out.reserve(count as usize);
-            for (k, p) in data.chunks_exact(stride).enumerate() {
-                let (center, radius) = match vt {
-                    1 => (
-                        DVec3::new(le_f32(p, 0), le_f32(p, 4), le_f32(p, 8)),
-                        global_radius,
-                    ),
-                    2 => (
-                        DVec3::new(le_f32(p, 0), le_f32(p, 4), le_f32(p, 8)),
-                        le_f32(p, 12),
-                    ),
-                    3 => (
-                        DVec3::new(le_i16(p, 0), le_i16(p, 2), le_i16(p, 4)),
-                        global_radius,
-                    ),
-                    _ => (
-                        DVec3::new(le_f64(p, 0), le_f64(p, 8), le_f64(p, 16)),
-                        global_radius,
-                    ),
-                };
-                let o = vstride;
-                let color = match ct {
-                    0 => global_color,
-                    1 | 2 => display_to_linear(
-                        DVec3::new(byte(p, o), byte(p, o + 1), byte(p, o + 2)) / 255.0,
-                    ),
-                    3 => intensity_color(le_f32(p, o), imin, imax),
-                    4 | 5 => display_to_linear(DVec3::new(
-                        le_f32(p, o),
-                        le_f32(p, o + 4),
-                        le_f32(p, o + 8),
-                    )),
-                    6 => display_to_linear(
-                        DVec3::new(le_u16(p, o), le_u16(p, o + 2), le_u16(p, o + 4)) / 65535.0,
-                    ),
-                    _ => intensity_color(le_f64(p, o), imin, imax),
-                };
-                let at = data_at + k * stride;
-                if !center.is_finite() || !color.is_finite() {
-                    return Err(c.err(
-                        at,
-                        format!("particle {k} of the list has a non-finite position or colour"),
-                    ));
-                }
-                out.push(ParticleRecord {
-                    center,
-                    radius,
-                    color: Some(color),
-                    opacity: None,
-                    location: Location::Byte(at as u64),
-                });
-            }
-        }
+        let h = list_header(&mut c, version)?;
+        read_list_particles(&mut c, &h, &mut out)?;
         if version == 101 {
-            c.u32("the cluster count")?;
-            let size_at = c.pos;
-            let size = c.u64("the cluster data size")?;
-            let size = usize::try_from(size)
-                .ok()
-                .filter(|&s| s <= end.saturating_sub(c.pos))
-                .ok_or_else(|| {
-                    c.err(
-                        size_at,
-                        format!("cluster data of {size} bytes does not fit in the frame"),
-                    )
-                })?;
-            c.take(size, "the cluster data")?;
+            skip_cluster_info(&mut c)?;
         }
     }
     if c.pos != end {
@@ -496,7 +605,7 @@ mod tests {
 
     #[test]
     fn reads_a_synthetic_file() {
-        let l = load(&spec(), &one_list(102, true, 3, 3)).expect("ok");
+        let l = read(&spec(), &one_list(102, true, 3, 3)).expect("ok");
         assert_eq!(l.records.len(), 3);
         assert_eq!(l.records[2].center.x, 2.0);
         assert_eq!(l.records[2].radius, 0.5);
@@ -506,7 +615,7 @@ mod tests {
     #[test]
     fn every_version() {
         for (v, ts) in [(100, false), (101, false), (102, true), (103, true)] {
-            let l = load(&spec(), &one_list(v, ts, 2, 2)).expect("ok");
+            let l = read(&spec(), &one_list(v, ts, 2, 2)).expect("ok");
             assert_eq!(l.records.len(), 2, "{v}");
             assert_eq!(l.records[1].center.x, 1.0, "{v}");
         }
@@ -535,7 +644,7 @@ mod tests {
         b.extend_from_slice(&[255, 0, 0]);
         let end = b.len() as u64;
         b[end_at..end_at + 8].copy_from_slice(&end.to_le_bytes());
-        let l = load(&spec(), &b).expect("ok");
+        let l = read(&spec(), &b).expect("ok");
         assert_eq!(l.records[0].center, DVec3::new(-2.0, 3.0, 7.0));
         assert_eq!(l.records[0].radius, 0.25);
         assert_eq!(l.records[0].color, Some(DVec3::X));
@@ -543,16 +652,16 @@ mod tests {
 
     #[test]
     fn v103_without_timestamp_is_recovered() {
-        let l = load(&spec(), &one_list(103, false, 2, 2)).expect("ok");
+        let l = read(&spec(), &one_list(103, false, 2, 2)).expect("ok");
         assert_eq!(l.records.len(), 2);
         assert!(l.warnings.iter().any(|w| w.contains("timestamp")));
-        let l = load(&spec(), &one_list(103, true, 2, 2)).expect("ok");
+        let l = read(&spec(), &one_list(103, true, 2, 2)).expect("ok");
         assert!(l.warnings.is_empty());
     }
 
     #[test]
     fn lying_count_is_an_error_not_an_allocation() {
-        let e = load(&spec(), &one_list(102, true, 2, u64::MAX / 2))
+        let e = read(&spec(), &one_list(102, true, 2, u64::MAX / 2))
             .expect_err("lie")
             .to_string();
         assert!(
@@ -565,7 +674,7 @@ mod tests {
     fn every_truncation_is_an_error() {
         let full = one_list(102, true, 3, 3);
         for n in 0..full.len() {
-            assert!(load(&spec(), &full[..n]).is_err(), "{n}");
+            assert!(read(&spec(), &full[..n]).is_err(), "{n}");
         }
     }
 }

@@ -1,16 +1,17 @@
-//! Particle file formats (DESIGN.md §6). Each format turns a file into [`ParticleRecord`]s with
-//! the line (or byte offset) each came from, so that validation can point at it.
+//! Particle file formats (DESIGN.md §6). Each format turns a file's bytes into
+//! [`ParticleRecord`]s with the line (or byte offset) each came from, so that validation can
+//! point at it.
 //!
-//! | format | extensions | module |
-//! |---|---|---|
-//! | PDB | `.pdb`, `.ent` | [`pdb`] |
-//! | mmCIF | `.cif`, `.mmcif` | [`mmcif`] |
-//! | VRML97 | `.wrl`, `.vrml` | [`vrml`] |
-//! | MegaMol MMPLD | `.mmpld` | [`mmpld`] |
-//! | XYZ | `.xyz` | [`xyz_csv`] |
-//! | CSV | `.csv` | [`xyz_csv`] |
+//! **The table of formats.** Every format is one [`Format`] value, declared in its own module
+//! (`pdb::FORMAT`, …) and listed once in [`FORMATS`]. Extension detection ([`Format::from_path`]),
+//! the `format = "…"` of an `[[include]]` ([`Format::named`]), the "unsupported file type" message
+//! and `pgt info` (name and details) all read that table; nobody matches on a format.
+//! A new format is a new module with a `pub const FORMAT: Format` (its reader has the signature
+//! [`Reader`]), its `mod` line here and its line in [`FORMATS`].
 //!
-//! `[[include]] format = "pdb"` forces a format whatever the extension.
+//! **One loading path.** [`load_particles`] (a file) and [`load_bytes`] (bytes already read) run
+//! the reader and then, for every format alike: `radius_scale`, `color_by = "uniform"`, the
+//! refusal of a file that yields no particles (DESIGN.md §1), and the check of every record.
 
 pub mod atoms;
 pub mod elements;
@@ -18,11 +19,13 @@ pub mod mmcif;
 pub mod mmpld;
 pub mod pdb;
 pub mod random;
+pub mod record;
 pub mod vrml;
 pub mod xyz_csv;
 
+pub use record::{ColorBy, IncludeSpec, ParticleRecord};
+
 use crate::error::{PgtError, Result};
-use crate::scene::{IncludeSpec, ParticleRecord};
 use std::path::Path;
 
 /// What a format delivers: the particles and non-fatal warnings (skipped shapes, guesses).
@@ -34,40 +37,99 @@ pub struct LoadedParticles {
     pub warnings: Vec<String>,
 }
 
-/// The particle file formats pgt reads.
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum,
-)]
-#[serde(rename_all = "kebab-case")]
-pub enum Format {
-    /// PDB (fixed columns).
-    Pdb,
-    /// mmCIF / PDBx.
-    Mmcif,
-    /// VRML97.
-    Vrml,
-    /// MegaMol MMPLD.
-    Mmpld,
-    /// XYZ (element x y z).
-    Xyz,
-    /// CSV with a header row.
-    Csv,
+/// The one signature of every reader: the include (its `path` names the file in messages; its
+/// selections apply where the format has them) and the file's bytes. `radius_scale`,
+/// `color_by = "uniform"`, the empty-file refusal and the record checks are left to
+/// [`load_bytes`].
+pub type Reader = fn(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles>;
+
+/// Format-specific facts for `pgt info` (`models`, `chains`, `version`, `frames`, …).
+pub type Details =
+    fn(path: &Path, bytes: &[u8]) -> Result<serde_json::Map<String, serde_json::Value>>;
+
+/// One particle file format: an entry of [`FORMATS`].
+#[derive(Debug)]
+pub struct Format {
+    /// The name of `[[include]] format = "…"` and of `pgt info` (`"pdb"`).
+    pub name: &'static str,
+    /// File name extensions, lower case, without the dot.
+    pub extensions: &'static [&'static str],
+    /// One line for people (`"PDB (wwPDB 3.3, fixed columns)"`).
+    pub description: &'static str,
+    /// What a particle is in this format, for the "holds no particles" error
+    /// (`"ATOM or HETATM records"`).
+    pub particles: &'static str,
+    /// The reader.
+    pub read: Reader,
+    /// Extra facts for `pgt info`, where the format has any.
+    pub details: Option<Details>,
+}
+
+/// Every format pgt reads, in the order messages list them.
+pub static FORMATS: &[&Format] = &[
+    &pdb::FORMAT,
+    &mmcif::FORMAT,
+    &vrml::FORMAT,
+    &mmpld::FORMAT,
+    &xyz_csv::XYZ,
+    &xyz_csv::CSV,
+];
+
+impl PartialEq for Format {
+    fn eq(&self, other: &Format) -> bool {
+        self.name == other.name
+    }
 }
 
 impl Format {
-    /// The format a file name's extension stands for.
-    pub fn from_path(path: &Path) -> Option<Format> {
-        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
-        Some(match ext.as_str() {
-            "pdb" | "ent" => Format::Pdb,
-            "cif" | "mmcif" => Format::Mmcif,
-            "wrl" | "vrml" => Format::Vrml,
-            "mmpld" => Format::Mmpld,
-            "xyz" => Format::Xyz,
-            "csv" => Format::Csv,
-            _ => return None,
-        })
+    /// The format of this name (`"pdb"`), as `[[include]] format = "…"` writes it.
+    pub fn named(name: &str) -> Option<&'static Format> {
+        FORMATS.iter().copied().find(|f| f.name == name)
     }
+
+    /// The format a file name's extension stands for (case-insensitive).
+    pub fn from_path(path: &Path) -> Option<&'static Format> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        FORMATS
+            .iter()
+            .copied()
+            .find(|f| f.extensions.contains(&ext.as_str()))
+    }
+}
+
+/// Every extension of [`FORMATS`] as a list for messages: `.pdb, .ent, …, .csv`.
+pub fn known_extensions() -> String {
+    let all: Vec<String> = FORMATS
+        .iter()
+        .flat_map(|f| f.extensions.iter().map(|e| format!(".{e}")))
+        .collect();
+    all.join(", ")
+}
+
+/// Every name of [`FORMATS`] as a list for messages: `pdb, mmcif, …`.
+pub fn known_names() -> String {
+    let all: Vec<&str> = FORMATS.iter().map(|f| f.name).collect();
+    all.join(", ")
+}
+
+/// serde for `[[include]] format = "…"`: a name of [`FORMATS`]; another name is an error that
+/// lists them (toml adds the line).
+pub(crate) fn deserialize_format<'de, D>(
+    d: D,
+) -> std::result::Result<Option<&'static Format>, D::Error>
+where
+    D: serde::Deserializer<'de>,
+{
+    let name: Option<String> = serde::Deserialize::deserialize(d)?;
+    name.map(|n| {
+        Format::named(&n).ok_or_else(|| {
+            serde::de::Error::custom(format!(
+                "unknown format `{n}`, expected one of {}",
+                known_names()
+            ))
+        })
+    })
+    .transpose()
 }
 
 /// Largest particle file pgt reads (bytes); beyond it the file is refused before it is read.
@@ -94,42 +156,74 @@ pub fn read_input(path: &Path) -> Result<Vec<u8>> {
     std::fs::read(path).map_err(|e| PgtError::io(path, e))
 }
 
-/// Loads the particles of an `[[include]]` (or a bare particle file), choosing the format by
-/// `spec.format` or else the file's extension, and applies `radius_scale` and, for every
-/// format, `color_by = "uniform"` (no particle keeps a colour of its own).
+/// The format of an include: `spec.format` if set, else the file's extension; an unknown
+/// extension is an error that lists the known ones.
+pub fn format_of(spec: &IncludeSpec) -> Result<&'static Format> {
+    if let Some(f) = spec.format.or_else(|| Format::from_path(&spec.path)) {
+        return Ok(f);
+    }
+    let ext = spec
+        .path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or_default();
+    Err(PgtError::in_file(
+        &spec.path,
+        format!(
+            "unsupported particle file type '.{ext}': expected {} or .toml (or set `format` in the [[include]])",
+            known_extensions()
+        ),
+    ))
+}
+
+/// Loads the particles of an `[[include]]` (or a bare particle file): [`format_of`], then
+/// [`read_input`], then [`load_bytes`].
 pub fn load_particles(spec: &IncludeSpec) -> Result<LoadedParticles> {
-    let format = match spec.format.or_else(|| Format::from_path(&spec.path)) {
-        Some(f) => f,
-        None => {
-            let ext = spec
-                .path
-                .extension()
-                .and_then(|e| e.to_str())
-                .unwrap_or_default();
-            return Err(PgtError::in_file(
-                &spec.path,
-                format!(
-                    "unsupported particle file type '.{ext}': expected .pdb, .ent, .cif, .mmcif, .wrl, .vrml, \
-                     .mmpld, .xyz, .csv or .toml (or set `format` in the [[include]])"
-                ),
-            ));
-        }
-    };
+    let format = format_of(spec)?;
     let bytes = read_input(&spec.path)?;
-    let mut loaded = load_bytes(spec, format, &bytes)?;
+    load_bytes(spec, format, &bytes)
+}
+
+/// Parses a file's bytes as `format` and applies what every format shares: `radius_scale`,
+/// `color_by = "uniform"` (no particle keeps a colour of its own), the refusal of a file with
+/// no particles (DESIGN.md §1: an error naming the file), and [`check_records`]. `spec.path`
+/// names the file in messages.
+pub fn load_bytes(spec: &IncludeSpec, format: &Format, bytes: &[u8]) -> Result<LoadedParticles> {
+    let mut loaded = (format.read)(spec, bytes)?;
+    if loaded.records.is_empty() {
+        return Err(no_particles(spec, format, bytes.len(), &loaded.warnings));
+    }
     if spec.radius_scale != 1.0 {
         for r in &mut loaded.records {
             r.radius *= spec.radius_scale;
         }
     }
-    if spec.color_by == crate::scene::ColorBy::Uniform {
-        // Every format: the file's colours give way to the scene's default colour.
+    if spec.color_by == ColorBy::Uniform {
         for r in &mut loaded.records {
             r.color = None;
         }
     }
     check_records(&spec.path, &loaded.records)?;
     Ok(loaded)
+}
+
+/// The error for a file that yields no particles: nearly always a truncated download or a wrong
+/// path, so it is refused rather than rendered as an empty background. Readers whose selections
+/// (model, chains, frame, …) emptied a non-empty file report that themselves, naming the filter.
+fn no_particles(spec: &IncludeSpec, format: &Format, len: usize, warnings: &[String]) -> PgtError {
+    let mut message = if len == 0 {
+        "the file is empty (0 bytes), so it holds no particles (a truncated download or a wrong path?)"
+            .to_string()
+    } else {
+        format!(
+            "the file holds no particles: its {len} bytes contain no {}, read as {}",
+            format.particles, format.description
+        )
+    };
+    if !warnings.is_empty() {
+        message.push_str(&format!("; the reader noted: {}", warnings.join("; ")));
+    }
+    PgtError::in_file(&spec.path, message)
 }
 
 /// Every particle has a finite centre, a finite radius > 0, a colour ≥ 0 and an opacity in
@@ -169,23 +263,4 @@ fn check_records(path: &Path, records: &[ParticleRecord]) -> Result<()> {
         }
     }
     Ok(())
-}
-
-/// Parses a file's bytes as `format` (no `radius_scale`); `spec.path` names it in messages.
-pub fn load_bytes(spec: &IncludeSpec, format: Format, bytes: &[u8]) -> Result<LoadedParticles> {
-    let path = &spec.path;
-    match format {
-        Format::Pdb => {
-            let (atoms, warnings) = pdb::read_atoms(path, bytes)?;
-            atoms::atoms_to_particles(spec, atoms, warnings)
-        }
-        Format::Mmcif => {
-            let (atoms, warnings) = mmcif::read_atoms(path, bytes)?;
-            atoms::atoms_to_particles(spec, atoms, warnings)
-        }
-        Format::Vrml => vrml::load(path, bytes),
-        Format::Mmpld => mmpld::load(spec, bytes),
-        Format::Xyz => xyz_csv::load_xyz(path, bytes, spec.frame.unwrap_or(0)),
-        Format::Csv => xyz_csv::load_csv(path, bytes),
-    }
 }

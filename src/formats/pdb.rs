@@ -9,11 +9,34 @@
 //! ([`super::atoms::infer_element`]). pdbtbx was not used: pgt needs the file and line of every
 //! error and the lenient handling of those old files.
 
-use super::atoms::{infer_element, Atom};
+use super::atoms::{atoms_to_particles, infer_element, Atom};
 use super::elements::Element;
+use super::{Format, IncludeSpec, LoadedParticles};
 use crate::error::{PgtError, Result};
 use glam::DVec3;
 use std::path::Path;
+
+/// PDB in the table of formats ([`super::FORMATS`]).
+pub const FORMAT: Format = Format {
+    name: "pdb",
+    extensions: &["pdb", "ent"],
+    description: "PDB (wwPDB format 3.3, fixed columns)",
+    particles: "ATOM or HETATM records",
+    read,
+    details: Some(details),
+};
+
+/// The [`super::Reader`] of PDB: every atom record, then the include's selections
+/// ([`atoms_to_particles`]).
+pub fn read(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
+    let (atoms, warnings) = read_atoms(&spec.path, bytes)?;
+    atoms_to_particles(spec, atoms, warnings)
+}
+
+/// The [`super::Details`] of PDB: models and chains ([`super::atoms::details`]).
+fn details(path: &Path, bytes: &[u8]) -> Result<serde_json::Map<String, serde_json::Value>> {
+    Ok(super::atoms::details(&read_atoms(path, bytes)?.0))
+}
 
 /// Reads every atom of every model of a PDB file's text.
 pub fn read_atoms(path: &Path, bytes: &[u8]) -> Result<(Vec<Atom>, Vec<String>)> {

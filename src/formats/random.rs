@@ -97,7 +97,7 @@ pub fn generate(spec: &RandomSpec) -> Vec<RandomParticle> {
 }
 
 /// Writes particles as CSV with the header `x,y,z,radius,red,green,blue` (six decimals), the
-/// format [`super::xyz_csv::load_csv`] reads.
+/// format [`super::xyz_csv::read_csv`] reads.
 pub fn write_csv(
     out: &mut impl std::io::Write,
     particles: impl IntoIterator<Item = RandomParticle>,

@@ -13,11 +13,30 @@
 //! lines starting with `#` are skipped.
 
 use super::elements::{element_color, element_radius, Element};
-use super::LoadedParticles;
+use super::{Format, IncludeSpec, LoadedParticles, ParticleRecord};
 use crate::error::{Location, PgtError, Result};
-use crate::scene::ParticleRecord;
 use glam::DVec3;
 use std::path::Path;
+
+/// XYZ in the table of formats ([`super::FORMATS`]).
+pub const XYZ: Format = Format {
+    name: "xyz",
+    extensions: &["xyz"],
+    description: "XYZ (lines of element x y z)",
+    particles: "atoms in the frame",
+    read: read_xyz,
+    details: None,
+};
+
+/// CSV in the table of formats ([`super::FORMATS`]).
+pub const CSV: Format = Format {
+    name: "csv",
+    extensions: &["csv"],
+    description: "CSV with a header row",
+    particles: "data rows after the header",
+    read: read_csv,
+    details: None,
+};
 
 fn lines(bytes: &[u8]) -> impl Iterator<Item = (usize, String)> + '_ {
     bytes.split(|&b| b == b'\n').enumerate().map(|(i, l)| {
@@ -42,8 +61,10 @@ fn number(path: &Path, line: usize, what: &str, s: &str) -> Result<f64> {
     }
 }
 
-/// Loads frame `frame` (0-based) of an XYZ file.
-pub fn load_xyz(path: &Path, bytes: &[u8], frame: usize) -> Result<LoadedParticles> {
+/// The [`super::Reader`] of XYZ: frame `spec.frame` (0-based, default 0).
+pub fn read_xyz(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
+    let path = spec.path.as_path();
+    let frame = spec.frame.unwrap_or(0);
     let mut it = lines(bytes).peekable();
     let mut records = Vec::new();
     let mut warnings = Vec::new();
@@ -133,6 +154,13 @@ pub fn load_xyz(path: &Path, bytes: &[u8], frame: usize) -> Result<LoadedParticl
             break;
         }
         current += 1;
+    }
+    if records.is_empty() && spec.frame.is_some() {
+        // The selection emptied the include: name it (issue 13).
+        return Err(PgtError::in_file(
+            path,
+            format!("`frame = {frame}` holds no particles (its atom count is 0)"),
+        ));
     }
     if unknown > 0 {
         warnings.push(format!(
@@ -229,8 +257,9 @@ fn columns(path: &Path, line: usize, header: &str, warnings: &mut Vec<String>) -
     Ok(cols)
 }
 
-/// Loads a CSV file with a header row.
-pub fn load_csv(path: &Path, bytes: &[u8]) -> Result<LoadedParticles> {
+/// The [`super::Reader`] of CSV: a file with a header row.
+pub fn read_csv(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
+    let path = spec.path.as_path();
     let mut warnings = Vec::new();
     let mut cols: Option<Columns> = None;
     let mut width = 0usize;
@@ -289,10 +318,16 @@ pub fn load_csv(path: &Path, bytes: &[u8]) -> Result<LoadedParticles> {
 mod tests {
     use super::*;
 
+    fn xyz_frame(frame: usize) -> IncludeSpec {
+        let mut spec = IncludeSpec::bare(Path::new("t.xyz"));
+        spec.frame = Some(frame);
+        spec
+    }
+
     #[test]
     fn csv_with_r_g_b_and_radius() {
         let text = "x, y, z, radius, r, g, b\n1,2,3,0.5,1,0,0\n\n# c\n4,5,6,1.5,0,1,0\n";
-        let l = load_csv(Path::new("t.csv"), text.as_bytes()).expect("ok");
+        let l = read_csv(&IncludeSpec::bare(Path::new("t.csv")), text.as_bytes()).expect("ok");
         assert_eq!(l.records.len(), 2);
         assert_eq!(l.records[1].center, DVec3::new(4.0, 5.0, 6.0));
         assert_eq!(l.records[1].radius, 1.5);
@@ -303,22 +338,22 @@ mod tests {
     #[test]
     fn csv_double_r() {
         let text = "x,y,z,r,r,g,b\n1,2,3,0.5,1,0.2,0.3\n";
-        let l = load_csv(Path::new("t.csv"), text.as_bytes()).expect("ok");
+        let l = read_csv(&IncludeSpec::bare(Path::new("t.csv")), text.as_bytes()).expect("ok");
         assert_eq!(l.records[0].radius, 0.5);
         assert_eq!(l.records[0].color, Some(DVec3::new(1.0, 0.2, 0.3)));
     }
 
     #[test]
     fn csv_errors() {
-        let e = load_csv(Path::new("t.csv"), b"1,2,3\n")
+        let e = read_csv(&IncludeSpec::bare(Path::new("t.csv")), b"1,2,3\n")
             .expect_err("no header")
             .to_string();
         assert!(e.contains("t.csv:1") && e.contains("header"), "{e}");
-        let e = load_csv(Path::new("t.csv"), b"x,y,z\n1,2\n")
+        let e = read_csv(&IncludeSpec::bare(Path::new("t.csv")), b"x,y,z\n1,2\n")
             .expect_err("short")
             .to_string();
         assert!(e.contains("t.csv:2") && e.contains("expected 3"), "{e}");
-        let e = load_csv(Path::new("t.csv"), b"x,y,z\n1,nan,2\n")
+        let e = read_csv(&IncludeSpec::bare(Path::new("t.csv")), b"x,y,z\n1,nan,2\n")
             .expect_err("nan")
             .to_string();
         assert!(e.contains("t.csv:2") && e.contains("not finite"), "{e}");
@@ -327,17 +362,17 @@ mod tests {
     #[test]
     fn xyz_frames() {
         let text = "2\nwater\nO 0 0 0\nH 1 0 0\n1\nsecond\nC 5 5 5\n";
-        let l = load_xyz(Path::new("t.xyz"), text.as_bytes(), 0).expect("ok");
+        let l = read_xyz(&xyz_frame(0), text.as_bytes()).expect("ok");
         assert_eq!(l.records.len(), 2);
         assert_eq!(l.records[0].radius, 1.52);
-        let l = load_xyz(Path::new("t.xyz"), text.as_bytes(), 1).expect("ok");
+        let l = read_xyz(&xyz_frame(1), text.as_bytes()).expect("ok");
         assert_eq!(l.records[0].center, DVec3::splat(5.0));
         assert_eq!(l.records[0].location, Location::Line(7));
-        let e = load_xyz(Path::new("t.xyz"), text.as_bytes(), 2)
+        let e = read_xyz(&xyz_frame(2), text.as_bytes())
             .expect_err("no frame 2")
             .to_string();
         assert!(e.contains("2 frame"), "{e}");
-        let e = load_xyz(Path::new("t.xyz"), b"3\nc\nO 0 0 0\n", 0)
+        let e = read_xyz(&xyz_frame(0), b"3\nc\nO 0 0 0\n")
             .expect_err("short")
             .to_string();
         assert!(e.contains("t.xyz:1") && e.contains("ends after 1"), "{e}");

@@ -3,17 +3,9 @@
 //! replicated into R, G, B; alpha is ignored). Every error names the file.
 
 use super::RgbImage;
+use crate::color::srgb_to_linear_f32;
 use crate::error::{PgtError, Result};
 use std::path::Path;
-
-/// sRGB decoding (IEC 61966-2-1) of a value in [0, 1].
-fn srgb_to_linear(s: f32) -> f32 {
-    if s <= 0.040_45 {
-        s / 12.92
-    } else {
-        ((s + 0.055) / 1.055).powf(2.4)
-    }
-}
 
 /// An image as read, with the number of colour channels the file had (1 for a grey PNG, 3
 /// otherwise), so that a comparison can refuse pairs whose channel counts differ.
@@ -60,7 +52,7 @@ fn read_png(path: &Path) -> Result<ReadImage> {
     let (width, height) = (img.width(), img.height());
     let channels = if img.color().has_color() { 3 } else { 1 };
     let rgb = img.to_rgb32f();
-    let pixels = rgb.pixels().map(|p| p.0.map(srgb_to_linear)).collect();
+    let pixels = rgb.pixels().map(|p| p.0.map(srgb_to_linear_f32)).collect();
     Ok(ReadImage {
         image: RgbImage {
             width,

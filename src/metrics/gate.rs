@@ -34,7 +34,7 @@
 
 use super::maps;
 use super::{Comparison, CHANNELS};
-use crate::error::{PgtError, Result};
+use crate::error::{toml_error, PgtError, Result};
 use crate::image_io::RgbImage;
 use std::path::Path;
 
@@ -99,15 +99,7 @@ impl Gate {
     /// Reads and validates a gate file.
     pub fn load(path: &Path) -> Result<Gate> {
         let text = std::fs::read_to_string(path).map_err(|e| PgtError::io(path, e))?;
-        let gate: Gate = toml::from_str(&text).map_err(|e| {
-            let line = e
-                .span()
-                .map(|s| crate::metrics::gate::line_of(&text, s.start));
-            match line {
-                Some(l) => PgtError::at_line(path, l, e.message().to_string()),
-                None => PgtError::in_file(path, e.message().to_string()),
-            }
-        })?;
+        let gate: Gate = toml::from_str(&text).map_err(|e| toml_error(path, &text, &e))?;
         gate.validate().map_err(|m| PgtError::in_file(path, m))?;
         Ok(gate)
     }
@@ -187,145 +179,152 @@ impl Gate {
         Ok(())
     }
 
-    /// Evaluates every threshold. An error (not a failure) where a gated metric is undefined:
-    /// SSIM of an image smaller than the window, FLIP of an HDR pair.
+    /// Evaluates every threshold: the lower bounds (SSIM, PSNR), the upper bounds (errors,
+    /// FLIP), then the percentiles, in that order. An error (not a failure) where a gated metric
+    /// is undefined: SSIM of an image smaller than the window, FLIP of an HDR pair.
     pub fn evaluate(
         &self,
         cmp: &Comparison,
         reference: &RgbImage,
         approximation: &RgbImage,
     ) -> Result<Vec<GateCheck>> {
-        let mut checks = Vec::new();
-        let need_ssim = || {
-            cmp.ssim_values().ok_or_else(|| {
-                PgtError::Usage(format!(
-                    "an SSIM gate is set but SSIM is undefined: {}",
-                    ssim_reason(cmp)
-                ))
-            })
-        };
-        let need_flip = || {
-            cmp.flip_mean().ok_or_else(|| {
-                PgtError::Usage(format!(
-                    "a FLIP gate is set but FLIP is undefined: {}",
-                    flip_reason(cmp)
-                ))
-            })
-        };
-        let mut at_least = |name: String, value: f64, threshold: f64| {
-            checks.push(GateCheck {
-                name,
-                value,
-                threshold,
-                passed: value >= threshold,
-            })
-        };
-        if let Some(t) = self.min_ssim {
-            at_least("min_ssim".into(), need_ssim()?.mean, t);
-        }
-        if let Some(t) = self.min_psnr {
-            at_least("min_psnr".into(), cmp.error_values(|e| e.psnr).mean, t);
-        }
-        if let Some(c) = &self.channels {
-            if let Some(t) = c.min_ssim {
-                let s = need_ssim()?;
-                for k in 0..3 {
-                    at_least(
-                        format!("channels.min_ssim[{}]", CHANNELS[k]),
-                        s.get(k),
-                        t[k],
-                    );
-                }
-            }
-            if let Some(t) = c.min_psnr {
-                for k in 0..3 {
-                    at_least(
-                        format!("channels.min_psnr[{}]", CHANNELS[k]),
-                        cmp.errors[k].psnr,
-                        t[k],
-                    );
-                }
-            }
-        }
-        let mut at_most = |name: String, value: f64, threshold: f64| {
-            checks.push(GateCheck {
-                name,
-                value,
-                threshold,
-                passed: value <= threshold,
-            })
-        };
-        if let Some(t) = self.max_rmse {
-            at_most("max_rmse".into(), cmp.error_values(|e| e.rmse).mean, t);
-        }
-        if let Some(t) = self.max_abs {
-            let worst = cmp.errors.iter().map(|e| e.max_abs).fold(0.0, f64::max);
-            at_most("max_abs".into(), worst, t);
-        }
-        if let Some(t) = self.max_mean_abs {
-            at_most(
-                "max_mean_abs".into(),
-                cmp.error_values(|e| e.mean_abs).mean,
-                t,
-            );
-        }
-        if let Some(t) = self.max_mean_rel {
-            at_most(
-                "max_mean_rel".into(),
-                cmp.error_values(|e| e.mean_rel).mean,
-                t,
-            );
-        }
-        if let Some(t) = self.max_flip {
-            at_most("max_flip".into(), need_flip()?, t);
-        }
-        if let Some(c) = &self.channels {
-            if let Some(t) = c.max_rmse {
-                for k in 0..3 {
-                    at_most(
-                        format!("channels.max_rmse[{}]", CHANNELS[k]),
-                        cmp.errors[k].rmse,
-                        t[k],
-                    );
-                }
-            }
-            if let Some(t) = c.max_abs {
-                for k in 0..3 {
-                    at_most(
-                        format!("channels.max_abs[{}]", CHANNELS[k]),
-                        cmp.errors[k].max_abs,
-                        t[k],
-                    );
-                }
-            }
-        }
+        let mut checks = Checks(Vec::new());
+        self.lower_bounds(cmp, &mut checks)?;
+        self.upper_bounds(cmp, &mut checks)?;
         for p in &self.percentiles {
             let values = per_pixel(p.map, cmp, reference, approximation)?;
             let v = maps::percentile(&values, p.percentile).unwrap_or(f32::NAN) as f64;
             let kind = format!("{:?}", p.map).to_lowercase();
-            let (name, threshold, passed) = match (p.min, p.max) {
-                (Some(t), _) => (format!("p{}({kind}) >= min", p.percentile), t, v >= t),
-                (None, Some(t)) => (format!("p{}({kind}) <= max", p.percentile), t, v <= t),
+            match (p.min, p.max) {
+                (Some(t), _) => checks.at_least(format!("p{}({kind}) >= min", p.percentile), v, t),
+                (None, Some(t)) => {
+                    checks.at_most(format!("p{}({kind}) <= max", p.percentile), v, t)
+                }
                 (None, None) => continue, // excluded by validate()
-            };
-            checks.push(GateCheck {
-                name,
-                value: v,
-                threshold,
-                passed,
-            });
+            }
         }
-        Ok(checks)
+        Ok(checks.0)
+    }
+
+    /// The `min_*` thresholds: mean, then per channel.
+    fn lower_bounds(&self, cmp: &Comparison, checks: &mut Checks) -> Result<()> {
+        if let Some(t) = self.min_ssim {
+            checks.at_least("min_ssim".into(), need_ssim(cmp)?.mean, t);
+        }
+        if let Some(t) = self.min_psnr {
+            checks.at_least("min_psnr".into(), cmp.error_values(|e| e.psnr).mean, t);
+        }
+        let Some(c) = &self.channels else {
+            return Ok(());
+        };
+        if let Some(t) = c.min_ssim {
+            let s = need_ssim(cmp)?;
+            checks.per_channel("channels.min_ssim", |k| s.get(k), t, Checks::at_least);
+        }
+        if let Some(t) = c.min_psnr {
+            let psnr = |k: usize| cmp.errors[k].psnr;
+            checks.per_channel("channels.min_psnr", psnr, t, Checks::at_least);
+        }
+        Ok(())
+    }
+
+    /// The `max_*` thresholds: mean (the worst pixel for `max_abs`), then per channel.
+    fn upper_bounds(&self, cmp: &Comparison, checks: &mut Checks) -> Result<()> {
+        if let Some(t) = self.max_rmse {
+            checks.at_most("max_rmse".into(), cmp.error_values(|e| e.rmse).mean, t);
+        }
+        if let Some(t) = self.max_abs {
+            let worst = cmp.errors.iter().map(|e| e.max_abs).fold(0.0, f64::max);
+            checks.at_most("max_abs".into(), worst, t);
+        }
+        if let Some(t) = self.max_mean_abs {
+            let v = cmp.error_values(|e| e.mean_abs).mean;
+            checks.at_most("max_mean_abs".into(), v, t);
+        }
+        if let Some(t) = self.max_mean_rel {
+            let v = cmp.error_values(|e| e.mean_rel).mean;
+            checks.at_most("max_mean_rel".into(), v, t);
+        }
+        if let Some(t) = self.max_flip {
+            checks.at_most("max_flip".into(), need_flip(cmp)?, t);
+        }
+        let Some(c) = &self.channels else {
+            return Ok(());
+        };
+        if let Some(t) = c.max_rmse {
+            let rmse = |k: usize| cmp.errors[k].rmse;
+            checks.per_channel("channels.max_rmse", rmse, t, Checks::at_most);
+        }
+        if let Some(t) = c.max_abs {
+            let max_abs = |k: usize| cmp.errors[k].max_abs;
+            checks.per_channel("channels.max_abs", max_abs, t, Checks::at_most);
+        }
+        Ok(())
     }
 }
 
-/// The 1-based line of byte offset `offset` in `text` (for errors that name file:line).
-pub fn line_of(text: &str, offset: usize) -> usize {
-    text.as_bytes()[..offset.min(text.len())]
-        .iter()
-        .filter(|&&b| b == b'\n')
-        .count()
-        + 1
+/// The checks of one evaluation, in order.
+struct Checks(Vec<GateCheck>);
+
+impl Checks {
+    /// A lower bound: passes when `value >= threshold` (NaN fails).
+    fn at_least(&mut self, name: String, value: f64, threshold: f64) {
+        let passed = value >= threshold;
+        self.push(name, value, threshold, passed);
+    }
+
+    /// An upper bound: passes when `value <= threshold` (NaN fails).
+    fn at_most(&mut self, name: String, value: f64, threshold: f64) {
+        let passed = value <= threshold;
+        self.push(name, value, threshold, passed);
+    }
+
+    /// One check per channel, named `name[R]`, `name[G]`, `name[B]`.
+    fn per_channel(
+        &mut self,
+        name: &str,
+        value: impl Fn(usize) -> f64,
+        thresholds: [f64; 3],
+        check: fn(&mut Self, String, f64, f64),
+    ) {
+        for k in 0..3 {
+            check(
+                self,
+                format!("{name}[{}]", CHANNELS[k]),
+                value(k),
+                thresholds[k],
+            );
+        }
+    }
+
+    fn push(&mut self, name: String, value: f64, threshold: f64, passed: bool) {
+        self.0.push(GateCheck {
+            name,
+            value,
+            threshold,
+            passed,
+        });
+    }
+}
+
+/// The mean SSIM values, or an error saying why a gate on them cannot be evaluated.
+fn need_ssim(cmp: &Comparison) -> Result<super::PerChannel> {
+    cmp.ssim_values().ok_or_else(|| {
+        PgtError::Usage(format!(
+            "an SSIM gate is set but SSIM is undefined: {}",
+            ssim_reason(cmp)
+        ))
+    })
+}
+
+/// The mean FLIP, or an error saying why a gate on it cannot be evaluated.
+fn need_flip(cmp: &Comparison) -> Result<f64> {
+    cmp.flip_mean().ok_or_else(|| {
+        PgtError::Usage(format!(
+            "a FLIP gate is set but FLIP is undefined: {}",
+            flip_reason(cmp)
+        ))
+    })
 }
 
 /// One value per pixel of a map kind (see [`MapKind`]).
@@ -377,12 +376,17 @@ mod tests {
 
     #[test]
     fn error_lines_are_one_based() {
-        assert_eq!(line_of("a\nb\nc", 0), 1);
-        assert_eq!(line_of("a\nb\nc", 2), 2);
-        assert_eq!(line_of("a\nb\nc", 99), 3);
         let text = "min_ssim = 0.9\nmax_rsme = 0.1\n";
         let e = toml::from_str::<Gate>(text).unwrap_err();
-        assert_eq!(line_of(text, e.span().unwrap().start), 2);
+        assert_eq!(crate::error::line_of(text, e.span().unwrap().start), 2);
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("gate.toml");
+        std::fs::write(&path, text).unwrap();
+        let err = Gate::load(&path).unwrap_err().to_string();
+        assert!(
+            err.contains("gate.toml:2:") && err.contains("max_rsme"),
+            "{err}"
+        );
     }
 
     #[test]

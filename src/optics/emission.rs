@@ -30,12 +30,24 @@ pub struct Composite {
 /// contributes its colour E with weight T and makes everything behind it invisible, without
 /// ever forming ∞·0.
 pub fn composite(intervals: &[Interval], background: DVec3) -> Composite {
+    composite_by(intervals, background, |iv| iv.emission)
+}
+
+/// [`composite`] with the constant source Q of each interval given by `source` instead of its
+/// emission colour E (DESIGN.md §2: the closed form holds for any Q constant per interval;
+/// a model without a per-light part has Q = k·E).
+#[inline]
+pub fn composite_by(
+    intervals: &[Interval],
+    background: DVec3,
+    source: impl Fn(&Interval) -> DVec3,
+) -> Composite {
     let mut radiance = DVec3::ZERO;
     let mut transmittance = 1.0;
     for iv in intervals {
         let tau = iv.sigma * iv.length();
         let a = opacity(tau);
-        radiance += (transmittance * a) * iv.emission;
+        radiance += (transmittance * a) * source(iv);
         if tau.is_infinite() {
             transmittance = 0.0;
             break;

@@ -18,8 +18,8 @@
 // degenerate input takes the safe branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+use super::particle::Particle;
 use crate::geometry::Hit;
-use crate::scene::Particle;
 use glam::DVec3;
 use std::cmp::Ordering;
 

@@ -24,8 +24,9 @@
 // degenerate input takes the safe branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+use super::light::Light;
+use super::particle::Particle;
 use crate::geometry::{Bvh, Ray};
-use crate::scene::{Light, Particle};
 use glam::DVec3;
 
 /// Appends to `out` the ray parameters t in (t_lo, t_hi) where the shadow ray from `ray.at(t)`
@@ -256,7 +257,7 @@ impl SweptPolygon {
 mod tests {
     use super::*;
     use crate::geometry::intersect_sphere;
-    use crate::scene::Falloff;
+    use crate::optics::light::Falloff;
 
     fn sphere(c: DVec3, r: f64) -> Particle {
         Particle {

@@ -1,9 +1,12 @@
-//! The source terms Q of the lit and single-scatter models (DESIGN.md §2), given what the shadow
-//! rays found. The renderer traces the shadow rays; this file holds only the formulas.
+//! The vocabulary the source terms Q of DESIGN.md §2 share: what a shadow ray found
+//! ([`LightSample`]), the scene's parameters of the models ([`SourceParams`]) and the weight of
+//! the Θmax = 1 surface limit. The models themselves are in `models/`, one file each; the
+//! renderer traces the shadow rays.
 
-use crate::scene::LightWeight;
+use super::light::LightWeight;
 use glam::DVec3;
-use std::f64::consts::PI;
+
+pub use super::light::light_weight;
 
 /// What one shadow ray from a point x towards light l found.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -17,38 +20,39 @@ pub struct LightSample {
     pub transmittance: f64,
 }
 
-/// w of the lit model: 1/m for `mean` (thesis eq. 4.17), 1 for `sum`; 0 without lights.
-pub fn light_weight(weight: LightWeight, lights: usize) -> f64 {
-    match (weight, lights) {
-        (_, 0) => 0.0,
-        (LightWeight::Mean, m) => 1.0 / m as f64,
-        (LightWeight::Sum, _) => 1.0,
+impl LightSample {
+    /// The σ → ∞ limit of this sample at the entry point of a Θmax = 1 particle of colour
+    /// `emission`, where `self` is the shadow ray without that particle and `keep` =
+    /// [`surface_limit_weight`]`(c)` (see `reference::volume`, "Θmax = 1"):
+    /// L_l,∞ = L_l,rest·keep + E·(1 − keep), T_l,∞ = T_l,rest·keep.
+    #[inline]
+    pub fn surface_limit(&self, keep: f64, emission: DVec3) -> LightSample {
+        LightSample {
+            radiance: self.radiance * keep + emission * (1.0 - keep),
+            irradiance: self.irradiance,
+            transmittance: self.transmittance * keep,
+        }
     }
 }
 
-/// DESIGN.md §2, lit model (thesis eq. 4.17 with the λκ factor of §8 applied by the caller):
-/// Q(x) = w·Σ_l L_l(x).
-pub fn lit_source(w: f64, lights: &[LightSample]) -> DVec3 {
-    let mut sum = DVec3::ZERO;
-    for l in lights {
-        sum += l.radiance;
-    }
-    w * sum
+/// The scene's parameters of the source terms (DESIGN.md §1 `[render]`), resolved once per
+/// render so that the models' per-node work is arithmetic only.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SourceParams {
+    /// w of the lit model ([`light_weight`]).
+    pub light_weight: f64,
+    /// a of the single-scatter model, `emission_weight` ∈ [0, 1].
+    pub emission_weight: f64,
 }
 
-/// DESIGN.md §2, single-scatter model: Q(x) = a·E(x) + α(x)·(1/4π)·Σ_l E_l(x)·T_l(x), with E the
-/// emission colour and α the σ-weighted albedo of the particles at x.
-pub fn single_scatter_source(
-    a: f64,
-    emission: DVec3,
-    albedo: DVec3,
-    lights: &[LightSample],
-) -> DVec3 {
-    let mut inscatter = DVec3::ZERO;
-    for l in lights {
-        inscatter += l.irradiance * l.transmittance;
+impl SourceParams {
+    /// Resolves `light_weight` for `lights` lights; `emission_weight` is taken as it is.
+    pub fn new(weight: LightWeight, lights: usize, emission_weight: f64) -> Self {
+        SourceParams {
+            light_weight: light_weight(weight, lights),
+            emission_weight,
+        }
     }
-    a * emission + albedo * inscatter / (4.0 * PI)
 }
 
 /// The weight 1/(1 + c) with which the light that reaches the entry point of a Θmax = 1 particle
@@ -68,26 +72,18 @@ mod tests {
     use super::*;
 
     #[test]
-    fn weights_and_sources() {
-        assert_eq!(light_weight(LightWeight::Mean, 4), 0.25);
-        assert_eq!(light_weight(LightWeight::Sum, 4), 1.0);
-        assert_eq!(light_weight(LightWeight::Mean, 0), 0.0);
-        let s = [
-            LightSample {
-                radiance: DVec3::X,
-                irradiance: DVec3::splat(4.0 * PI),
-                transmittance: 0.5,
-            },
-            LightSample {
-                radiance: DVec3::Y,
-                irradiance: DVec3::ZERO,
-                transmittance: 1.0,
-            },
-        ];
-        assert_eq!(lit_source(0.5, &s), DVec3::new(0.5, 0.5, 0.0));
-        let q = single_scatter_source(1.0, DVec3::Z, DVec3::splat(0.5), &s);
-        assert!((q - DVec3::new(0.25, 0.25, 1.25)).abs().max_element() < 1e-15);
+    fn surface_limit_blends_towards_the_particle() {
         assert_eq!(surface_limit_weight(f64::INFINITY), 0.0);
         assert_eq!(surface_limit_weight(1.0), 0.5);
+        let rest = LightSample {
+            radiance: DVec3::new(2.0, 0.0, 4.0),
+            irradiance: DVec3::ONE,
+            transmittance: 0.5,
+        };
+        let l = rest.surface_limit(0.5, DVec3::new(0.0, 2.0, 0.0));
+        assert_eq!(l.radiance, DVec3::new(1.0, 1.0, 2.0));
+        assert_eq!((l.irradiance, l.transmittance), (DVec3::ONE, 0.25));
+        let p = SourceParams::new(LightWeight::Mean, 4, 0.3);
+        assert_eq!((p.light_weight, p.emission_weight), (0.25, 0.3));
     }
 }

@@ -3,7 +3,9 @@
 
 use super::{RadianceEstimator, Sample};
 use crate::geometry::{Bvh, Ray};
-use crate::scene::{Light, Particle, Scene};
+use crate::optics::light::Light;
+use crate::optics::particle::Particle;
+use crate::scene::Scene;
 use glam::DVec3;
 use std::f64::consts::PI;
 
@@ -120,7 +122,8 @@ impl RadianceEstimator for OpaqueRenderer<'_> {
 mod tests {
     use super::*;
     use crate::geometry::Camera;
-    use crate::scene::{Falloff, RenderMode, RenderSettings};
+    use crate::optics::light::Falloff;
+    use crate::scene::{RenderMode, RenderSettings};
     use approx::assert_relative_eq;
 
     fn particle(center: DVec3, radius: f64) -> Particle {

@@ -23,7 +23,8 @@
 
 use crate::geometry::{intersect_sphere, Bvh, Hit, Ray};
 use crate::optics::kinks::{for_each_swept_leaf, swept_polygon};
-use crate::scene::{Light, Particle};
+use crate::optics::light::Light;
+use crate::optics::particle::Particle;
 use glam::DVec3;
 
 /// Relative padding of a candidate sphere's box in the polygon test: far above the round-off of
@@ -130,7 +131,7 @@ impl Occluders {
 mod tests {
     use super::*;
     use crate::formats::random::SplitMix64;
-    use crate::scene::Falloff;
+    use crate::optics::light::Falloff;
 
     /// The list-based hits equal the BVH's for random shadow rays from random camera segments,
     /// for both kinds of light (the property the bit-identical images rest on).

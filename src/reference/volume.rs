@@ -5,11 +5,14 @@
 //!
 //!   L = L_bg·T(0,∞) + ∫₀^∞ T(0,t)·σ(x_t)·Q(x_t) dt                       (DESIGN.md §2)
 //!
-//! The ray is cut into intervals with a fixed set of particles (`optics::intervals`).
+//! The ray is cut into intervals with a fixed set of particles (`optics::intervals`). The
+//! optical model (`optics::models`, one file each) supplies Q as a constant part k·E and a part
+//! per light (`optics::model::Model`); this file never asks which model it is.
 //!
-//! * **emission**: Q = E is constant per interval, and the integral has the closed form
-//!   L_in = L_out·e^{−σΔ} + E·(1 − e^{−σΔ}) (`optics::emission`). Error estimate 0.
-//! * **lit / single-scatter**: inside interval k, T(0,t) = T(0,t0)·e^{−σ(t−t0)}; with the
+//! * **no per-light part** (emission): Q = k·E is constant per interval, and the integral has
+//!   the closed form L_in = L_out·e^{−σΔ} + Q·(1 − e^{−σΔ}) (`optics::emission`). Error
+//!   estimate 0.
+//! * **per-light parts** (lit, single-scatter): inside interval k, T(0,t) = T(0,t0)·e^{−σ(t−t0)}; with the
 //!   substitution u = 1 − e^{−σ(t−t0)} (du = σ·e^{−σ(t−t0)} dt) its part of the integral is
 //!
 //!     T(0,t0)·∫₀^{U} Q(x(t(u))) du,   U = 1 − e^{−σΔ},   t(u) = t0 − ln(1 − u)/σ,
@@ -20,8 +23,8 @@
 //!   G7–K15 (`reference::quadrature`) to `tol` per pixel and channel, or by the thesis's
 //!   midpoint sums in t (`reference::riemann`). Q is linear in the lights, so the adaptive path
 //!   integrates each light's part on its own (one shadow ray per node, only that light's kinks,
-//!   tol/m each; the estimates add up to ≤ tol), and single-scatter's a·E term, constant per
-//!   interval, exactly.
+//!   tol/m each; the estimates add up to ≤ tol), and the constant part k·E (single-scatter's
+//!   a·E) exactly.
 //!
 //! **Kinks.** Q is smooth inside an interval except where a shadow ray grazes a sphere. Those
 //! camera-ray parameters are computed in closed form (`optics::kinks`: ray–cylinder for
@@ -34,8 +37,8 @@
 //!
 //! **Θmax = 1.** An interval with σ = ∞ is the end of the ray: T = 0 from its start t0 on. Its
 //! contribution T(0,t0)·Q∞ is the σ → ∞ limit of the integral, which concentrates on x(t0⁺):
-//! with s = σ·(t − t0), ∫ σe^{−σ(t−t0)}·Q dt = ∫₀^∞ e^{−s}·Q(x(t0 + s/σ)) ds. For the emission
-//! model Q∞ = E. For lit and single-scatter, Q contains the particle itself along the shadow ray:
+//! with s = σ·(t − t0), ∫ σe^{−σ(t−t0)}·Q dt = ∫₀^∞ e^{−s}·Q(x(t0 + s/σ)) ds. For a model
+//! without a per-light part Q∞ = Q = k·E. For lit and single-scatter, Q contains the particle itself along the shadow ray:
 //! if t0 is where the ray enters the particle through its surface (outward normal n, cosines
 //! μ_in = −d·n > 0, μ_l = ω_l·n towards light l), the shadow ray from x(t0 + s/σ) runs through
 //! the particle for a length s·c/σ with c = μ_in/μ_l when μ_l > 0 (optical depth s·c), and
@@ -45,7 +48,8 @@
 //!   single-scatter: T_l,∞ = T_l,rest/(1 + c)
 //!
 //! where "rest" is the shadow ray from the entry point without the Θmax = 1 particle(s) that
-//! start there. This is the value the renderer converges to as Θmax → 1 (a test checks it); the
+//! start there (`LightSample::surface_limit`), and Q∞ is Q of those limits
+//! (`Model::opaque_limit`). This is the value the renderer converges to as Θmax → 1 (a test checks it); the
 //! naive "Q at the entry point" would give L_l,rest, which no finite Θmax approaches. An eye
 //! inside a Θmax = 1 particle sees its colour (c = ∞). Several Θmax = 1 particles entered at the
 //! same point act as one (mean colour, largest c).
@@ -55,13 +59,12 @@ use super::riemann::midpoint_sum;
 use super::shadow::Occluders;
 use super::{Integrator, RadianceEstimator, Sample};
 use crate::geometry::{Bvh, Hit, Ray};
-use crate::optics::emission::{composite, opacity};
+use crate::optics::emission::{composite, composite_by, opacity};
 use crate::optics::intervals::{Interval, IntervalCutter, IntervalScratch};
 use crate::optics::kinks::shadow_tangencies;
-use crate::optics::source::{
-    light_weight, lit_source, single_scatter_source, surface_limit_weight, LightSample,
-};
-use crate::scene::{OpticalModel, Scene};
+use crate::optics::model::{LightNeed, Model};
+use crate::optics::source::{surface_limit_weight, LightSample, SourceParams};
+use crate::scene::Scene;
 use glam::DVec3;
 
 /// The Gauss–Kronrod pair of the lit and single-scatter integrals (see `integrate_per_light`).
@@ -77,8 +80,10 @@ pub struct VolumeRenderer<'a> {
     bvh: Bvh,
     cutter: IntervalCutter<'a>,
     integrator: Integrator,
-    /// w of the lit model.
-    light_weight: f64,
+    /// The scene's optical model (DESIGN.md §2).
+    model: &'static dyn Model,
+    /// Its parameters (w, a), resolved once.
+    params: SourceParams,
 }
 
 /// Per-camera-ray buffers for shadow rays (reused, so shadow rays do not allocate).
@@ -95,14 +100,19 @@ struct ShadowScratch {
 
 impl<'a> VolumeRenderer<'a> {
     /// Builds the BVH and the canonical particle order for `scene`; `integrator` chooses how the
-    /// lit and single-scatter integrals are done (the emission model is always closed-form).
+    /// per-light parts of Q are integrated (a model without them, emission, is closed-form).
     pub fn new(scene: &'a Scene, integrator: Integrator) -> Self {
         VolumeRenderer {
             scene,
             bvh: scene.build_bvh(),
             cutter: IntervalCutter::new(&scene.particles),
             integrator,
-            light_weight: light_weight(scene.render.light_weight, scene.lights.len()),
+            model: scene.render.model.model(),
+            params: SourceParams::new(
+                scene.render.light_weight,
+                scene.lights.len(),
+                scene.render.emission_weight,
+            ),
         }
     }
 
@@ -154,7 +164,7 @@ impl<'a> VolumeRenderer<'a> {
         }
     }
 
-    /// Q(x) of the lit or single-scatter model (DESIGN.md §2) at a point inside interval `iv`.
+    /// Q(x) of the scene's model (DESIGN.md §2) at a point inside interval `iv`.
     fn source(&self, x: DVec3, iv: &Interval, sh: &mut ShadowScratch) -> DVec3 {
         sh.lights.clear();
         for l in 0..self.scene.lights.len() {
@@ -162,19 +172,7 @@ impl<'a> VolumeRenderer<'a> {
                 sh.lights.push(s);
             }
         }
-        self.combine(iv, &sh.lights)
-    }
-
-    fn combine(&self, iv: &Interval, lights: &[LightSample]) -> DVec3 {
-        match self.scene.render.model {
-            OpticalModel::SingleScatter => single_scatter_source(
-                self.scene.render.emission_weight,
-                iv.emission,
-                iv.albedo,
-                lights,
-            ),
-            _ => lit_source(self.light_weight, lights),
-        }
+        self.model.source(&self.params, iv, &sh.lights)
     }
 
     /// The part of Q(x) that light `l` contributes at x = ray.at(t) in interval `k` (Q is
@@ -217,17 +215,14 @@ impl<'a> VolumeRenderer<'a> {
         sh.rays += 1;
         sh.occluders[k].hits(&shadow_ray, inc.distance, &mut sh.hits);
         let s = self.shadow_composite(inc.distance, inc.irradiance, |_| false, sh);
-        match self.scene.render.model {
-            OpticalModel::SingleScatter => single_scatter_source(0.0, DVec3::ZERO, iv.albedo, &[s]),
-            _ => lit_source(self.light_weight, &[s]),
-        }
+        self.model.light_source(&self.params, iv, &s)
     }
 
     /// Σ_k T(0,t0_k)·∫₀^{U_k} Q du over the finite intervals, adaptively. Q is linear in the
     /// lights, so each light is integrated on its own, with only its own kinks as breakpoints
     /// and one shadow ray per node (integrating the sum would put every light's kinks into
-    /// every light's integral), each to tol/m; the summed estimates are ≤ tol. The
-    /// single-scatter emission term a·E is constant per interval and exact: a·E·U.
+    /// every light's integral), each to tol/m; the summed estimates are ≤ tol. The constant
+    /// part k·E of Q (single-scatter's a·E) is exact: k·E·U.
     fn integrate_per_light(
         &self,
         ray: &Ray,
@@ -239,10 +234,10 @@ impl<'a> VolumeRenderer<'a> {
         let mut value = DVec3::ZERO;
         let mut error = DVec3::ZERO;
         let mut unconverged = false;
-        if render.model == OpticalModel::SingleScatter {
+        let k = self.model.emission_factor(&self.params);
+        if k != 0.0 {
             for p in pieces {
-                value +=
-                    (p.weight * (p.hi - p.lo) * render.emission_weight) * intervals[p.tag].emission;
+                value += (p.weight * (p.hi - p.lo) * k) * intervals[p.tag].emission;
             }
         }
         let (Some(first), Some(last)) = (intervals.first(), intervals.last()) else {
@@ -322,8 +317,8 @@ impl<'a> VolumeRenderer<'a> {
         hits: &[Hit],
         sh: &mut ShadowScratch,
     ) -> DVec3 {
-        if self.scene.render.model == OpticalModel::Emission {
-            return iv.emission;
+        if self.model.light_need() == LightNeed::None {
+            return self.model.opaque_limit(&self.params, iv, &[]);
         }
         let particles = self.cutter.particles();
         let x = ray.at(iv.t0);
@@ -366,12 +361,9 @@ impl<'a> VolumeRenderer<'a> {
                 let Some(rest) = self.light_sample(x, l, skip, sh) else {
                     continue;
                 };
-                LightSample {
-                    radiance: rest.radiance * keep + iv.emission * (1.0 - keep),
-                    irradiance: rest.irradiance,
-                    transmittance: rest.transmittance * keep,
-                }
+                rest.surface_limit(keep, iv.emission)
             } else {
+                // Nothing from outside survives: the shadow ray sees only the particle.
                 LightSample {
                     radiance: iv.emission,
                     irradiance: inc.irradiance,
@@ -380,7 +372,7 @@ impl<'a> VolumeRenderer<'a> {
             };
             lights.push(sample);
         }
-        self.combine(iv, &lights)
+        self.model.opaque_limit(&self.params, iv, &lights)
     }
 }
 
@@ -399,9 +391,12 @@ impl RadianceEstimator for VolumeRenderer<'_> {
             &mut cut_scratch,
             &mut intervals,
         );
-        if render.model == OpticalModel::Emission {
+        if self.model.light_need() == LightNeed::None {
+            // Q = k·E is constant per interval: the closed form, exact.
+            let k = self.model.emission_factor(&self.params);
             return Sample {
-                radiance: composite(&intervals, render.background).radiance,
+                radiance: composite_by(&intervals, render.background, |iv| k * iv.emission)
+                    .radiance,
                 error: DVec3::ZERO,
                 shadow_rays: 0,
                 unconverged: false,

@@ -1,5 +1,5 @@
 //! Reports of a comparison (DESIGN.md §5): colour maps and heatmaps with colour bars, the
-//! self-contained HTML page, and SVG plots of swept parameters.
+//! self-contained HTML page, SVG plots of swept parameters, and the page of a sweep.
 
 pub mod colormap;
 mod colormap_data;
@@ -13,3 +13,4 @@ pub mod summary;
 pub use html::{write_report, ReportInputs, ReportOptions};
 pub use summary::Summary;
 pub mod plot;
+pub mod sweep_page;

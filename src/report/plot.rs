@@ -1,6 +1,11 @@
 //! SVG line plots of a swept parameter (DESIGN.md §5 "plots (error and time against a swept
 //! parameter) as SVG"), drawn with plotters: one series per value of the other parameters, like
 //! the thesis's Figures 6.2/6.3 (time against samples, one line per N).
+//!
+//! Ticks are placed here, not by plotters, so that labels stay readable: on a log axis at
+//! 1, 2, 5 × 10^k (or every decade, or every few decades, whichever keeps them apart), written
+//! `1`, `10`, `0.001` (and `1e-7` outside 0.001..100000); on a category axis (e.g. `n_exact` =
+//! 1, 2, 5, all) at each category; linear axes keep plotters' round ticks.
 
 use crate::error::{PgtError, Result};
 use plotters::prelude::*;
@@ -24,6 +29,62 @@ pub struct PlotSpec<'a> {
     pub log_x: bool,
     /// Logarithmic y axis (for errors spanning decades); non-positive values are dropped.
     pub log_y: bool,
+    /// A category axis: x values are indices into these names (`log_x` is then ignored).
+    pub x_categories: Option<&'a [String]>,
+}
+
+/// Most ticks on the x and the y axis (640×400 plots: about 55 and 35 pixels apart at least).
+const MAX_X_TICKS: usize = 10;
+const MAX_Y_TICKS: usize = 8;
+
+/// Ticks of a log axis over [lo, hi] (0 < lo < hi): 1, 2, 5 × 10^k where that gives at most
+/// `max` ticks, else every decade, else every n-th decade; 1…9 × 10^k for ranges too short to
+/// hold two of those.
+pub fn log_ticks(lo: f64, hi: f64, max: usize) -> Vec<f64> {
+    let (k0, k1) = (lo.log10().floor() as i32, hi.log10().ceil() as i32);
+    let within = |mantissas: &[u32], every: i32| -> Vec<f64> {
+        let mut out = Vec::new();
+        for k in (k0..=k1).filter(|k| k.rem_euclid(every) == 0) {
+            for &m in mantissas {
+                // Parsed from text, so that 2e-7 is the double nearest 2·10⁻⁷ (and prints so).
+                let v: f64 = format!("{m}e{k}").parse().unwrap_or(f64::NAN);
+                if v >= lo && v <= hi {
+                    out.push(v);
+                }
+            }
+        }
+        out
+    };
+    let fine = within(&[1, 2, 5], 1);
+    if fine.len() >= 2 && fine.len() <= max {
+        return fine;
+    }
+    if fine.len() < 2 {
+        return within(&[1, 2, 3, 4, 5, 6, 7, 8, 9], 1);
+    }
+    let mut every = 1;
+    loop {
+        let decades = within(&[1], every);
+        if decades.len() <= max {
+            return decades;
+        }
+        every += 1;
+    }
+}
+
+/// A tick label: the shortest decimal for 0.001 ≤ |v| < 100000 (`1`, `10`, `0.002`, `0.35`),
+/// else `2e-7`, with at most three significant digits.
+pub fn tick_label(v: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 {
+        return "0".into();
+    }
+    let rounded: f64 = format!("{v:.2e}").parse().unwrap_or(v);
+    if (1e-3..1e5).contains(&a) {
+        format!("{rounded}")
+    } else {
+        format!("{rounded:e}")
+    }
 }
 
 const PALETTE: [RGBColor; 6] = [
@@ -35,10 +96,19 @@ const PALETTE: [RGBColor; 6] = [
     RGBColor(140, 86, 75),
 ];
 
-/// Draws `series` into an SVG file at `path` (640×400).
-pub fn line_plot_svg(path: &Path, spec: &PlotSpec, series: &[Series]) -> Result<()> {
+/// An axis: its range and its ticks.
+struct Axis {
+    lo: f64,
+    hi: f64,
+    ticks: Vec<f64>,
+}
+
+/// The drawable points of `series` (finite, positive on log axes, sorted by x) and the axes
+/// that hold them with a margin.
+fn layout(spec: &PlotSpec, series: &[Series]) -> (Vec<Series>, Axis, Axis) {
+    let log_x = spec.log_x && spec.x_categories.is_none();
     let keep = |(x, y): &(f64, f64)| {
-        x.is_finite() && y.is_finite() && (!spec.log_x || *x > 0.0) && (!spec.log_y || *y > 0.0)
+        x.is_finite() && y.is_finite() && (!log_x || *x > 0.0) && (!spec.log_y || *y > 0.0)
     };
     let series: Vec<Series> = series
         .iter()
@@ -67,8 +137,22 @@ pub fn line_plot_svg(path: &Path, spec: &PlotSpec, series: &[Series]) -> Result<
     if all.is_empty() {
         (x0, x1, y0, y1) = (1.0, 10.0, 1.0, 10.0);
     }
-    let widen = |lo: f64, hi: f64, log: bool| -> (f64, f64) {
-        if log {
+    let x = match spec.x_categories {
+        Some(c) => Axis {
+            lo: -0.5,
+            hi: c.len().max(1) as f64 - 0.5,
+            ticks: (0..c.len()).map(|i| i as f64).collect(),
+        },
+        None => Axis::around(x0, x1, log_x, MAX_X_TICKS),
+    };
+    let y = Axis::around(y0, y1, spec.log_y, MAX_Y_TICKS);
+    (series, x, y)
+}
+
+impl Axis {
+    /// [lo, hi] with a margin (a factor on log axes), and its ticks.
+    fn around(lo: f64, hi: f64, log: bool, max_ticks: usize) -> Axis {
+        let (lo, hi) = if log {
             let (lo, hi) = if hi / lo < 1.5 {
                 (lo / 1.5, hi * 1.5)
             } else {
@@ -82,10 +166,33 @@ pub fn line_plot_svg(path: &Path, spec: &PlotSpec, series: &[Series]) -> Result<
                 0.5 * lo.abs().max(1e-3)
             };
             (lo - pad, hi + pad)
+        };
+        // Linear axes keep plotters' ticks (round numbers already), at most `max_ticks`.
+        let ticks = if log {
+            log_ticks(lo, hi, max_ticks)
+        } else {
+            Vec::new()
+        };
+        Axis { lo, hi, ticks }
+    }
+}
+
+/// Draws `series` into an SVG file at `path` (640×400).
+pub fn line_plot_svg(path: &Path, spec: &PlotSpec, series: &[Series]) -> Result<()> {
+    let log_x = spec.log_x && spec.x_categories.is_none();
+    let (series, x, y) = layout(spec, series);
+    let (x0, x1, xt) = (x.lo, x.hi, x.ticks);
+    let (y0, y1, yt) = (y.lo, y.hi, y.ticks);
+    let x_label = |v: &f64| match spec.x_categories {
+        Some(c) if (v - v.round()).abs() < 1e-6 && *v >= 0.0 => {
+            c.get(v.round() as usize).cloned().unwrap_or_default()
         }
+        Some(_) => String::new(),
+        None => tick_label(*v),
     };
-    let (x0, x1) = widen(x0, x1, spec.log_x);
-    let (y0, y1) = widen(y0, y1, spec.log_y);
+    // A category axis is linear from −0.5 to n − 0.5: plotters puts its ticks on the integers
+    // when asked for n + 1 at most, and the formatter leaves any others blank.
+    let x_labels = spec.x_categories.map_or(MAX_X_TICKS, |c| c.len() + 1);
     let err = |e: &dyn std::fmt::Display| PgtError::io(path, std::io::Error::other(e.to_string()));
     let root = SVGBackend::new(path, (640, 400)).into_drawing_area();
     root.fill(&WHITE).map_err(|e| err(&e))?;
@@ -102,8 +209,10 @@ pub fn line_plot_svg(path: &Path, spec: &PlotSpec, series: &[Series]) -> Result<
                 .configure_mesh()
                 .x_desc(spec.x_label)
                 .y_desc(spec.y_label)
-                .x_label_formatter(&|v| crate::report::heatmap::format_label(*v))
-                .y_label_formatter(&|v| crate::report::heatmap::format_label(*v))
+                .x_labels(x_labels)
+                .y_labels(MAX_Y_TICKS)
+                .x_label_formatter(&x_label)
+                .y_label_formatter(&|v| tick_label(*v))
                 .draw()
                 .map_err(|e| err(&e))?;
             for (i, s) in series.iter().enumerate() {
@@ -132,12 +241,85 @@ pub fn line_plot_svg(path: &Path, spec: &PlotSpec, series: &[Series]) -> Result<
             }
         }};
     }
-    match (spec.log_x, spec.log_y) {
+    match (log_x, spec.log_y) {
         (false, false) => draw!(x0..x1, y0..y1),
-        (true, false) => draw!((x0..x1).log_scale(), y0..y1),
-        (false, true) => draw!(x0..x1, (y0..y1).log_scale()),
-        (true, true) => draw!((x0..x1).log_scale(), (y0..y1).log_scale()),
+        (true, false) => draw!((x0..x1).log_scale().with_key_points(xt), y0..y1),
+        (false, true) => draw!(x0..x1, (y0..y1).log_scale().with_key_points(yt)),
+        (true, true) => draw!(
+            (x0..x1).log_scale().with_key_points(xt),
+            (y0..y1).log_scale().with_key_points(yt)
+        ),
     }
     root.present().map_err(|e| err(&e))?;
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn log_ticks_are_round_and_few() {
+        assert_eq!(
+            log_ticks(0.9, 70.0, 10),
+            vec![1.0, 2.0, 5.0, 10.0, 20.0, 50.0]
+        );
+        assert_eq!(log_ticks(1e-7, 2e-3, 8), vec![1e-7, 1e-6, 1e-5, 1e-4, 1e-3]);
+        assert_eq!(
+            log_ticks(1e-12, 1.0, 8),
+            vec![1e-12, 1e-10, 1e-8, 1e-6, 1e-4, 1e-2, 1.0]
+        );
+        assert_eq!(log_ticks(2.1, 5.7, 10), vec![3.0, 4.0, 5.0]);
+        assert_eq!(tick_label(1.0), "1");
+        assert_eq!(tick_label(100.0), "100");
+        assert_eq!(tick_label(0.002), "0.002");
+        assert_eq!(tick_label(2e-7), "2e-7");
+        assert_eq!(tick_label(123456.0), "1.23e5");
+    }
+
+    #[test]
+    fn labels_do_not_repeat_or_crowd() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.svg");
+        let series = [Series {
+            label: "thesis".into(),
+            points: vec![(1.0, 1e-3), (4.0, 2e-5), (16.0, 3e-7), (64.0, 1e-7)],
+        }];
+        let spec = PlotSpec {
+            title: "t",
+            x_label: "samples",
+            y_label: "e",
+            log_x: true,
+            log_y: true,
+            x_categories: None,
+        };
+        line_plot_svg(&path, &spec, &series).unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        let labels: Vec<&str> = svg
+            .split("</text>")
+            .filter_map(|t| t.rsplit('>').next())
+            .map(str::trim)
+            .filter(|t| !t.is_empty())
+            .collect();
+        for l in ["1", "10", "1e-7", "0.001"] {
+            assert!(labels.contains(&l), "{l} not in {labels:?}");
+        }
+        assert!(!labels.iter().any(|l| l.contains(".00e")), "{labels:?}");
+        let mut sorted = labels.clone();
+        sorted.sort();
+        sorted.dedup();
+        assert_eq!(sorted.len(), labels.len(), "repeated labels: {labels:?}");
+        let categories = ["1".to_string(), "2".into(), "all".into()];
+        let spec = PlotSpec {
+            x_categories: Some(&categories),
+            ..spec
+        };
+        let series = [Series {
+            label: String::new(),
+            points: vec![(0.0, 1e-3), (1.0, 1e-4), (2.0, 1e-5)],
+        }];
+        line_plot_svg(&path, &spec, &series).unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        assert!(svg.contains("all") && !svg.contains("4294967295"), "{svg}");
+    }
 }

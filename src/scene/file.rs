@@ -3,6 +3,7 @@
 //! can name the line.
 
 use super::{Falloff, LightWeight, OpticalModel, RenderMode};
+use crate::formats::IncludeSpec;
 use serde::Deserialize;
 use toml::Spanned;
 
@@ -89,62 +90,4 @@ pub(super) struct ParticleTable {
     pub albedo: Option<[f64; 3]>,
     pub ks: Option<f64>,
     pub shininess: Option<f64>,
-}
-
-/// How particles read from a file are coloured (PDB/mmCIF).
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum ColorBy {
-    #[default]
-    Element,
-    Chain,
-    Uniform,
-}
-
-fn one() -> f64 {
-    1.0
-}
-
-/// `[[include]]`: particles from a file (DESIGN.md §1, §6). The path is relative to the scene
-/// file. Format-specific selections are ignored by formats they do not apply to.
-#[derive(Debug, Clone, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct IncludeSpec {
-    pub path: std::path::PathBuf,
-    #[serde(default)]
-    pub color_by: ColorBy,
-    #[serde(default = "one")]
-    pub radius_scale: f64,
-    /// PDB/mmCIF: keep only these chains.
-    pub chains: Option<Vec<String>>,
-    /// PDB/mmCIF: which model (1-based); the first by default.
-    pub model: Option<usize>,
-    /// PDB/mmCIF: drop waters.
-    #[serde(default)]
-    pub skip_water: bool,
-    /// PDB/mmCIF: drop hydrogens.
-    #[serde(default)]
-    pub skip_hydrogen: bool,
-    /// MMPLD and XYZ: which frame (0-based); the first by default.
-    pub frame: Option<usize>,
-    /// Forces a file format whatever the extension (`"pdb"`, `"mmcif"`, `"vrml"`, `"mmpld"`,
-    /// `"xyz"`, `"csv"`).
-    pub format: Option<crate::formats::Format>,
-}
-
-impl IncludeSpec {
-    /// The include of a bare particle file, with every option at its default.
-    pub fn bare(path: &std::path::Path) -> IncludeSpec {
-        IncludeSpec {
-            path: path.to_path_buf(),
-            color_by: ColorBy::default(),
-            radius_scale: 1.0,
-            chains: None,
-            model: None,
-            skip_water: false,
-            skip_hydrogen: false,
-            frame: None,
-            format: None,
-        }
-    }
 }

@@ -1,7 +1,8 @@
 //! The default scene for a bare particle file (DESIGN.md §1).
 
-use super::{Light, Particle};
 use crate::geometry::Camera;
+use crate::optics::light::Light;
+use crate::optics::particle::Particle;
 use glam::DVec3;
 
 /// Vertical field of view of the default camera, degrees.

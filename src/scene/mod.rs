@@ -6,8 +6,13 @@ mod file;
 mod framing;
 mod validate;
 
-pub use file::{ColorBy, IncludeSpec};
+pub use crate::formats::{ColorBy, IncludeSpec, ParticleRecord};
 pub use framing::{default_camera, thesis_lights};
+// The light physics, the resolved particle and the optical models live in `optics` (the scene
+// builds on optics, never the reverse); re-exported so that `scene::Light` etc. keep working.
+pub use crate::optics::light::{Falloff, Incident, Light, LightWeight};
+pub use crate::optics::model::OpticalModel;
+pub use crate::optics::particle::Particle;
 
 use crate::error::{PgtError, Result};
 use crate::geometry::Camera;
@@ -24,120 +29,11 @@ pub enum RenderMode {
     Volume,
 }
 
-/// `model` (DESIGN.md §2): the source term Q of the volume renderer.
-#[derive(
-    Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum,
-)]
-#[serde(rename_all = "kebab-case")]
-pub enum OpticalModel {
-    Emission,
-    Lit,
-    SingleScatter,
-}
-
-/// `light_weight` of the lit model: w = 1/m (`mean`) or w = 1 (`sum`).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum LightWeight {
-    Mean,
-    Sum,
-}
-
-/// How a point light's irradiance falls off with distance d.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Falloff {
-    /// E = I/d².
-    InverseSquare,
-    /// E = I.
-    None,
-}
-
-/// A light source (DESIGN.md §1).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Light {
-    /// `direction` is unit length and is the way the light travels.
-    Directional { direction: DVec3, irradiance: DVec3 },
-    /// `intensity` in W/sr.
-    Point {
-        position: DVec3,
-        intensity: DVec3,
-        falloff: Falloff,
-    },
-}
-
-/// What arrives at a point from one light, before any occlusion.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Incident {
-    /// Unit vector from the point towards the light.
-    pub toward: DVec3,
-    /// Distance to the light (∞ for a directional light).
-    pub distance: f64,
-    /// Irradiance on a surface facing the light, unoccluded: E, or I/d² (I with `falloff = none`).
-    pub irradiance: DVec3,
-}
-
-impl Light {
-    /// The unoccluded light arriving at `x` (DESIGN.md §1: E for directional lights, I/d² for
-    /// point lights). A point exactly at a point light's position gets `None`.
-    #[inline]
-    pub fn incident_at(&self, x: DVec3) -> Option<Incident> {
-        match *self {
-            Light::Directional {
-                direction,
-                irradiance,
-            } => Some(Incident {
-                toward: -direction,
-                distance: f64::INFINITY,
-                irradiance,
-            }),
-            Light::Point {
-                position,
-                intensity,
-                falloff,
-            } => {
-                let v = position - x;
-                let d = v.length();
-                if d <= 0.0 || !d.is_finite() {
-                    return None;
-                }
-                let irradiance = match falloff {
-                    Falloff::InverseSquare => intensity / (d * d),
-                    Falloff::None => intensity,
-                };
-                Some(Incident {
-                    toward: v / d,
-                    distance: d,
-                    irradiance,
-                })
-            }
-        }
-    }
-}
-
-/// One sphere, resolved: σ computed from Θmax or κ, defaults applied.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Particle {
-    pub center: DVec3,
-    /// Radius in metres, > 0.
-    pub radius: f64,
-    /// Linear RGB colour C ≥ 0 (emission colour in volume mode, albedo-diffuse in opaque mode).
-    pub color: DVec3,
-    /// Extinction σ = λκ = −ln(1−Θmax)/(2r) in 1/m (DESIGN.md §1, thesis eq. 5.1); may be +∞
-    /// (Θmax = 1) or 0 (Θmax = 0).
-    pub sigma: f64,
-    /// Single-scatter albedo (defaults to `color`).
-    pub albedo: DVec3,
-    /// Blinn–Phong specular weight (opaque mode).
-    pub ks: f64,
-    /// Blinn–Phong exponent (opaque mode).
-    pub shininess: f64,
-}
-
 /// Global render settings, `[render]` of the scene file with the command-line overrides applied.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RenderSettings {
     pub mode: RenderMode,
+    /// The optical model of the volume mode, an entry of `optics::models::ALL`.
     pub model: OpticalModel,
     /// L_bg, linear RGB.
     pub background: DVec3,
@@ -156,7 +52,7 @@ impl Default for RenderSettings {
     fn default() -> Self {
         RenderSettings {
             mode: RenderMode::Volume,
-            model: OpticalModel::Lit,
+            model: crate::optics::models::LIT,
             background: DVec3::ZERO,
             lambda: 1.0,
             light_weight: LightWeight::Mean,
@@ -187,18 +83,6 @@ pub struct SceneLoadOptions {
     pub mode: Option<RenderMode>,
     pub model: Option<OpticalModel>,
     pub tol: Option<f64>,
-}
-
-/// A particle as a file format delivers it, before defaults and validation.
-#[derive(Debug, Clone, PartialEq)]
-pub struct ParticleRecord {
-    pub center: DVec3,
-    pub radius: f64,
-    pub color: Option<DVec3>,
-    /// Θmax, if the format carries one (e.g. VRML transparency).
-    pub opacity: Option<f64>,
-    /// Where in its file the particle was defined (line, or byte offset for binary formats).
-    pub location: crate::error::Location,
 }
 
 /// Largest image side pgt accepts; beyond it a typo (`--size 5120000x512`) would allocate
@@ -243,11 +127,6 @@ impl Scene {
     /// Parses and validates scene TOML text; `path` names it in messages and anchors includes.
     pub fn from_toml_str(text: &str, path: &Path, options: &SceneLoadOptions) -> Result<Scene> {
         validate::scene_from_toml(text, path, options)
-    }
-
-    /// σ of every particle, in input order.
-    pub fn sigmas(&self) -> Vec<f64> {
-        self.particles.iter().map(|p| p.sigma).collect()
     }
 
     /// A BVH over the scene's particles (indices are positions in `particles`).

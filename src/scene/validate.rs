@@ -5,24 +5,15 @@ use super::file::{
     CameraTable, LightKind, LightTable, ParticleDefaults, ParticleTable, RenderTable, SceneFile,
 };
 use super::framing::{default_camera, thesis_lights, DEFAULT_FOV_Y, DEFAULT_SIZE};
-use super::{
-    Falloff, IncludeSpec, Light, Particle, ParticleRecord, RenderSettings, Scene, SceneLoadOptions,
-};
-use crate::error::{Location, PgtError, Result};
+use super::{IncludeSpec, ParticleRecord, RenderSettings, Scene, SceneLoadOptions};
+use crate::error::{line_of, toml_error, Location, PgtError, Result};
 use crate::geometry::Camera;
-use crate::optics::extinction::sigma_from_opacity;
+use crate::optics::extinction::Extinction;
+use crate::optics::light::{Falloff, Light};
+use crate::optics::particle::Particle;
 use glam::DVec3;
 use std::path::Path;
 use toml::Spanned;
-
-/// 1-based line of a byte offset.
-fn line_of(text: &str, offset: usize) -> usize {
-    text.as_bytes()[..offset.min(text.len())]
-        .iter()
-        .filter(|&&b| b == b'\n')
-        .count()
-        + 1
-}
 
 /// Names a place for messages: the file and a location.
 struct At<'a> {
@@ -81,30 +72,12 @@ impl At<'_> {
     }
 }
 
-/// Turns a TOML syntax or type error into one naming the file and line.
-/// The offending line's text is quoted, since serde's message alone ("invalid length 2") does
-/// not name the field.
-fn toml_error(path: &Path, text: &str, e: toml::de::Error) -> PgtError {
-    let line = e.span().map(|s| line_of(text, s.start)).unwrap_or(1);
-    let mut message = e.message().trim().to_string();
-    if let Some(source_line) = text
-        .lines()
-        .nth(line - 1)
-        .map(str::trim)
-        .filter(|l| !l.is_empty())
-    {
-        let quoted: String = source_line.chars().take(100).collect();
-        message = format!("{message} (in `{quoted}`)");
-    }
-    PgtError::at_line(path, line, message)
-}
-
 pub(super) fn scene_from_toml(
     text: &str,
     path: &Path,
     options: &SceneLoadOptions,
 ) -> Result<Scene> {
-    let file: SceneFile = toml::from_str(text).map_err(|e| toml_error(path, text, e))?;
+    let file: SceneFile = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
     let at = |span: std::ops::Range<usize>| At {
         path,
         location: Location::Line(line_of(text, span.start)),
@@ -330,17 +303,19 @@ impl ResolvedDefaults {
         })
     }
 
-    /// σ from the particle's own opacity/kappa or the defaults (DESIGN.md §1, thesis eq. 5.1).
+    /// σ from the particle's own opacity/kappa, else the defaults, else Θmax =
+    /// [`DEFAULT_OPACITY`] (DESIGN.md §1); the equation itself is [`Extinction::sigma`].
     fn sigma(&self, opacity: Option<f64>, kappa: Option<f64>, radius: f64, lambda: f64) -> f64 {
-        match (opacity, kappa) {
-            (Some(o), _) => sigma_from_opacity(o, radius),
-            (None, Some(k)) => lambda * k,
+        let extinction = match (opacity, kappa) {
+            (Some(o), _) => Extinction::Opacity(o),
+            (None, Some(k)) => Extinction::Kappa(k),
             (None, None) => match (self.opacity, self.kappa) {
-                (_, Some(k)) => lambda * k,
-                (Some(o), None) => sigma_from_opacity(o, radius),
-                (None, None) => sigma_from_opacity(DEFAULT_OPACITY, radius),
+                (_, Some(k)) => Extinction::Kappa(k),
+                (Some(o), None) => Extinction::Opacity(o),
+                (None, None) => Extinction::Opacity(DEFAULT_OPACITY),
             },
-        }
+        };
+        extinction.sigma(radius, lambda)
     }
 }
 
@@ -614,6 +589,7 @@ opacity = 0.8
         assert!(e.starts_with("s.toml:2:") && e.contains("modle"), "{e}");
         let e = err_text("[render]\nmodel = \"glow\"\n");
         assert!(e.starts_with("s.toml:2:") && e.contains("glow"), "{e}");
+        assert!(e.contains("`emission`, `lit`, `single-scatter`"), "{e}");
         let e =
             err_text("[[lights]]\ntype=\"directional\"\ndirection=[0,0,0]\nirradiance=[1,1,1]\n");
         assert!(

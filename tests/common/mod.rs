@@ -1,27 +1,57 @@
 //! Helpers shared by the format tests: the shared data directory (`../shared/data` beside the
 //! clone), which CI provides and a bare checkout may not.
-#![allow(dead_code)]
+//!
+//! A test that needs a file of it gets the path from [`shared`] (or [`shared_or_skip!`]): absent
+//! under `CI=true`, that is a failure (a broken setup must not pass as green); elsewhere the test
+//! is skipped with a message. No test may return early without going through them.
+#![allow(dead_code, unused_macros, unused_imports)]
 
-use pgt::formats::{load_particles, LoadedParticles};
-use pgt::scene::IncludeSpec;
+use pgt::formats::{load_particles, IncludeSpec, LoadedParticles};
 use std::path::{Path, PathBuf};
 
-/// `../shared/data/<rel>` relative to the crate root, or `None` (with a note on stdout) when absent.
-pub fn shared(rel: &str) -> Option<PathBuf> {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let p = root
-        .parent()
-        .unwrap_or(root)
-        .join("shared")
-        .join("data")
-        .join(rel);
-    if p.exists() {
-        Some(p)
-    } else {
-        println!("skipping: {} is absent", p.display());
-        None
+/// The shared data directory: `$PGT_SHARED_DATA` if set (to check that the tests fail without
+/// the data: `PGT_SHARED_DATA=/nonexistent CI=true cargo test --test formats_pdb`), else
+/// `../shared/data` beside the crate root.
+pub fn shared_root() -> PathBuf {
+    if let Some(dir) = std::env::var_os("PGT_SHARED_DATA") {
+        return PathBuf::from(dir);
     }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    root.parent().unwrap_or(root).join("shared").join("data")
 }
+
+/// Whether this is CI (`CI=true`, as `.ci/run` sets it), where missing data is a failure.
+pub fn in_ci() -> bool {
+    std::env::var("CI").is_ok_and(|v| v == "true")
+}
+
+/// `<shared data>/<rel>`, or, when absent: a panic under `CI=true`, and elsewhere `None` with a
+/// message on stderr saying what is skipped.
+pub fn shared(rel: &str) -> Option<PathBuf> {
+    let p = shared_root().join(rel);
+    if p.exists() {
+        return Some(p);
+    }
+    assert!(
+        !in_ci(),
+        "CI=true and the test data {} is absent (CI must provide ../shared/data)",
+        p.display()
+    );
+    eprintln!("skipping: {} is absent (CI is not set)", p.display());
+    None
+}
+
+/// `let p = shared_or_skip!("pdb/1rx1.pdb");`: the path of a shared data file, or the end of the
+/// test (skipped with [`shared`]'s message; a failure under `CI=true`).
+macro_rules! shared_or_skip {
+    ($rel:expr) => {
+        match $crate::common::shared($rel) {
+            Some(path) => path,
+            None => return,
+        }
+    };
+}
+pub(crate) use shared_or_skip;
 
 /// `tests/data/<rel>` in the crate.
 pub fn local(rel: &str) -> PathBuf {

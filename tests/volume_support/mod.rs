@@ -4,11 +4,10 @@
 use glam::DVec3;
 use pgt::formats::random::SplitMix64;
 use pgt::geometry::{Camera, Ray};
+use pgt::optics::{models, Falloff, Light, LightWeight, OpticalModel, Particle};
 use pgt::reference::volume::VolumeRenderer;
 use pgt::reference::{Integrator, RadianceEstimator, Sample};
-use pgt::scene::{
-    Falloff, Light, LightWeight, OpticalModel, Particle, RenderMode, RenderSettings, Scene,
-};
+use pgt::scene::{RenderMode, RenderSettings, Scene};
 
 /// The library's deterministic SplitMix64 (the one `pgt gen random` uses), with the draws the
 /// volume tests need.
@@ -120,8 +119,4 @@ pub fn radiance(scene: &Scene, integrator: Integrator, ray: &Ray) -> Sample {
     VolumeRenderer::new(scene, integrator).radiance(ray)
 }
 
-pub const MODELS: [OpticalModel; 3] = [
-    OpticalModel::Emission,
-    OpticalModel::Lit,
-    OpticalModel::SingleScatter,
-];
+pub const MODELS: [OpticalModel; 3] = [models::EMISSION, models::LIT, models::SINGLE_SCATTER];

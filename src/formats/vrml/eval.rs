@@ -20,9 +20,9 @@
 //!   material (VRML's unlit white) leaves the colour to the scene's default.
 
 use super::parser::{Node, NodeKind, Proto, Value};
+use crate::color::srgb_to_linear;
 use crate::error::{Location, PgtError, Result};
-use crate::formats::elements::srgb_to_linear;
-use crate::scene::ParticleRecord;
+use crate::formats::ParticleRecord;
 use glam::{DMat3, DMat4, DQuat, DVec3};
 use std::collections::{BTreeMap, HashMap};
 use std::path::Path;

@@ -6,13 +6,23 @@ pub mod eval;
 pub mod lexer;
 pub mod parser;
 
-use super::LoadedParticles;
+use super::{Format, IncludeSpec, LoadedParticles};
 use crate::error::{PgtError, Result};
-use std::path::Path;
 
-/// Loads the spheres of a VRML97 file. The file must start with `#VRML V2.0` (VRML 1.0 is a
-/// different language and is refused).
-pub fn load(path: &Path, bytes: &[u8]) -> Result<LoadedParticles> {
+/// VRML97 in the table of formats ([`super::FORMATS`]).
+pub const FORMAT: Format = Format {
+    name: "vrml",
+    extensions: &["wrl", "vrml"],
+    description: "VRML97",
+    particles: "Sphere shapes",
+    read,
+    details: None,
+};
+
+/// The [`super::Reader`] of VRML97: the spheres of the file. The file must start with
+/// `#VRML V2.0` (VRML 1.0 is a different language and is refused).
+pub fn read(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
+    let path = spec.path.as_path();
     let bytes = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes);
     if !bytes.starts_with(b"#VRML V2.0") {
         let first: String =

@@ -1,0 +1,87 @@
+//! What every format delivers and what an `[[include]]` asks of it (DESIGN.md §1, §6): the
+//! [`ParticleRecord`] before defaults and validation, and the [`IncludeSpec`] with its selections.
+//! They live here, not in `scene`, so that `formats` depends on nothing above it: the scene
+//! reads particle files, particle files know nothing of scenes.
+
+use glam::DVec3;
+use serde::Deserialize;
+
+/// A particle as a file format delivers it, before defaults and validation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ParticleRecord {
+    /// Centre, in the file's units (Å for PDB/mmCIF/XYZ).
+    pub center: DVec3,
+    /// Radius, same units, `radius_scale` applied.
+    pub radius: f64,
+    /// Linear RGB, if the file gives the particle a colour of its own.
+    pub color: Option<DVec3>,
+    /// Θmax, if the format carries one (e.g. VRML transparency).
+    pub opacity: Option<f64>,
+    /// Where in its file the particle was defined (line, or byte offset for binary formats).
+    pub location: crate::error::Location,
+}
+
+/// How particles read from a file are coloured (PDB/mmCIF; `uniform` applies to every format).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ColorBy {
+    /// Jmol's CPK colour of the element.
+    #[default]
+    Element,
+    /// One colour per chain, in order of first appearance.
+    Chain,
+    /// No colour of its own: the scene's `[defaults] color`.
+    Uniform,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+/// `[[include]]`: particles from a file (DESIGN.md §1, §6). The path is relative to the scene
+/// file. Format-specific selections are ignored by formats they do not apply to.
+#[derive(Debug, Clone, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IncludeSpec {
+    /// The particle file (already joined to the scene file's folder once validated).
+    pub path: std::path::PathBuf,
+    /// How the particles are coloured.
+    #[serde(default)]
+    pub color_by: ColorBy,
+    /// Factor on every radius (> 0).
+    #[serde(default = "one")]
+    pub radius_scale: f64,
+    /// PDB/mmCIF: keep only these chains.
+    pub chains: Option<Vec<String>>,
+    /// PDB/mmCIF: which model (1-based); the first by default.
+    pub model: Option<usize>,
+    /// PDB/mmCIF: drop waters.
+    #[serde(default)]
+    pub skip_water: bool,
+    /// PDB/mmCIF: drop hydrogens.
+    #[serde(default)]
+    pub skip_hydrogen: bool,
+    /// MMPLD and XYZ: which frame (0-based); the first by default.
+    pub frame: Option<usize>,
+    /// Forces a file format whatever the extension: a name of [`super::FORMATS`] (`"pdb"`,
+    /// `"mmcif"`, `"vrml"`, `"mmpld"`, `"xyz"`, `"csv"`).
+    #[serde(default, deserialize_with = "super::deserialize_format")]
+    pub format: Option<&'static super::Format>,
+}
+
+impl IncludeSpec {
+    /// The include of a bare particle file, with every option at its default.
+    pub fn bare(path: &std::path::Path) -> IncludeSpec {
+        IncludeSpec {
+            path: path.to_path_buf(),
+            color_by: ColorBy::default(),
+            radius_scale: 1.0,
+            chains: None,
+            model: None,
+            skip_water: false,
+            skip_hydrogen: false,
+            frame: None,
+            format: None,
+        }
+    }
+}

@@ -1,0 +1,176 @@
+//! What an optical model is (DESIGN.md §2): the source term Q of
+//!
+//!   L = L_bg·T(0,∞) + ∫₀^∞ T(0,t)·σ(x_t)·Q(x_t) dt
+//!
+//! split into a part that is constant inside an interval of fixed particles, k·E(x), and a part
+//! that is a sum over the lights of what the shadow ray towards each light found. The models
+//! are in `models/`, one file each, listed in the registry `models::ALL`; the renderer asks the
+//! model and never matches on its name.
+
+use super::intervals::Interval;
+use super::source::{LightSample, SourceParams};
+use glam::DVec3;
+use std::fmt;
+
+/// What a model's per-light part needs from the shadow ray towards each light.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum LightNeed {
+    /// No per-light part: Q = k·E is constant inside an interval, so the emission closed form
+    /// L_in = L_out·e^{−σΔ} + Q·(1 − e^{−σΔ}) is exact and no shadow ray is traced.
+    None,
+    /// L_l(x): the emission model along the shadow ray, the light as its background (lit).
+    Radiance,
+    /// E_l(x)·T_l(x): the unoccluded irradiance and the transmittance to the light
+    /// (single-scatter).
+    IrradianceTransmittance,
+}
+
+/// An optical model of DESIGN.md §2: Q(x) = k·E(x) + Σ_l q_l(x), where E is the σ-weighted
+/// emission colour of the particles at x and q_l the part of light l.
+///
+/// The renderer integrates the per-light parts one light at a time (Q is linear in the lights)
+/// and the constant part in closed form; [`Model::source`] is the whole Q, for the Riemann sums
+/// and the Θmax = 1 limit. Each implementation's file opens with a table citing DESIGN.md §2.
+pub trait Model: Sync + Send {
+    /// The name in scene files and on the command line (`model = "lit"`, `--model lit`).
+    fn name(&self) -> &'static str;
+    /// One line for `--help` and the docs.
+    fn summary(&self) -> &'static str;
+    /// What [`Model::light_source`] reads from each light's shadow ray.
+    fn light_need(&self) -> LightNeed;
+    /// k of the constant part k·E(x) of Q.
+    fn emission_factor(&self, params: &SourceParams) -> f64;
+    /// q_l(x), the part of Q that one light contributes, at a point inside `interval`.
+    fn light_source(
+        &self,
+        params: &SourceParams,
+        interval: &Interval,
+        light: &LightSample,
+    ) -> DVec3;
+    /// Q(x) whole, given the samples of every light that reaches x, at a point inside
+    /// `interval`. Equal to k·E + Σ q_l up to rounding (each model writes it in the order its
+    /// equation does).
+    fn source(&self, params: &SourceParams, interval: &Interval, lights: &[LightSample]) -> DVec3;
+    /// Q∞, the Θmax = 1 (σ → ∞) limit of Q at the surface where the ray enters an opaque
+    /// particle, given each light's sample already taken to its surface limit
+    /// ([`LightSample::surface_limit`]). Q is linear in the samples for every model of
+    /// DESIGN.md §2, so the limit is Q of the limit samples; a model that is not overrides this.
+    fn opaque_limit(
+        &self,
+        params: &SourceParams,
+        interval: &Interval,
+        lights: &[LightSample],
+    ) -> DVec3 {
+        self.source(params, interval, lights)
+    }
+}
+
+/// The `model` of a scene (DESIGN.md §1 `[render]`): a handle on one entry of the registry
+/// `models::ALL`. Copy, compared by name, read from TOML and the command line by name; an
+/// unknown name is an error that lists the valid ones.
+#[derive(Clone, Copy)]
+pub struct OpticalModel(&'static dyn Model);
+
+impl OpticalModel {
+    /// Wraps a model; the registry does this once per model.
+    pub const fn new(model: &'static dyn Model) -> Self {
+        OpticalModel(model)
+    }
+
+    /// The model behind the handle.
+    #[inline]
+    pub fn model(self) -> &'static dyn Model {
+        self.0
+    }
+
+    /// The registered model called `name`, or `None`.
+    pub fn from_name(name: &str) -> Option<OpticalModel> {
+        super::models::ALL
+            .iter()
+            .copied()
+            .find(|m| m.name() == name)
+    }
+
+    /// The registered names, for messages: "`emission`, `lit`, `single-scatter`".
+    pub fn names() -> String {
+        super::models::ALL
+            .iter()
+            .map(|m| format!("`{}`", m.name()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
+    /// The message for a name that is not registered.
+    pub fn unknown(name: &str) -> String {
+        format!(
+            "unknown optical model `{name}`, expected one of {}",
+            Self::names()
+        )
+    }
+}
+
+impl std::ops::Deref for OpticalModel {
+    type Target = dyn Model;
+    #[inline]
+    fn deref(&self) -> &(dyn Model + 'static) {
+        self.0
+    }
+}
+
+impl PartialEq for OpticalModel {
+    fn eq(&self, other: &Self) -> bool {
+        self.name() == other.name()
+    }
+}
+
+impl Eq for OpticalModel {}
+
+impl std::hash::Hash for OpticalModel {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        self.name().hash(state)
+    }
+}
+
+impl fmt::Debug for OpticalModel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "OpticalModel({:?})", self.name())
+    }
+}
+
+impl fmt::Display for OpticalModel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::str::FromStr for OpticalModel {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        OpticalModel::from_name(s).ok_or_else(|| OpticalModel::unknown(s))
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for OpticalModel {
+    /// By name; toml attaches the line of the value to the error.
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        name.parse().map_err(serde::de::Error::custom)
+    }
+}
+
+impl serde::Serialize for OpticalModel {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+/// `--model NAME`: the registry is the list of values, each model's summary its help.
+impl clap::ValueEnum for OpticalModel {
+    fn value_variants<'a>() -> &'a [Self] {
+        super::models::ALL
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.name()).help(self.summary()))
+    }
+}

@@ -1,0 +1,110 @@
+//! The optical models of DESIGN.md §2, one file each, and their registry.
+//!
+//! A new model is one file here implementing [`Model`](super::model::Model) (opening with its
+//! table, as the others do), its `mod` line and one entry in [`ALL`]. Scene files, `--model`,
+//! error messages and the renderer read [`ALL`]; nothing matches on a model's name.
+
+mod emission;
+mod lit;
+mod single_scatter;
+
+use super::model::OpticalModel;
+
+/// DESIGN.md §2, emission model.
+pub const EMISSION: OpticalModel = OpticalModel::new(&emission::Emission);
+/// DESIGN.md §2, lit model (the default).
+pub const LIT: OpticalModel = OpticalModel::new(&lit::Lit);
+/// DESIGN.md §2, single-scatter model.
+pub const SINGLE_SCATTER: OpticalModel = OpticalModel::new(&single_scatter::SingleScatter);
+
+/// The registry, one entry per model, in the order of `--help` and of error messages.
+pub const ALL: &[OpticalModel] = &[EMISSION, LIT, SINGLE_SCATTER];
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::optics::intervals::Interval;
+    use crate::optics::source::{LightSample, SourceParams};
+    use glam::DVec3;
+    use std::f64::consts::PI;
+
+    fn interval() -> Interval {
+        Interval {
+            t0: 0.0,
+            t1: 1.0,
+            sigma: 2.0,
+            emission: DVec3::new(0.2, 0.4, 0.8),
+            albedo: DVec3::new(0.5, 0.25, 1.0),
+        }
+    }
+
+    fn samples() -> [LightSample; 2] {
+        [
+            LightSample {
+                radiance: DVec3::X,
+                irradiance: DVec3::splat(4.0 * PI),
+                transmittance: 0.5,
+            },
+            LightSample {
+                radiance: DVec3::Y,
+                irradiance: DVec3::new(0.0, 8.0 * PI, 0.0),
+                transmittance: 0.25,
+            },
+        ]
+    }
+
+    #[test]
+    fn names_are_unique_and_resolve() {
+        for (i, m) in ALL.iter().enumerate() {
+            assert_eq!(OpticalModel::from_name(m.name()), Some(*m));
+            assert!(ALL[..i].iter().all(|o| o.name() != m.name()), "{m} twice");
+            assert!(!m.summary().is_empty());
+        }
+        assert_eq!(OpticalModel::from_name("glow"), None);
+        assert_eq!(
+            OpticalModel::unknown("glow"),
+            "unknown optical model `glow`, expected one of `emission`, `lit`, `single-scatter`"
+        );
+        assert_eq!("single-scatter".parse::<OpticalModel>(), Ok(SINGLE_SCATTER));
+        assert_ne!(LIT, EMISSION);
+    }
+
+    #[test]
+    fn sources_are_the_equations_of_design_section_2() {
+        let p = SourceParams {
+            light_weight: 0.5,
+            emission_weight: 0.3,
+        };
+        let (iv, s) = (interval(), samples());
+        assert_eq!(EMISSION.source(&p, &iv, &s), iv.emission);
+        assert_eq!(LIT.source(&p, &iv, &s), DVec3::new(0.5, 0.5, 0.0));
+        // a·E + α·(E_1·T_1 + E_2·T_2)/4π = 0.3·E + α·(2, 3, 2)/4 … with E_l·T_l = (2π, 4π, 2π).
+        let expected = 0.3 * iv.emission + iv.albedo * DVec3::new(0.5, 1.0, 0.5);
+        let q = SINGLE_SCATTER.source(&p, &iv, &s);
+        assert!((q - expected).abs().max_element() < 1e-15, "{q}");
+    }
+
+    #[test]
+    fn source_is_the_constant_part_plus_the_light_parts() {
+        let p = SourceParams {
+            light_weight: 0.5,
+            emission_weight: 0.3,
+        };
+        let (iv, s) = (interval(), samples());
+        for m in ALL {
+            let mut split = m.emission_factor(&p) * iv.emission;
+            for l in &s {
+                split += m.light_source(&p, &iv, l);
+            }
+            let whole = m.source(&p, &iv, &s);
+            assert!(
+                (split - whole).abs().max_element() < 1e-15,
+                "{m}: {split} vs {whole}"
+            );
+            assert_eq!(m.opaque_limit(&p, &iv, &s), whole);
+            if m.light_need() == crate::optics::model::LightNeed::None {
+                assert_eq!(m.source(&p, &iv, &[]), whole, "{m} reads its lights");
+            }
+        }
+    }
+}

@@ -1,0 +1,519 @@
+//! The experiment file (format: the module documentation of [`crate::sweep`]): parsing with
+//! file:line errors, validation of every entry against its method's declared parameters, and the
+//! expansion of each `[[approximations]]` entry into runs (the Cartesian product of its lists),
+//! each with the index of its baseline run where the entry names one.
+
+use super::method::{find_method, method_names, ParamDefault, ParamValue, SweepMethod, SweepParam};
+use crate::error::{line_of, toml_error, with_quoted_line, PgtError, Result};
+use std::collections::BTreeMap;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use toml::Spanned;
+
+/// The file as TOML sees it.
+#[derive(Debug, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ExperimentFile {
+    scene: PathBuf,
+    size: Option<[u32; 2]>,
+    data_range: Option<f64>,
+    #[serde(default)]
+    reference: ReferenceSpec,
+    approximations: Vec<BTreeMap<Spanned<String>, Spanned<toml::Value>>>,
+}
+
+/// Options of the one reference render.
+#[derive(Debug, Clone, Default, PartialEq, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ReferenceSpec {
+    /// Stratified k×k samples per pixel (default 1).
+    pub spp: Option<u32>,
+    /// Overrides the scene's quadrature tolerance.
+    pub tol: Option<f64>,
+}
+
+/// A validated experiment.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Experiment {
+    /// The experiment file.
+    pub path: PathBuf,
+    /// The scene, resolved against the experiment file's folder.
+    pub scene: PathBuf,
+    pub size: Option<[u32; 2]>,
+    pub data_range: Option<f64>,
+    pub reference: ReferenceSpec,
+    /// Every run of every entry, in file order.
+    pub runs: Vec<Run>,
+}
+
+/// One parameter combination of one method.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Run {
+    /// The method's name ([`find_method`] finds it).
+    pub method: &'static str,
+    /// One value per declared parameter of the method, in its declared order (the plots' x axis
+    /// is chosen among them).
+    pub params: Vec<(&'static str, ParamValue)>,
+    /// The index in [`Experiment::runs`] of the run this one is also compared with (`baseline`).
+    pub baseline: Option<usize>,
+}
+
+impl Run {
+    /// `thesis samples=100 n_exact=all`.
+    pub fn label(&self) -> String {
+        let mut s = self.method.to_string();
+        for (k, v) in &self.params {
+            let _ = write!(s, " {k}={v}");
+        }
+        s
+    }
+
+    /// `thesis_samples_100_n_exact_all`: the stem of the run's files.
+    pub fn file_stem(&self) -> String {
+        self.label().replace([' ', '='], "_")
+    }
+
+    /// The value of parameter `name`.
+    pub fn param(&self, name: &str) -> Option<ParamValue> {
+        self.params
+            .iter()
+            .find(|(k, _)| *k == name)
+            .map(|(_, v)| *v)
+    }
+
+    /// The values as renderers take them (`"all"` as `u32::MAX`).
+    pub fn values(&self) -> Vec<(&'static str, u32)> {
+        self.params.iter().map(|(k, v)| (*k, v.as_u32())).collect()
+    }
+}
+
+/// A `baseline = { … }` table: the method (default: the entry's own) and the values that
+/// replace the run's own.
+#[derive(Debug)]
+struct BaselineSpec {
+    method: &'static dyn SweepMethod,
+    values: Vec<(&'static str, ParamValue)>,
+    line: usize,
+}
+
+/// One `[[approximations]]` entry, validated.
+struct Entry {
+    method: &'static dyn SweepMethod,
+    lists: Vec<Vec<ParamValue>>,
+    baseline: Option<BaselineSpec>,
+}
+
+impl Experiment {
+    /// Reads and validates an experiment file.
+    pub fn load(path: &Path) -> Result<Experiment> {
+        let text = std::fs::read_to_string(path).map_err(|e| PgtError::io(path, e))?;
+        Experiment::parse(&text, path)
+    }
+
+    /// Parses and validates the text of the experiment file `path`.
+    pub fn parse(text: &str, path: &Path) -> Result<Experiment> {
+        let file: ExperimentFile = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
+        let at = Place { path, text };
+        let ref_spp = file.reference.spp.unwrap_or(1);
+        let mut entries = Vec::new();
+        for table in &file.approximations {
+            entries.push(at.entry(table, ref_spp)?);
+        }
+        let mut runs = Vec::new();
+        for entry in &entries {
+            runs.extend(entry.runs());
+        }
+        if runs.is_empty() {
+            return Err(PgtError::in_file(
+                path,
+                "no approximation runs (every [[approximations]] list is empty)",
+            ));
+        }
+        resolve_baselines(&at, &entries, ref_spp, &mut runs)?;
+        let base = path.parent().unwrap_or(Path::new("."));
+        Ok(Experiment {
+            path: path.to_path_buf(),
+            scene: base.join(&file.scene),
+            size: file.size,
+            data_range: file.data_range,
+            reference: file.reference,
+            runs,
+        })
+    }
+}
+
+impl Entry {
+    /// The Cartesian product of the lists, the first parameter varying slowest.
+    fn runs(&self) -> Vec<Run> {
+        let names: Vec<&'static str> = self.method.params().iter().map(|p| p.name).collect();
+        let mut combos: Vec<Vec<(&'static str, ParamValue)>> = vec![Vec::new()];
+        for (name, values) in names.iter().zip(&self.lists) {
+            combos = combos
+                .into_iter()
+                .flat_map(|prefix| {
+                    values.iter().map(move |&v| {
+                        let mut p = prefix.clone();
+                        p.push((*name, v));
+                        p
+                    })
+                })
+                .collect();
+        }
+        combos
+            .into_iter()
+            .map(|params| Run {
+                method: self.method.name(),
+                params,
+                baseline: None,
+            })
+            .collect()
+    }
+}
+
+/// The run that `run`'s baseline names: the baseline's method, each parameter from the
+/// baseline table, else from `run` (same name), else the method's default.
+fn baseline_run(run: &Run, spec: &BaselineSpec, ref_spp: u32) -> Run {
+    let params = spec
+        .method
+        .params()
+        .iter()
+        .map(|p| {
+            let given = spec.values.iter().find(|(k, _)| *k == p.name).map(|v| v.1);
+            let v = given
+                .or_else(|| run.param(p.name))
+                .unwrap_or_else(|| default_value(p, ref_spp));
+            (p.name, v)
+        })
+        .collect();
+    Run {
+        method: spec.method.name(),
+        params,
+        baseline: None,
+    }
+}
+
+/// Sets each run's `baseline` index; an error at the `baseline` line when the named run is not
+/// among the experiment's runs.
+fn resolve_baselines(at: &Place, entries: &[Entry], ref_spp: u32, runs: &mut [Run]) -> Result<()> {
+    let mut start = 0;
+    for entry in entries {
+        let n = entry.runs().len();
+        if let Some(spec) = &entry.baseline {
+            for i in start..start + n {
+                let target = baseline_run(&runs[i], spec, ref_spp);
+                let found = runs
+                    .iter()
+                    .position(|r| r.method == target.method && r.params == target.params);
+                match found {
+                    Some(j) => runs[i].baseline = Some(j),
+                    None => {
+                        return Err(at.error(
+                            spec.line,
+                            format!(
+                                "the baseline of `{}` is `{}`, which is not one of the experiment's runs; list it in an [[approximations]] entry",
+                                runs[i].label(),
+                                target.label()
+                            ),
+                        ))
+                    }
+                }
+            }
+        }
+        start += n;
+    }
+    Ok(())
+}
+
+/// A parameter's value when an entry does not list it.
+fn default_value(p: &SweepParam, ref_spp: u32) -> ParamValue {
+    match p.default {
+        ParamDefault::Value(v) => v,
+        ParamDefault::ReferenceSpp => ParamValue::Count(ref_spp),
+    }
+}
+
+/// The experiment file, for errors that name file:line.
+struct Place<'a> {
+    path: &'a Path,
+    text: &'a str,
+}
+
+impl Place<'_> {
+    fn line<T>(&self, s: &Spanned<T>) -> usize {
+        line_of(self.text, s.span().start)
+    }
+
+    fn error(&self, line: usize, message: String) -> PgtError {
+        PgtError::at_line(self.path, line, with_quoted_line(message, self.text, line))
+    }
+
+    /// Validates one `[[approximations]]` table against its method's parameters.
+    fn entry(
+        &self,
+        table: &BTreeMap<Spanned<String>, Spanned<toml::Value>>,
+        ref_spp: u32,
+    ) -> Result<Entry> {
+        let get = |key: &str| table.iter().find(|(k, _)| k.get_ref() == key);
+        let Some((_, method_value)) = get("method") else {
+            let line = table.keys().map(|k| self.line(k)).min().unwrap_or(1);
+            return Err(self.error(
+                line,
+                format!(
+                    "an [[approximations]] entry needs `method = \"NAME\"` (one of {})",
+                    method_names().join(", ")
+                ),
+            ));
+        };
+        let method = self.method(method_value)?;
+        let mut lists: Vec<Option<Vec<ParamValue>>> = vec![None; method.params().len()];
+        let mut baseline = None;
+        for (key, value) in table {
+            match key.get_ref().as_str() {
+                "method" => {}
+                "baseline" => baseline = Some(self.baseline(method, value)?),
+                name => {
+                    let (i, p) = self.param(method, key, name)?;
+                    lists[i] = Some(self.values(p, value)?);
+                }
+            }
+        }
+        let lists = lists
+            .into_iter()
+            .zip(method.params())
+            .map(|(l, p)| l.unwrap_or_else(|| vec![default_value(p, ref_spp)]))
+            .collect();
+        Ok(Entry {
+            method,
+            lists,
+            baseline,
+        })
+    }
+
+    /// The method a `method = "NAME"` value names.
+    fn method(&self, value: &Spanned<toml::Value>) -> Result<&'static dyn SweepMethod> {
+        let name = value.get_ref().as_str();
+        name.and_then(find_method).ok_or_else(|| {
+            self.error(
+                self.line(value),
+                format!(
+                    "unknown method {}; the methods are {}",
+                    value.get_ref(),
+                    method_names().join(", ")
+                ),
+            )
+        })
+    }
+
+    /// The declared parameter `name` of `method` and its index.
+    fn param(
+        &self,
+        method: &'static dyn SweepMethod,
+        key: &Spanned<String>,
+        name: &str,
+    ) -> Result<(usize, &'static SweepParam)> {
+        let params = method.params();
+        params
+            .iter()
+            .enumerate()
+            .find(|(_, p)| p.name == name)
+            .ok_or_else(|| {
+                let valid: Vec<&str> = params.iter().map(|p| p.name).collect();
+                let valid = if valid.is_empty() {
+                    "it has none".to_string()
+                } else {
+                    format!("its parameters are {}", valid.join(", "))
+                };
+                self.error(
+                    self.line(key),
+                    format!(
+                        "method {} has no parameter '{name}'; {valid} (and `baseline`)",
+                        method.name()
+                    ),
+                )
+            })
+    }
+
+    /// A parameter's values: one value or a list, each a count or `"all"`.
+    fn values(&self, p: &SweepParam, value: &Spanned<toml::Value>) -> Result<Vec<ParamValue>> {
+        let items: Vec<&toml::Value> = match value.get_ref() {
+            toml::Value::Array(a) => a.iter().collect(),
+            v => vec![v],
+        };
+        items
+            .into_iter()
+            .map(|v| {
+                one_value(p, v)
+                    .map_err(|m| self.error(self.line(value), format!("{}: {m}", p.name)))
+            })
+            .collect()
+    }
+
+    /// A `baseline = { [method = "NAME",] param = value, … }` table.
+    fn baseline(
+        &self,
+        entry_method: &'static dyn SweepMethod,
+        value: &Spanned<toml::Value>,
+    ) -> Result<BaselineSpec> {
+        let line = self.line(value);
+        let Some(table) = value.get_ref().as_table() else {
+            return Err(self.error(
+                line,
+                "baseline must be a table, e.g. baseline = { n_exact = \"all\" }".into(),
+            ));
+        };
+        let method = match table.get("method") {
+            Some(m) => {
+                let m = Spanned::new(value.span(), m.clone());
+                self.method(&m)?
+            }
+            None => entry_method,
+        };
+        let mut values = Vec::new();
+        for (name, v) in table.iter().filter(|(k, _)| k.as_str() != "method") {
+            let key = Spanned::new(value.span(), name.clone());
+            let (_, p) = self.param(method, &key, name)?;
+            let v = one_value(p, v)
+                .map_err(|m| self.error(line, format!("baseline {}: {m}", p.name)))?;
+            values.push((p.name, v));
+        }
+        Ok(BaselineSpec {
+            method,
+            values,
+            line,
+        })
+    }
+}
+
+/// One value of parameter `p`: a count ≥ `p.min`, or `"all"` where `p` accepts it.
+fn one_value(p: &SweepParam, v: &toml::Value) -> std::result::Result<ParamValue, String> {
+    let expected = || {
+        if p.accepts_all {
+            format!("expected whole numbers ≥ {} or \"all\"", p.min)
+        } else {
+            format!("expected whole numbers ≥ {}", p.min)
+        }
+    };
+    match v {
+        toml::Value::String(s) if p.accepts_all && s == "all" => Ok(ParamValue::All),
+        toml::Value::Integer(n) if *n >= p.min as i64 && *n < u32::MAX as i64 => {
+            Ok(ParamValue::Count(*n as u32))
+        }
+        other => Err(format!("{}, got {other}", expected())),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Experiment> {
+        Experiment::parse(text, Path::new("dir/exp.toml"))
+    }
+
+    #[test]
+    fn runs_are_the_cartesian_product_in_declared_order() {
+        let e = parse(
+            "scene = \"s.toml\"\n[reference]\nspp = 2\n[[approximations]]\nmethod = \"thesis\"\nn_exact = [1, 2, 3]\nsamples = [10, 100]\n[[approximations]]\nmethod = \"riemann\"\nsamples = 5\n",
+        )
+        .unwrap();
+        assert_eq!(e.scene, Path::new("dir/s.toml"));
+        assert_eq!(e.runs.len(), 7);
+        assert_eq!(e.runs[0].label(), "thesis samples=10 n_exact=1");
+        assert_eq!(e.runs[5].label(), "thesis samples=100 n_exact=3");
+        // spp defaults to the reference's.
+        assert_eq!(e.runs[6].label(), "riemann samples=5 spp=2");
+        assert_eq!(e.runs[6].values(), vec![("samples", 5), ("spp", 2)]);
+    }
+
+    #[test]
+    fn all_is_a_value_of_n_exact_only() {
+        let e = parse("scene = \"s.toml\"\n[[approximations]]\nmethod = \"thesis\"\nsamples = [4]\nn_exact = [2, \"all\"]\n").unwrap();
+        assert_eq!(e.runs[1].param("n_exact"), Some(ParamValue::All));
+        assert_eq!(e.runs[1].label(), "thesis samples=4 n_exact=all");
+        assert_eq!(e.runs[1].file_stem(), "thesis_samples_4_n_exact_all");
+        assert_eq!(e.runs[1].values()[1], ("n_exact", u32::MAX));
+        let e = parse(
+            "scene = \"s.toml\"\n[[approximations]]\nmethod = \"thesis\"\nn_exact = \"all\"\n",
+        )
+        .unwrap();
+        assert_eq!(e.runs[0].label(), "thesis samples=100 n_exact=all");
+        let err = parse(
+            "scene = \"s.toml\"\n[[approximations]]\nmethod = \"thesis\"\nsamples = \"all\"\n",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            err.starts_with("dir/exp.toml:4: samples: expected whole numbers ≥ 1, got \"all\""),
+            "{err}"
+        );
+        let err = parse(
+            "scene = \"s.toml\"\n[[approximations]]\nmethod = \"riemann\"\nsamples = [1, 0]\n",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            err.contains("exp.toml:4:") && err.contains("got 0"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn unknown_methods_and_parameters_name_the_line_and_the_valid_ones() {
+        let err =
+            parse("scene = \"s.toml\"\n[[approximations]]\nmethod = \"magic\"\nsamples = [1]\n")
+                .unwrap_err()
+                .to_string();
+        assert!(
+            err.starts_with("dir/exp.toml:3: unknown method \"magic\""),
+            "{err}"
+        );
+        assert!(err.contains("riemann, emission, opaque, thesis"), "{err}");
+        let err = parse("scene = \"s.toml\"\n[[approximations]]\nmethod = \"riemann\"\nsamples = [1]\nsample = [1]\n").unwrap_err().to_string();
+        assert!(err.starts_with("dir/exp.toml:5: method riemann has no parameter 'sample'; its parameters are samples, spp"), "{err}");
+        let err = parse("scene = \"s.toml\"\n[[approximations]]\nsamples = [1]\n")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.starts_with("dir/exp.toml:3:") && err.contains("needs `method"),
+            "{err}"
+        );
+        let err =
+            parse("scene = \"s.toml\"\nbogus = 1\n[[approximations]]\nmethod = \"riemann\"\n")
+                .unwrap_err()
+                .to_string();
+        assert!(
+            err.starts_with("dir/exp.toml:2:") && err.contains("bogus"),
+            "{err}"
+        );
+        let e = parse("scene = \"s.toml\"\n[[approximations]]\nmethod = \"emission\"\n").unwrap();
+        assert_eq!(e.runs[0].label(), "emission");
+    }
+
+    #[test]
+    fn baselines_name_runs_of_the_experiment() {
+        let e = parse("scene = \"s.toml\"\n[[approximations]]\nmethod = \"thesis\"\nsamples = [10, 100]\nn_exact = [1, \"all\"]\nbaseline = { n_exact = \"all\" }\n[[approximations]]\nmethod = \"riemann\"\nsamples = [10]\nbaseline = { method = \"thesis\", samples = 100 }\n").unwrap();
+        let b: Vec<Option<usize>> = e.runs.iter().map(|r| r.baseline).collect();
+        // thesis 10/1 → 10/all, 10/all → itself, 100/1 → 100/all; riemann → thesis 100/all.
+        assert_eq!(b, vec![Some(1), Some(1), Some(3), Some(3), Some(3)]);
+        let err = parse("scene = \"s.toml\"\n[[approximations]]\nmethod = \"thesis\"\nn_exact = [1]\nbaseline = { n_exact = 2 }\n").unwrap_err().to_string();
+        assert!(err.starts_with("dir/exp.toml:5: the baseline of `thesis samples=100 n_exact=1` is `thesis samples=100 n_exact=2`"), "{err}");
+        let err = parse(
+            "scene = \"s.toml\"\n[[approximations]]\nmethod = \"thesis\"\nbaseline = { n = 2 }\n",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            err.contains("exp.toml:4:") && err.contains("no parameter 'n'"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn an_experiment_without_runs_is_an_error() {
+        let err =
+            parse("scene = \"s.toml\"\n[[approximations]]\nmethod = \"riemann\"\nsamples = []\n")
+                .unwrap_err()
+                .to_string();
+        assert!(err.contains("no approximation runs"), "{err}");
+    }
+}

@@ -1,0 +1,64 @@
+//! Sweeps (DESIGN.md §5, §7 `pgt sweep`): the reference once, an approximation for each
+//! parameter combination an experiment lists, each compared with the reference (and with a
+//! baseline run where one is named). The results feed `report::sweep_page`: a table (the
+//! thesis's Tables 6.1/6.2: SSIM per channel and mean, in %) and SVG plots of error and time
+//! against the swept parameter (the thesis's Figures 6.2/6.3).
+//!
+//! The experiment file (TOML; unknown keys, methods and parameters are errors that name the
+//! file:line and list the valid ones):
+//!
+//! ```toml
+//! scene = "scene.toml"        # relative to the experiment file
+//! size = [256, 256]           # optional: overrides the scene's image size
+//! data_range = 1.0            # optional: SSIM/PSNR data range (default as in `pgt compare`)
+//!
+//! [reference]                 # optional: the one reference render
+//! spp = 1
+//! tol = 1e-5                  # overrides the scene's quadrature tolerance
+//!
+//! [[approximations]]
+//! method = "riemann"          # the reference with the thesis's midpoint Riemann sums (CPU)
+//! samples = [1, 2, 5, 10, 50, 100]
+//! spp = [1]                   # optional, default: the reference's spp
+//!
+//! [[approximations]]
+//! method = "thesis"           # a GPU approximation (DESIGN.md §4)
+//! samples = 100               # one value or a list
+//! n_exact = [1, 2, 3, 5, "all"]
+//! baseline = { n_exact = "all" }
+//! ```
+//!
+//! * `method` names any method of [`find_method`]: `riemann` (CPU), and every GPU method of the
+//!   approximation registry (`pgt approx --list-methods`); every other key is one of the method's parameters, with one value or a
+//!   list of values (whole numbers, or `"all"` where the parameter allows it: `n_exact`).
+//!   A parameter an entry does not list takes its default (the table in `riemann.rs`, and each
+//!   GPU method's parameter table in `src/approx/methods/`). Each entry runs the Cartesian product of its lists, parameters in the method's
+//!   declared order (the first varying slowest); a run's label is `method p1=v1 p2=v2 …` and
+//!   its image `method_p1_v1_p2_v2….png`.
+//! * `baseline = { [method = "NAME",] param = value, … }` compares each run of the entry also
+//!   with another run of the experiment (in the reference's place), as the thesis's "GT"
+//!   column does (its own scheme with N = all). The baseline run of a run is: the baseline's
+//!   method (default: the entry's), each parameter as the baseline table gives it, else the
+//!   run's own value of that parameter, else the method's default. It must be one of the
+//!   experiment's runs (an error at the `baseline` line otherwise). With the example above,
+//!   `thesis samples=100 n_exact=2` is compared with `thesis samples=100 n_exact=all`. The
+//!   comparison with the exact reference is always made too.
+//!
+//! The GPU methods run on the first adapter wgpu finds, one context for the whole sweep; their
+//! time is the GPU time, the CPU methods' the wall time.
+
+pub mod experiment;
+pub mod gpu;
+pub mod method;
+pub mod riemann;
+pub mod runner;
+
+pub use experiment::{Experiment, ReferenceSpec, Run};
+pub use method::{
+    find_method, method_names, ParamDefault, ParamValue, RunImage, SweepContext, SweepMethod,
+    SweepParam,
+};
+pub use runner::{
+    load_scene, reference_key, run_sweep, BaselineResult, Progress, ReferenceInfo, RunResult,
+    SweepOptions, SweepResults,
+};

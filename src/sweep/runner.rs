@@ -1,0 +1,259 @@
+//! Running an experiment: the reference once (cached by a hash of the loaded scene and the
+//! options in `DIR/cache`), each run with its method on one [`SweepContext`], each image
+//! compared with the reference and, where the run names one, with its baseline run. Writes the
+//! images (`reference.png`, one PNG per run); the page, plots and JSON are `report::sweep_page`'s.
+
+use super::experiment::{Experiment, Run};
+use super::method::{find_method, SweepContext, SweepMethod};
+use crate::error::{PgtError, Result};
+use crate::image_io::{read_exr_layer, write_image, RgbImage};
+use crate::metrics::{compare, maps, CompareOptions, Comparison};
+use crate::reference::{self, Integrator, RenderOptions};
+use crate::scene::{Scene, SceneLoadOptions};
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// How to run a sweep.
+#[derive(Debug, Clone, Default)]
+pub struct SweepOptions {
+    /// Folder for the images and the reference cache (`DIR/cache`).
+    pub dir: PathBuf,
+    /// Worker threads of the CPU renders; `None` uses rayon's default.
+    pub threads: Option<usize>,
+    /// A progress bar for the reference render (the CLI sets it when stderr is a terminal).
+    pub progress: bool,
+}
+
+/// The reference render of a sweep.
+#[derive(Debug, Clone)]
+pub struct ReferenceInfo {
+    /// The cached EXR (`DIR/cache/reference-KEY.exr`).
+    pub cache_file: PathBuf,
+    /// Render time in seconds; `None` when it came from the cache.
+    pub seconds: Option<f64>,
+}
+
+/// A run compared with its baseline run.
+#[derive(Debug, Clone)]
+pub struct BaselineResult {
+    /// The baseline run's label.
+    pub label: String,
+    /// The run's image against the baseline's (the baseline in the reference's place).
+    pub comparison: Comparison,
+}
+
+/// The result of one run.
+#[derive(Debug, Clone)]
+pub struct RunResult {
+    pub run: Run,
+    /// GPU time for GPU methods, wall time for CPU ones.
+    pub seconds: f64,
+    /// Against the exact reference.
+    pub comparison: Comparison,
+    pub baseline: Option<BaselineResult>,
+    /// The run's PNG, relative to the sweep's folder.
+    pub image_file: String,
+    /// |a − r| against the reference, mean over channels, per pixel (for the heatmaps).
+    pub abs_error: Vec<f32>,
+    pub warnings: Vec<String>,
+}
+
+/// Everything a sweep measured.
+#[derive(Debug, Clone)]
+pub struct SweepResults {
+    pub experiment: PathBuf,
+    pub scene: PathBuf,
+    pub reference: ReferenceInfo,
+    pub width: u32,
+    pub height: u32,
+    pub runs: Vec<RunResult>,
+}
+
+/// What [`run_sweep`] reports while it works (the CLI prints one line each).
+#[derive(Debug)]
+pub enum Progress<'a> {
+    Reference(&'a ReferenceInfo),
+    Run(&'a RunResult),
+}
+
+/// Loads the experiment's scene with its size and tolerance overrides.
+pub fn load_scene(exp: &Experiment) -> Result<Scene> {
+    let load = SceneLoadOptions {
+        size: exp.size.map(|[w, h]| (w, h)),
+        tol: exp.reference.tol,
+        ..SceneLoadOptions::default()
+    };
+    Scene::load(&exp.scene, &load)
+}
+
+/// FNV-1a, 64 bit: a stable hash for the cache key (not cryptographic; a collision would need a
+/// deliberately crafted scene).
+fn fnv1a(bytes: &[u8]) -> u64 {
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for &b in bytes {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    h
+}
+
+/// The cache key of a reference render: everything that determines its pixels (the loaded
+/// scene with its particles, which covers included particle files, the options, pgt's version).
+pub fn reference_key(scene: &Scene, options: &RenderOptions) -> String {
+    let text = format!(
+        "pgt {} reference v1\n{:?}\n{:?}\n{:?}\n{:?}\nspp {} integrator {:?}",
+        env!("CARGO_PKG_VERSION"),
+        scene.camera,
+        scene.render,
+        scene.lights,
+        scene.particles,
+        options.spp,
+        options.integrator
+    );
+    format!("{:016x}", fnv1a(text.as_bytes()))
+}
+
+/// The exact reference (adaptive quadrature, DESIGN.md §3), from the cache or rendered and
+/// cached.
+fn cached_reference(
+    exp: &Experiment,
+    scene: &Scene,
+    options: &SweepOptions,
+) -> Result<(RgbImage, ReferenceInfo)> {
+    let cache = options.dir.join("cache");
+    std::fs::create_dir_all(&cache).map_err(|e| PgtError::io(&cache, e))?;
+    let ref_options = RenderOptions {
+        spp: exp.reference.spp.unwrap_or(1),
+        threads: options.threads,
+        progress: options.progress,
+        integrator: Integrator::Adaptive,
+    };
+    let cache_file = cache.join(format!(
+        "reference-{}.exr",
+        reference_key(scene, &ref_options)
+    ));
+    if cache_file.is_file() {
+        let image = read_exr_layer(&cache_file, "")?;
+        return Ok((
+            image,
+            ReferenceInfo {
+                cache_file,
+                seconds: None,
+            },
+        ));
+    }
+    let t = Instant::now();
+    let out = reference::render(scene, &ref_options)?;
+    let seconds = Some(t.elapsed().as_secs_f64());
+    write_image(&cache_file, &out.image, &[], 0.0)?;
+    Ok((
+        out.image,
+        ReferenceInfo {
+            cache_file,
+            seconds,
+        },
+    ))
+}
+
+/// The method of a run of a validated experiment.
+fn method_of(run: &Run) -> Result<&'static dyn SweepMethod> {
+    find_method(run.method)
+        .ok_or_else(|| PgtError::Usage(format!("unknown approximation method '{}'", run.method)))
+}
+
+/// Runs the experiment on `scene` (see [`load_scene`]): checks every method against the scene
+/// first, then the reference, then each run in order; calls `progress` after each step.
+pub fn run_sweep(
+    exp: &Experiment,
+    scene: &Scene,
+    options: &SweepOptions,
+    mut progress: impl FnMut(Progress),
+) -> Result<SweepResults> {
+    for run in &exp.runs {
+        method_of(run)?
+            .check_scene(scene)
+            .map_err(|e| e.context(run.label()))?;
+    }
+    let (reference_image, reference) = cached_reference(exp, scene, options)?;
+    progress(Progress::Reference(&reference));
+    let compare_options = CompareOptions {
+        data_range: exp.data_range,
+        ..CompareOptions::default()
+    };
+    write_image(
+        &options.dir.join("reference.png"),
+        &reference_image,
+        &[],
+        0.0,
+    )?;
+    // Images of runs that are a baseline or have one, kept until every run is done.
+    let mut kept: Vec<Option<RgbImage>> = vec![None; exp.runs.len()];
+    let mut runs = Vec::with_capacity(exp.runs.len());
+    let mut ctx = SweepContext::new(options.threads);
+    for (i, run) in exp.runs.iter().enumerate() {
+        let (result, image) = one_run(
+            run,
+            scene,
+            &mut ctx,
+            &reference_image,
+            &compare_options,
+            &options.dir,
+        )
+        .map_err(|e| e.context(run.label()))?;
+        progress(Progress::Run(&result));
+        if run.baseline.is_some() || exp.runs.iter().any(|r| r.baseline == Some(i)) {
+            kept[i] = Some(image);
+        }
+        runs.push(result);
+    }
+    for (i, result) in runs.iter_mut().enumerate() {
+        let Some(j) = result.run.baseline else {
+            continue;
+        };
+        let (Some(image), Some(base)) = (&kept[i], &kept[j]) else {
+            continue;
+        };
+        let comparison =
+            compare(base, image, &compare_options).map_err(|e| e.context(result.run.label()))?;
+        result.baseline = Some(BaselineResult {
+            label: exp.runs[j].label(),
+            comparison,
+        });
+    }
+    Ok(SweepResults {
+        experiment: exp.path.clone(),
+        scene: exp.scene.clone(),
+        reference,
+        width: reference_image.width,
+        height: reference_image.height,
+        runs,
+    })
+}
+
+/// Renders one run, writes its PNG, compares it with the reference.
+fn one_run(
+    run: &Run,
+    scene: &Scene,
+    ctx: &mut SweepContext,
+    reference_image: &RgbImage,
+    compare_options: &CompareOptions,
+    dir: &Path,
+) -> Result<(RunResult, RgbImage)> {
+    let t = Instant::now();
+    let out = method_of(run)?.render(ctx, scene, &run.values())?;
+    let seconds = out.gpu_seconds.unwrap_or_else(|| t.elapsed().as_secs_f64());
+    let comparison = compare(reference_image, &out.image, compare_options)?;
+    let image_file = format!("{}.png", run.file_stem());
+    write_image(&dir.join(&image_file), &out.image, &[], 0.0)?;
+    let abs_error = maps::channel_mean(&maps::abs_error(reference_image, &out.image));
+    let result = RunResult {
+        run: run.clone(),
+        seconds,
+        comparison,
+        baseline: None,
+        image_file,
+        abs_error,
+        warnings: out.warnings,
+    };
+    Ok((result, out.image))
+}
