@@ -358,6 +358,8 @@ mod tests {
         assert_relative_eq!(both, wall, max_relative = 1e-14);
         // The sphere at (0, 6, 0), seen from outside, gets nothing from the light inside the
         // big sphere (its lit side faces the light, but the big sphere is in the way).
+        s.lights.pop();
+        let r = OpaqueRenderer::new(&s);
         let outside = r
             .radiance(&Ray::new(DVec3::new(0.0, 6.0, -10.0), DVec3::Z))
             .radiance;

@@ -176,7 +176,7 @@ mod tests {
             for (l, light) in lights.iter().enumerate() {
                 occ.gather(&bvh, &particles, &ray, (trial, l), light, (ta, tb));
                 for j in 0..=20 {
-                    let t = ta + (tb - ta) * j as f64 / 20.0;
+                    let t = (ta + (tb - ta) * j as f64 / 20.0).min(tb);
                     assert!(occ.covers(trial, l, t));
                     let x = ray.at(t);
                     let Some(inc) = light.incident_at(x) else {
