@@ -109,3 +109,38 @@ fn one_sphere(model: OpticalModel, sigma: f64) -> pgt::scene::Scene {
     s.render.tol = 1e-8;
     s
 }
+
+/// DESIGN.md §3: a pixel that does not converge is reported, not hidden. The centre pixel's ray
+/// runs exactly through a point light inside gas (∫ dt/t² diverges there): the render counts it
+/// and names it as the worst, and the CLI's warning says so.
+#[test]
+fn a_ray_through_a_point_light_inside_gas_is_reported() {
+    let lights = vec![Light::Point {
+        position: DVec3::ZERO,
+        intensity: DVec3::splat(0.1),
+        falloff: pgt::optics::Falloff::InverseSquare,
+    }];
+    let mut s = scene(
+        models::LIT,
+        vec![particle(DVec3::ZERO, 1.0, DVec3::ONE, 0.7)],
+        lights,
+        3,
+    );
+    s.render.tol = 1e-4;
+    let out = pgt::reference::render(&s, &pgt::reference::RenderOptions::default()).unwrap();
+    let st = &out.stats;
+    assert!(st.unconverged >= 1, "{st:?}");
+    let (x, y, e) = st.worst_unconverged.unwrap();
+    assert_eq!((x, y), (1, 1));
+    assert!(e > s.render.tol);
+    let warning = pgt::cli::render::unconverged_warning(st, s.render.tol).unwrap();
+    assert!(warning.contains("(1, 1)") && warning.contains("did not reach tol"));
+    // Everything else converged, and a converged render has no warning.
+    s.lights = vec![Light::Directional {
+        direction: DVec3::NEG_Y,
+        irradiance: DVec3::ONE,
+    }];
+    let out = pgt::reference::render(&s, &pgt::reference::RenderOptions::default()).unwrap();
+    assert_eq!(out.stats.unconverged, 0);
+    assert!(pgt::cli::render::unconverged_warning(&out.stats, s.render.tol).is_none());
+}
