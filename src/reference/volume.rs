@@ -73,7 +73,6 @@ use crate::geometry::{Bvh, Hit, Ray};
 use crate::optics::emission::{composite, composite_by, opacity};
 use crate::optics::intervals::{Interval, IntervalCutter, IntervalScratch};
 use crate::optics::kinks::shadow_tangencies;
-use crate::optics::light::Light;
 use crate::optics::model::{LightNeed, Model};
 use crate::optics::source::{surface_limit_weight, LightSample, SourceParams};
 use crate::scene::Scene;
@@ -96,8 +95,6 @@ pub struct VolumeRenderer<'a> {
     model: &'static dyn Model,
     /// Its parameters (w, a), resolved once.
     params: SourceParams,
-    /// The largest particle colour per channel: every emission colour E ≤ it.
-    max_color: DVec3,
 }
 
 /// Per-camera-ray buffers for shadow rays (reused, so shadow rays do not allocate).
@@ -127,96 +124,7 @@ impl<'a> VolumeRenderer<'a> {
                 scene.lights.len(),
                 scene.render.emission_weight,
             ),
-            max_color: scene
-                .particles
-                .iter()
-                .fold(DVec3::ZERO, |m, p| m.max(p.color)),
         }
-    }
-
-    /// A bound Q_l,max on light `l`'s part of Q over the piece [lo, hi] of interval `iv`, per
-    /// channel, or `None` where there is none (a point light on the piece). Along the shadow
-    /// ray, L_l is a convex combination of emission colours (≤ the largest particle colour)
-    /// and the arriving irradiance (E, or I/d² at the point of the piece nearest the light), so
-    /// 0 ≤ L_l ≤ max(C_max, E_max) and 0 ≤ T_l ≤ 1; the model's part of Q is non-negative and
-    /// non-decreasing in those (w·L_l; α·E_l·T_l/4π), so its value there bounds it.
-    fn light_bound(
-        &self,
-        ray: &Ray,
-        iv: &Interval,
-        (lo, hi): (f64, f64),
-        l: usize,
-    ) -> Option<DVec3> {
-        let (a, b) = (ray.at(t_at(iv, 1.0, lo)), ray.at(t_at(iv, 1.0, hi)));
-        let light = &self.scene.lights[l];
-        let nearest = match *light {
-            Light::Directional { .. } => a,
-            Light::Point { position, .. } => {
-                let ab = b - a;
-                let s = ((position - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
-                if s.is_finite() {
-                    a + s * ab
-                } else {
-                    a
-                }
-            }
-        };
-        let inc = light.incident_at(nearest)?;
-        // Rounding of the nearest point: a margin of 1e-9 relative on the irradiance.
-        let irradiance = inc.irradiance * (1.0 + 1e-9);
-        if !irradiance.is_finite() {
-            return None;
-        }
-        let bound = LightSample {
-            radiance: irradiance.max(self.max_color),
-            irradiance,
-            transmittance: 1.0,
-        };
-        let q = self.model.light_source(&self.params, iv, &bound);
-        q.is_finite().then_some(q)
-    }
-
-    /// Takes out of `split` the pieces whose whole possible contribution is negligible: a piece
-    /// of weight W and u-range Δu contributes W·∫Q_l du ∈ [0, B], B = W·Δu·Q_l,max
-    /// ([`Self::light_bound`]), so B/2 is within B/2 of it with no shadow ray at all. The
-    /// smallest pieces are taken while their summed B/2 stays within `budget` per channel.
-    /// Returns their summed value and error.
-    fn skip_negligible(
-        &self,
-        ray: &Ray,
-        intervals: &[Interval],
-        split: &mut Vec<Piece>,
-        l: usize,
-        budget: f64,
-    ) -> (DVec3, DVec3) {
-        let mut bounds: Vec<(f64, usize, DVec3)> = Vec::new();
-        for (i, p) in split.iter().enumerate() {
-            let iv = &intervals[p.tag];
-            if let Some(q) = self.light_bound(ray, iv, (p.lo, p.hi), l) {
-                let b = (p.weight * (p.hi - p.lo)) * q;
-                if b.max_element() <= budget {
-                    bounds.push((b.max_element(), i, b));
-                }
-            }
-        }
-        // Smallest first; ties by position, so the choice is deterministic.
-        bounds.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-        let mut spent = DVec3::ZERO;
-        let mut skip = vec![false; split.len()];
-        for &(_, i, b) in &bounds {
-            let half = 0.5 * b;
-            if (spent + half).max_element() > budget {
-                break;
-            }
-            spent += half;
-            skip[i] = true;
-        }
-        let mut i = 0;
-        split.retain(|_| {
-            i += 1;
-            !skip[i - 1]
-        });
-        (spent, spent)
     }
 
     /// The shadow ray from `x` towards light `l`: L_l(x) (emission model with the light's
@@ -396,14 +304,10 @@ impl<'a> VolumeRenderer<'a> {
                 (u > lo && u < hi).then_some(u)
             };
             let tol = render.tol / m as f64;
-            let (skipped, skipped_error) =
-                self.skip_negligible(ray, intervals, &mut split, l, SKIP_FRACTION * tol);
-            value += skipped;
-            error += skipped_error;
             let r = integrate_adaptive_with(
                 QUADRATURE_RULE,
                 &split,
-                tol - skipped_error.max_element(),
+                tol,
                 MAX_SEGMENTS,
                 |k, u| self.light_source(ray, t_of(k, u), (k, &intervals[k]), l, sh),
                 kink_in,
@@ -504,10 +408,6 @@ impl<'a> VolumeRenderer<'a> {
         self.model.opaque_limit(&self.params, iv, &lights)
     }
 }
-
-/// The part of each light's share of `tol` that pieces too light to matter may use up
-/// (`VolumeRenderer::skip_negligible`); the quadrature gets the rest.
-const SKIP_FRACTION: f64 = 0.25;
 
 /// Optical depth from which an interval whose skin depth the ray parameter cannot resolve is
 /// replaced by its σ → ∞ limit: its transmittance e^{−τ} < 1e-30 is far below any tolerance.
