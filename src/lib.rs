@@ -13,9 +13,11 @@ pub mod geometry;
 pub mod image_io;
 pub mod metrics;
 pub mod optics;
+pub mod parts;
 pub mod reference;
 pub mod report;
 pub mod scene;
+pub mod signals;
 pub mod sweep;
 
 pub use error::{PgtError, Result};

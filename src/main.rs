@@ -14,6 +14,12 @@ fn main() -> ExitCode {
             return ExitCode::from(code);
         }
     };
+    // SIGINT/SIGTERM: remove temporary files, exit 130/143 (pgt::signals).
+    if let Err(e) = pgt::signals::install() {
+        eprintln!(
+            "warning: cannot handle SIGINT/SIGTERM ({e}); an interrupt may leave temporary files"
+        );
+    }
     match cli::run(cli) {
         Ok(Outcome::Success) => ExitCode::SUCCESS,
         Ok(Outcome::GateFailed) => ExitCode::from(1),

@@ -134,7 +134,12 @@ pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
                 rel_scale: args.rel_scale,
             },
         };
-        let page = report::write_report(dir, &inputs)?;
+        // Written into a temporary folder and moved into place at the end (issue 13): an
+        // interrupted or failed run leaves no half-written report.
+        let page = crate::image_io::write_folder_atomically(dir, |tmp| {
+            report::write_report(tmp, &inputs)
+        })?;
+        let page = dir.join(page.file_name().unwrap_or_default());
         eprintln!("report: {}", page.display());
     }
     let verdict = summary.verdict();

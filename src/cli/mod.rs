@@ -3,9 +3,12 @@
 
 pub mod approx;
 pub mod bench;
+pub mod camera;
 pub mod compare;
+pub mod export;
 pub mod gen;
 pub mod info;
+pub mod merge;
 pub mod render;
 pub mod sweep;
 
@@ -47,6 +50,12 @@ pub enum Command {
     Gen(gen::GenArgs),
     /// The speed of the reference on standard workloads, as one table of ratios.
     Bench(bench::BenchArgs),
+    /// Join the parts of a cluster render (`pgt render --tile I/N`) into the whole image.
+    Merge(merge::MergeArgs),
+    /// The camera as view and projection matrices per graphics API (OpenGL, Vulkan, WebGPU, Direct3D).
+    Camera(camera::CameraArgs),
+    /// Write the resolved particles (centre, radius, colour, σ, Θmax) as CSV or PLY.
+    Export(export::ExportArgs),
 }
 
 /// Runs the parsed command line.
@@ -59,6 +68,9 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Info(args) => info::run(args),
         Command::Gen(args) => gen::run(args),
         Command::Bench(args) => bench::run(args),
+        Command::Merge(args) => merge::run(args),
+        Command::Camera(args) => camera::run(args),
+        Command::Export(args) => export::run(args),
     }
 }
 

@@ -46,6 +46,10 @@ pub struct RenderArgs {
     /// Samples per interval for `--integrator riemann`.
     #[arg(long, default_value_t = 100)]
     pub samples: u32,
+    /// Render only part I of N (I from 0, as job arrays count) into an EXR part file, to be
+    /// joined by `pgt merge` (see `pgt::parts`).
+    #[arg(long, value_parser = crate::parts::parse_tile, value_name = "I/N")]
+    pub tile: Option<crate::parts::Tile>,
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
@@ -73,6 +77,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
         progress: super::stderr_is_terminal(),
         integrator,
     };
+    if let Some(tile) = args.tile {
+        return render_part(&args, &scene, &render_options, tile);
+    }
     let out = reference::render(&scene, &render_options)?;
     let layers: Vec<(&str, &crate::image_io::RgbImage)> =
         out.error.iter().map(|e| ("err", e)).collect();
@@ -109,4 +116,33 @@ pub fn unconverged_warning(stats: &reference::RenderStats, tol: f64) -> Option<S
         "{} pixel(s) did not reach tol {tol:e}; the worst is ({x}, {y}) with error estimate {e:.3e} (its err value says how far off it may be)",
         stats.unconverged
     ))
+}
+
+/// `--tile I/N`: renders and writes one part (`pgt::parts`), with a one-line summary.
+fn render_part(
+    args: &RenderArgs,
+    scene: &crate::scene::Scene,
+    options: &RenderOptions,
+    tile: crate::parts::Tile,
+) -> anyhow::Result<Outcome> {
+    if crate::image_io::ImageFormat::from_path(&args.output)? != crate::image_io::ImageFormat::Exr {
+        anyhow::bail!(
+            "{}: a part (--tile) is written as an EXR; name it .exr and merge the parts with `pgt merge` into any format",
+            args.output.display()
+        );
+    }
+    let (part, s) = crate::parts::render_part(scene, options, tile)?;
+    crate::parts::write_part(&args.output, &part)?;
+    eprintln!(
+        "rendered part {tile} ({} of {} rows of {}x{}) into {} in {:.2} s: {} primary + {} shadow rays",
+        part.image.height,
+        scene.camera.height,
+        scene.camera.width,
+        scene.camera.height,
+        args.output.display(),
+        s.seconds,
+        s.primary_rays,
+        s.shadow_rays
+    );
+    Ok(Outcome::Success)
 }

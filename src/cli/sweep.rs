@@ -3,6 +3,7 @@
 //! [`crate::report::sweep_page`].
 
 use super::Outcome;
+use crate::image_io::write_folder_atomically;
 use crate::report::sweep_page::write_sweep_report;
 use crate::sweep::{load_scene, run_sweep, Experiment, Progress, SweepOptions};
 use clap::Args;
@@ -28,12 +29,27 @@ pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
-    let options = SweepOptions {
-        dir: args.report.clone(),
-        threads: args.threads,
-        progress: super::stderr_is_terminal(),
-    };
-    let results = run_sweep(&experiment, &scene, &options, |p| match p {
+    // The report is written into a temporary folder that takes the report's place at the end
+    // (an interrupted sweep leaves no half-written report); the reference cache lives in the
+    // report folder itself, so that it survives from one sweep to the next.
+    let (runs, page) = write_folder_atomically(&args.report, |tmp| {
+        let options = SweepOptions {
+            dir: tmp.to_path_buf(),
+            cache: args.report.join("cache"),
+            threads: args.threads,
+            progress: super::stderr_is_terminal(),
+        };
+        let results = run_sweep(&experiment, &scene, &options, print_progress)?;
+        write_sweep_report(tmp, &results)?;
+        Ok((results.runs.len(), args.report.join("index.html")))
+    })?;
+    println!("sweep: {runs} runs, report {}", page.display());
+    Ok(Outcome::Success)
+}
+
+/// One line per finished render on stderr.
+fn print_progress(p: Progress) {
+    match p {
         Progress::Reference(r) => eprintln!(
             "reference: {} ({})",
             r.cache_file.display(),
@@ -58,12 +74,5 @@ pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
                 eprintln!("warning: {}: {w}", r.run.label());
             }
         }
-    })?;
-    let page = write_sweep_report(&args.report, &results)?;
-    println!(
-        "sweep: {} runs, report {}",
-        results.runs.len(),
-        page.display()
-    );
-    Ok(Outcome::Success)
+    }
 }

@@ -2,6 +2,7 @@
 
 pub mod bvh;
 pub mod camera;
+pub mod projection;
 pub mod ray;
 pub mod sphere;
 

@@ -2,11 +2,15 @@
 //! layers such as the reference's `err.R/G/B`) and PNG (8-bit sRGB of the linear image).
 //! Every write is atomic: a temporary file in the target folder, renamed at the end.
 
+mod folder;
 mod read;
 mod write;
 
+pub use folder::write_folder_atomically;
 pub use read::{read_exr_layer, read_image, read_image_layer, ReadImage};
-pub use write::{linear_to_srgb8, write_atomically, write_image, ImageFormat};
+pub use write::{
+    linear_to_srgb8, write_atomically, write_exr_with_header, write_image, ImageFormat,
+};
 
 /// A linear RGB image, row-major, row 0 at the top.
 #[derive(Debug, Clone, PartialEq)]

@@ -43,7 +43,9 @@ pub fn linear_to_srgb8(v: f32, exposure_scale: f32) -> u8 {
 }
 
 /// Writes `image` (and, for EXR, the extra layers, each written as `NAME.R/G/B`) to `path`,
-/// atomically. PNG ignores the extra layers and applies `exposure` in stops.
+/// atomically. PNG ignores the extra layers and applies `exposure` in stops. A NaN or infinite
+/// value in any layer is refused before anything is written (issue 13: nothing non-finite is
+/// ever written; it would be a bug, and must not pass a user's CI silently).
 pub fn write_image(
     path: &Path,
     image: &RgbImage,
@@ -51,10 +53,62 @@ pub fn write_image(
     exposure: f32,
 ) -> Result<()> {
     let format = ImageFormat::from_path(path)?;
+    check_finite(path, image, layers)?;
     write_atomically(path, |w| match format {
         ImageFormat::Png => write_png(w, image, exposure),
-        ImageFormat::Exr => write_exr(w, image, layers),
+        ImageFormat::Exr => write_exr(w, image, layers, &[]),
     })
+}
+
+/// Writes an EXR like [`write_image`] and adds `header` as custom text attributes of its header
+/// (name, value): the metadata of a part of a cluster render (`crate::parts`).
+pub fn write_exr_with_header(
+    path: &Path,
+    image: &RgbImage,
+    layers: &[(&str, &RgbImage)],
+    header: &[(&str, String)],
+) -> Result<()> {
+    if ImageFormat::from_path(path)? != ImageFormat::Exr {
+        return Err(PgtError::Usage(format!(
+            "{}: this output must be an .exr file",
+            path.display()
+        )));
+    }
+    check_finite(path, image, layers)?;
+    write_atomically(path, |w| write_exr(w, image, layers, header))
+}
+
+/// The first NaN or infinite value of the image or its layers, as an error naming the output,
+/// the pixel (x, y from the top left), the layer and the channel.
+fn check_finite(path: &Path, image: &RgbImage, layers: &[(&str, &RgbImage)]) -> Result<()> {
+    for (layer, img) in std::iter::once(("", image)).chain(layers.iter().copied()) {
+        let Some(i) = img
+            .pixels
+            .iter()
+            .position(|p| p.iter().any(|v| !v.is_finite()))
+        else {
+            continue;
+        };
+        let c = img.pixels[i]
+            .iter()
+            .position(|v| !v.is_finite())
+            .unwrap_or(0);
+        let (x, y) = (i % img.width.max(1) as usize, i / img.width.max(1) as usize);
+        let channel = ["R", "G", "B"][c];
+        let what = if layer.is_empty() {
+            format!("channel {channel} of the image")
+        } else {
+            format!("channel {layer}.{channel} of layer '{layer}'")
+        };
+        return Err(PgtError::in_file(
+            path,
+            format!(
+                "refusing to write a non-finite value ({}) at pixel ({x}, {y}), {what}; nothing was written (this is a bug in pgt: please report it with the command line)",
+                img.pixels[i][c]
+            ),
+        ));
+    }
+    Ok(())
 }
 
 /// Writes a file atomically (DESIGN.md §7: never a half-written output): `write` fills a
@@ -69,10 +123,17 @@ pub fn write_atomically(
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    let tmp = tempfile::Builder::new()
-        .prefix(".pgt-partial-")
-        .tempfile_in(dir)
-        .map_err(|e| PgtError::io(dir, e))?;
+    // Registered for removal on SIGINT/SIGTERM (crate::signals) from its creation on, and
+    // renamed with the signal cleanup held off, so an interrupt leaves neither it nor half a file.
+    let (tmp, guard) = crate::signals::track(
+        || {
+            tempfile::Builder::new()
+                .prefix(".pgt-partial-")
+                .tempfile_in(dir)
+        },
+        |t| t.path().to_path_buf(),
+    )
+    .map_err(|e| PgtError::io(dir, e))?;
     {
         let mut w = BufWriter::new(tmp.as_file());
         write(&mut w).map_err(|e| PgtError::io(path, e))?;
@@ -81,7 +142,9 @@ pub fn write_atomically(
     tmp.as_file()
         .sync_all()
         .map_err(|e| PgtError::io(path, e))?;
-    tmp.persist(path).map_err(|e| PgtError::io(path, e.error))?;
+    guard
+        .finish(|| tmp.persist(path))
+        .map_err(|e| PgtError::io(path, e.error))?;
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
@@ -120,6 +183,7 @@ fn write_exr(
     w: &mut BufWriter<&std::fs::File>,
     image: &RgbImage,
     layers: &[(&str, &RgbImage)],
+    header: &[(&str, String)],
 ) -> std::io::Result<()> {
     use exr::prelude::*;
     let size = (image.width as usize, image.height as usize);
@@ -136,14 +200,82 @@ fn write_exr(
         }
     }
     let channels = AnyChannels::sort(channels.into_iter().collect());
-    let layer = Layer::new(
-        size,
-        LayerAttributes::default(),
-        Encoding::FAST_LOSSLESS,
-        channels,
-    );
+    let mut attributes = LayerAttributes::default();
+    let text = |s: &str| {
+        Text::new_or_none(s)
+            .ok_or_else(|| std::io::Error::other(format!("EXR header text '{s}' is not Latin-1")))
+    };
+    for (name, value) in header {
+        attributes
+            .other
+            .insert(text(name)?, AttributeValue::Text(text(value)?));
+    }
+    let layer = Layer::new(size, attributes, Encoding::FAST_LOSSLESS, channels);
     Image::from_layer(layer)
         .write()
         .to_buffered(w)
         .map_err(std::io::Error::other)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn image_with(value: f32, at: usize, channel: usize) -> RgbImage {
+        let mut img = RgbImage::new(5, 4);
+        img.pixels[at][channel] = value;
+        img
+    }
+
+    /// Writes and expects a refusal mentioning every needle, with nothing left in the folder.
+    fn refused(name: &str, image: &RgbImage, layers: &[(&str, &RgbImage)], needles: &[&str]) {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join(name);
+        let e = write_image(&path, image, layers, 0.0)
+            .unwrap_err()
+            .to_string();
+        for n in needles {
+            assert!(e.contains(n), "'{n}' not in: {e}");
+        }
+        assert!(
+            std::fs::read_dir(dir.path()).unwrap().next().is_none(),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn non_finite_values_are_refused_in_every_layer_and_format() {
+        let fine = RgbImage::new(5, 4);
+        let nan = image_with(f32::NAN, 5 + 2, 1);
+        let inf = image_with(f32::NEG_INFINITY, 19, 2);
+        let main = ["out.exr", "pixel (2, 1)", "channel G of the image", "NaN"];
+        refused("out.exr", &nan, &[], &main);
+        refused(
+            "out.exr",
+            &fine,
+            &[("err", &inf)],
+            &["pixel (4, 3)", "err.B", "layer 'err'", "-inf"],
+        );
+        refused("out.png", &nan, &[], &["out.png", "pixel (2, 1)"]);
+        refused(
+            "out.png",
+            &inf,
+            &[("err", &fine)],
+            &["pixel (4, 3)", "channel B"],
+        );
+        // Every layer given is checked, even for a PNG that does not store them: a non-finite
+        // value anywhere is a bug.
+        let dir = tempfile::tempdir().unwrap();
+        write_image(&dir.path().join("ok.png"), &fine, &[("err", &inf)], 0.0)
+            .expect_err("every layer given is checked");
+        let with_header = write_exr_with_header(
+            &dir.path().join("part.exr"),
+            &fine,
+            &[("err", &nan)],
+            &[("pgtFormat", "x".into())],
+        );
+        assert!(with_header.unwrap_err().to_string().contains("layer 'err'"));
+        assert!(std::fs::read_dir(dir.path()).unwrap().next().is_none());
+        write_image(&dir.path().join("ok.exr"), &fine, &[("err", &fine)], 0.0).unwrap();
+    }
 }

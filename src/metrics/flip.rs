@@ -1,17 +1,20 @@
-//! FLIP, NVIDIA's perceptual difference metric (Andersson et al. 2020; HDR-FLIP 2021), through
-//! the `nv-flip` bindings to NVIDIA's C++ LDR-FLIP, with the HDR variant built on top of it here.
+//! FLIP, NVIDIA's perceptual difference metric (Andersson et al. 2020; HDR-FLIP 2021).
 //!
-//! LDR-FLIP compares two sRGB images in [0, 1]. pgt's images are linear, so each is encoded to
-//! 8-bit sRGB first (the same encoding as pgt's PNG output). Images with values above 1 are HDR:
-//! [`flip_ldr`] refuses them rather than clamp silently, and [`flip_hdr`] runs HDR-FLIP
-//! (Andersson et al. 2021): the reference's luminance picks an exposure range, both images are
-//! exposed, tone mapped (ACES) and compared with LDR-FLIP at each exposure, and the per-pixel
-//! maximum is the HDR-FLIP map. It follows NVIDIA's C++ (`FLIP.h`, `image.h::computeExposures`)
-//! step for step, with one difference: nv-flip only accepts 8-bit input, so each tone-mapped
-//! exposure is quantised to 8-bit sRGB (NVIDIA's tool keeps floats).
+//! [`flip_ldr`] and [`flip_hdr`] run pgt's own f32 implementation ([`super::flip_float`]) on the
+//! linear images: LDR-FLIP clamps them to [0, 1]; HDR-FLIP (Andersson et al. 2021) picks an
+//! exposure range from the reference's luminance, exposes and tone-maps (ACES) both images at
+//! each exposure, compares them with LDR-FLIP and keeps the per-pixel maximum. It follows
+//! NVIDIA's C++ (`FLIP.h`, `image.h::computeExposures`) step for step, in float throughout, as
+//! NVIDIA's tool does.
+//!
+//! The `nv-flip` bindings to NVIDIA's C++ LDR-FLIP are kept as the oracle ([`flip_srgb8`],
+//! [`flip_ldr_8bit`], [`flip_hdr_8bit`]): they only accept 8-bit sRGB, so each image (each
+//! tone-mapped exposure) was quantised to 8 bits, which pgt no longer does; and they are
+//! single-threaded (tests/compare_speed.rs times both).
 //!
 //! Checked against `flip-evaluator` (pip, `evaluate(ref, test, "LDR")` and `"HDR"`) on committed
-//! vectors in tests/compare_flip.rs.
+//! vectors in tests/compare_flip.rs, and against nv-flip on identical 8-bit input in
+//! `flip_float`'s tests.
 
 use crate::image_io::{linear_to_srgb8, RgbImage};
 
@@ -46,26 +49,69 @@ pub enum FlipError {
     BadExposureRange(f32, f32),
 }
 
-/// LDR-FLIP of two linear images whose values lie in [0, 1] (negative values are clamped to 0 by
-/// the sRGB encoding).
+/// LDR-FLIP of two linear images whose values lie in [0, 1] (negative values count as 0),
+/// evaluated in float ([`super::flip_float`]).
 pub fn flip_ldr(
     reference: &RgbImage,
     approximation: &RgbImage,
     pixels_per_degree: f32,
 ) -> Result<Flip, FlipError> {
+    check_sizes(reference, approximation)?;
+    let largest = largest_value(reference, approximation);
+    if largest > 1.0 {
+        return Err(FlipError::Hdr(largest));
+    }
+    let map = super::flip_float::flip_max_map(
+        &reference.pixels,
+        &approximation.pixels,
+        reference.width,
+        reference.height,
+        pixels_per_degree,
+        &[|p: [f32; 3]| p.map(|v| v.clamp(0.0, 1.0))],
+    );
+    Ok(Flip {
+        mean: mean_of(&map),
+        map,
+        pixels_per_degree,
+        exposures: None,
+    })
+}
+
+/// The size checks shared by every FLIP entry point.
+fn check_sizes(reference: &RgbImage, approximation: &RgbImage) -> Result<(), FlipError> {
     if reference.width != approximation.width || reference.height != approximation.height {
         return Err(FlipError::SizeMismatch);
     }
-    // nv-flip computes width·height·3 in u32.
+    // nv-flip computes width·height·3 in u32; pgt keeps the same limit for every path.
     if (reference.width as u64) * (reference.height as u64) * 3 > u32::MAX as u64 {
         return Err(FlipError::TooLarge);
     }
-    let largest = reference
+    Ok(())
+}
+
+fn largest_value(reference: &RgbImage, approximation: &RgbImage) -> f32 {
+    reference
         .pixels
         .iter()
         .chain(&approximation.pixels)
         .flatten()
-        .fold(0.0f32, |m, &v| m.max(v));
+        .fold(0.0f32, |m, &v| m.max(v))
+}
+
+/// Mean of a FLIP map (the number FLIP reports), summed in f64.
+fn mean_of(map: &[f32]) -> f64 {
+    map.iter().map(|&v| v as f64).sum::<f64>() / map.len().max(1) as f64
+}
+
+/// LDR-FLIP through nv-flip: each linear image encoded to 8-bit sRGB first (the oracle and the
+/// former implementation; negative values are clamped to 0 by the encoding).
+pub fn flip_ldr_8bit(
+    reference: &RgbImage,
+    approximation: &RgbImage,
+    pixels_per_degree: f32,
+) -> Result<Flip, FlipError> {
+    check_sizes(reference, approximation)?;
+    let largest = largest_value(reference, approximation);
     if largest > 1.0 {
         return Err(FlipError::Hdr(largest));
     }
@@ -83,9 +129,8 @@ pub fn flip_ldr(
         &encode(approximation),
         pixels_per_degree,
     );
-    let mean = map.iter().map(|&v| v as f64).sum::<f64>() / map.len().max(1) as f64;
     Ok(Flip {
-        mean,
+        mean: mean_of(&map),
         map,
         pixels_per_degree,
         exposures: None,
@@ -196,22 +241,11 @@ pub fn exposure_range(reference: &RgbImage) -> Result<(f32, f32), FlipError> {
     Ok(((x_max / y_max).log2(), (x_max / y_median).log2()))
 }
 
-/// HDR-FLIP of two linear images (negative values count as 0). `exposures`: the (start, stop)
-/// range in stops; `None` picks it from the reference as NVIDIA's FLIP does. The exposures are
-/// evaluated in parallel.
-pub fn flip_hdr(
+/// HDR-FLIP's exposures: (start, stop, count, step) from the given or the automatic range.
+fn exposures_of(
     reference: &RgbImage,
-    approximation: &RgbImage,
-    pixels_per_degree: f32,
     exposures: Option<(f32, f32)>,
-) -> Result<Flip, FlipError> {
-    use rayon::prelude::*;
-    if reference.width != approximation.width || reference.height != approximation.height {
-        return Err(FlipError::SizeMismatch);
-    }
-    if (reference.width as u64) * (reference.height as u64) * 3 > u32::MAX as u64 {
-        return Err(FlipError::TooLarge);
-    }
+) -> Result<(f32, f32, usize, f32), FlipError> {
     let (start, stop) = match exposures {
         Some(r) => r,
         None => exposure_range(reference)?,
@@ -222,19 +256,68 @@ pub fn flip_hdr(
     // FLIP.h: at least two exposures, about one per stop.
     let count = (stop - start).ceil().max(2.0) as usize;
     let step = (stop - start) / (count - 1) as f32;
+    Ok((start, stop, count, step))
+}
+
+/// ACES tone mapping of one linear value at exposure multiplier `m`, clamped to [0, 1]
+/// (negative values count as 0).
+#[inline]
+fn tone_map(v: f32, m: f32) -> f32 {
+    let x = v.max(0.0) * m;
+    let t = ((x * x) * ACES[0] + x * ACES[1] + ACES[2]) / (x * x * ACES[3] + x * ACES[4] + ACES[5]);
+    t.clamp(0.0, 1.0)
+}
+
+/// HDR-FLIP of two linear images (negative values count as 0). `exposures`: the (start, stop)
+/// range in stops; `None` picks it from the reference as NVIDIA's FLIP does. Each exposure is
+/// tone-mapped and compared in float ([`super::flip_float`]); bands of rows run in parallel.
+pub fn flip_hdr(
+    reference: &RgbImage,
+    approximation: &RgbImage,
+    pixels_per_degree: f32,
+    exposures: Option<(f32, f32)>,
+) -> Result<Flip, FlipError> {
+    check_sizes(reference, approximation)?;
+    let (start, stop, count, step) = exposures_of(reference, exposures)?;
+    let transforms: Vec<_> = (0..count)
+        .map(|i| {
+            let m = 2f32.powf(start + i as f32 * step);
+            move |p: [f32; 3]| p.map(|v| tone_map(v, m))
+        })
+        .collect();
+    let map = super::flip_float::flip_max_map(
+        &reference.pixels,
+        &approximation.pixels,
+        reference.width,
+        reference.height,
+        pixels_per_degree,
+        &transforms,
+    );
+    Ok(Flip {
+        mean: mean_of(&map),
+        map,
+        pixels_per_degree,
+        exposures: Some((start, stop, count)),
+    })
+}
+
+/// HDR-FLIP through nv-flip, each tone-mapped exposure quantised to 8-bit sRGB (the former
+/// implementation, kept to measure what the quantisation cost and how much faster pgt's own is).
+pub fn flip_hdr_8bit(
+    reference: &RgbImage,
+    approximation: &RgbImage,
+    pixels_per_degree: f32,
+    exposures: Option<(f32, f32)>,
+) -> Result<Flip, FlipError> {
+    use rayon::prelude::*;
+    check_sizes(reference, approximation)?;
+    let (start, stop, count, step) = exposures_of(reference, exposures)?;
     let (w, h) = (reference.width, reference.height);
     let tone_mapped = |img: &RgbImage, exposure: f32| -> Vec<u8> {
         let m = 2f32.powf(exposure);
         img.pixels
             .iter()
-            .flat_map(|p| {
-                p.map(|v| {
-                    let x = v.max(0.0) * m;
-                    let t = ((x * x) * ACES[0] + x * ACES[1] + ACES[2])
-                        / (x * x * ACES[3] + x * ACES[4] + ACES[5]);
-                    linear_to_srgb8(t.clamp(0.0, 1.0), 1.0)
-                })
-            })
+            .flat_map(|p| p.map(|v| linear_to_srgb8(tone_map(v, m), 1.0)))
             .collect()
     };
     let maps: Vec<Vec<f32>> = (0..count)
@@ -256,9 +339,8 @@ pub fn flip_hdr(
             *d = d.max(*s);
         }
     }
-    let mean = map.iter().map(|&v| v as f64).sum::<f64>() / map.len().max(1) as f64;
     Ok(Flip {
-        mean,
+        mean: mean_of(&map),
         map,
         pixels_per_degree,
         exposures: Some((start, stop, count)),

@@ -6,6 +6,7 @@
 
 pub mod errors;
 pub mod flip;
+pub mod flip_float;
 pub mod gate;
 pub mod maps;
 pub mod ssim;

@@ -111,9 +111,6 @@ pub fn ssim_channel(
     let weights = gaussian_window();
     let c1 = (K1 * data_range).powi(2);
     let c2 = (K2 * data_range).powi(2);
-    let x_at = |i: usize| reference.pixels[i][channel] as f64;
-    let y_at = |i: usize| approximation.pixels[i][channel] as f64;
-
     let bands: Vec<(usize, usize)> = (0..h)
         .step_by(BAND)
         .map(|y0| (y0, (y0 + BAND).min(h)))
@@ -121,75 +118,12 @@ pub fn ssim_channel(
     let results: Vec<(Vec<f64>, f64)> = bands
         .par_iter()
         .map(|&(y0, y1)| {
-            let rows = y1 - y0;
-            // Column pass (scipy filters axis 0 first): five statistics for the band's rows,
-            // stored with RADIUS reflected columns on each side for the row pass.
-            let padded = w + 2 * RADIUS;
-            let mut col = vec![[0.0f64; 5]; rows * padded];
-            for (r, y) in (y0..y1).enumerate() {
-                let row_index: [usize; WINDOW] =
-                    std::array::from_fn(|k| reflect(y as isize + k as isize - RADIUS as isize, h));
-                for x in 0..w {
-                    let stats = |i: usize| {
-                        let (a, b) = (x_at(i * w + x), y_at(i * w + x));
-                        [a, b, a * a, b * b, a * b]
-                    };
-                    let centre = stats(row_index[RADIUS]);
-                    let mut acc = centre.map(|v| v * weights[RADIUS]);
-                    for j in (1..=RADIUS).rev() {
-                        let lo = stats(row_index[RADIUS - j]);
-                        let hi = stats(row_index[RADIUS + j]);
-                        for q in 0..5 {
-                            acc[q] += (lo[q] + hi[q]) * weights[RADIUS - j];
-                        }
-                    }
-                    col[r * padded + RADIUS + x] = acc;
-                }
-                for k in 0..RADIUS {
-                    col[r * padded + k] =
-                        col[r * padded + RADIUS + reflect(k as isize - RADIUS as isize, w)];
-                    col[r * padded + RADIUS + w + k] =
-                        col[r * padded + RADIUS + reflect((w + k) as isize, w)];
-                }
-            }
-            // Row pass and the SSIM formula, in scikit-image's order of operations.
-            let mut map = vec![0.0f64; rows * w];
-            let mut cropped_sum = 0.0f64;
-            for r in 0..rows {
-                let line = &col[r * padded..(r + 1) * padded];
-                let y = y0 + r;
-                let mut row_sum = 0.0f64;
-                for x in 0..w {
-                    let c = x + RADIUS;
-                    let mut m = line[c].map(|v| v * weights[RADIUS]);
-                    for j in (1..=RADIUS).rev() {
-                        for q in 0..5 {
-                            m[q] += (line[c - j][q] + line[c + j][q]) * weights[RADIUS - j];
-                        }
-                    }
-                    let [ux, uy, uxx, uyy, uxy] = m;
-                    let vx = uxx - ux * ux;
-                    let vy = uyy - uy * uy;
-                    let vxy = uxy - ux * uy;
-                    let a1 = 2.0 * ux * uy + c1;
-                    let a2 = 2.0 * vxy + c2;
-                    let b1 = ux * ux + uy * uy + c1;
-                    let b2 = vx + vy + c2;
-                    let s = (a1 * a2) / (b1 * b2);
-                    map[r * w + x] = s;
-                    if x >= RADIUS && x < w - RADIUS {
-                        row_sum += s;
-                    }
-                }
-                if y >= RADIUS && y < h - RADIUS {
-                    cropped_sum += row_sum;
-                }
-            }
-            (map, cropped_sum)
+            let stats = Statistics::of_rows(reference, approximation, channel, y0, y1);
+            ssim_band(&stats, &weights, (w, h), (y0, y1), (c1, c2))
         })
         .collect();
     let mut map = Vec::with_capacity(w * h);
-    let mut sum = 0.0;
+    let mut sum = 0.0f64;
     for (band_map, band_sum) in results {
         map.extend_from_slice(&band_map);
         sum += band_sum;
@@ -199,6 +133,132 @@ pub fn ssim_channel(
         mean: sum / count,
         map,
     })
+}
+
+/// The five per-pixel quantities the local statistics filter, x, y, x², y², xy, as planes
+/// (structure of arrays, so that the filters run over contiguous rows and vectorise), for the
+/// image rows a band of output rows reads: `lo..hi`, its rows ± [`RADIUS`] within the image
+/// (the reflected rows beyond the border are among them, as the image has ≥ [`WINDOW`] rows).
+struct Statistics {
+    lo: usize,
+    width: usize,
+    height: usize,
+    planes: [Vec<f64>; 5],
+}
+
+impl Statistics {
+    fn of_rows(
+        reference: &RgbImage,
+        approximation: &RgbImage,
+        channel: usize,
+        y0: usize,
+        y1: usize,
+    ) -> Statistics {
+        let (w, h) = (reference.width as usize, reference.height as usize);
+        let (lo, hi) = (y0.saturating_sub(RADIUS), (y1 + RADIUS).min(h));
+        let n = (hi - lo) * w;
+        let mut planes: [Vec<f64>; 5] = std::array::from_fn(|_| Vec::with_capacity(n));
+        let rows = lo * w..hi * w;
+        for (p, q) in reference.pixels[rows.clone()]
+            .iter()
+            .zip(&approximation.pixels[rows])
+        {
+            let (a, b) = (p[channel] as f64, q[channel] as f64);
+            for (plane, v) in planes.iter_mut().zip([a, b, a * a, b * b, a * b]) {
+                plane.push(v);
+            }
+        }
+        Statistics {
+            lo,
+            width: w,
+            height: h,
+            planes,
+        }
+    }
+
+    /// Row `y` (image coordinates, reflected into the image) of plane `q`.
+    #[inline]
+    fn row(&self, q: usize, y: isize) -> &[f64] {
+        let r = reflect(y, self.height) - self.lo;
+        &self.planes[q][r * self.width..(r + 1) * self.width]
+    }
+}
+
+/// One band of the SSIM map and the sum of its cropped values. The column pass (scipy filters
+/// axis 0 first) then the row pass, each as the centre tap times its weight plus the pairs from
+/// the outside in (scipy's `NI_Correlate1D` for symmetric kernels), so that every value equals
+/// the per-pixel formulation bit for bit; loops run along rows so that the compiler vectorises.
+fn ssim_band(
+    stats: &Statistics,
+    weights: &[f64; WINDOW],
+    (w, h): (usize, usize),
+    (y0, y1): (usize, usize),
+    (c1, c2): (f64, f64),
+) -> (Vec<f64>, f64) {
+    let padded = w + 2 * RADIUS;
+    let mut map = vec![0.0f64; (y1 - y0) * w];
+    let mut cropped_sum = 0.0f64;
+    let mut line: [Vec<f64>; 5] = std::array::from_fn(|_| vec![0.0f64; padded]);
+    let mut m: [Vec<f64>; 5] = std::array::from_fn(|_| vec![0.0f64; w]);
+    for y in y0..y1 {
+        // Column pass into `line`, with RADIUS reflected columns on each side.
+        for (q, l) in line.iter_mut().enumerate() {
+            let acc = &mut l[RADIUS..RADIUS + w];
+            for (d, &c) in acc.iter_mut().zip(stats.row(q, y as isize)) {
+                *d = c * weights[RADIUS];
+            }
+            for j in (1..=RADIUS).rev() {
+                let lo = stats.row(q, y as isize - j as isize);
+                let hi = stats.row(q, (y + j) as isize);
+                let wj = weights[RADIUS - j];
+                for ((d, &a), &b) in acc.iter_mut().zip(lo).zip(hi) {
+                    *d += (a + b) * wj;
+                }
+            }
+            for k in 0..RADIUS {
+                l[k] = l[RADIUS + reflect(k as isize - RADIUS as isize, w)];
+                l[RADIUS + w + k] = l[RADIUS + reflect((w + k) as isize, w)];
+            }
+        }
+        // Row pass into `m`.
+        for (mq, l) in m.iter_mut().zip(&line) {
+            for (d, &c) in mq.iter_mut().zip(&l[RADIUS..RADIUS + w]) {
+                *d = c * weights[RADIUS];
+            }
+            for j in (1..=RADIUS).rev() {
+                let wj = weights[RADIUS - j];
+                let (lo, hi) = (
+                    &l[RADIUS - j..RADIUS - j + w],
+                    &l[RADIUS + j..RADIUS + j + w],
+                );
+                for ((d, &a), &b) in mq.iter_mut().zip(lo).zip(hi) {
+                    *d += (a + b) * wj;
+                }
+            }
+        }
+        // The SSIM formula, in scikit-image's order of operations.
+        let out = &mut map[(y - y0) * w..(y - y0 + 1) * w];
+        let mut row_sum = 0.0f64;
+        for x in 0..w {
+            let (ux, uy, uxx, uyy, uxy) = (m[0][x], m[1][x], m[2][x], m[3][x], m[4][x]);
+            let vx = uxx - ux * ux;
+            let vy = uyy - uy * uy;
+            let vxy = uxy - ux * uy;
+            let a1 = 2.0 * ux * uy + c1;
+            let a2 = 2.0 * vxy + c2;
+            let b1 = ux * ux + uy * uy + c1;
+            let b2 = vx + vy + c2;
+            let s = (a1 * a2) / (b1 * b2);
+            out[x] = s;
+            if (RADIUS..w - RADIUS).contains(&x) {
+                row_sum += s;
+            }
+        }
+        if (RADIUS..h - RADIUS).contains(&y) {
+            cropped_sum += row_sum;
+        }
+    }
+    (map, cropped_sum)
 }
 
 #[cfg(test)]

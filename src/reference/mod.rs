@@ -4,6 +4,7 @@
 pub mod opaque;
 pub mod quadrature;
 pub mod riemann;
+pub mod rows;
 pub mod shadow;
 pub mod volume;
 
@@ -98,6 +99,17 @@ pub struct RenderOutput {
 
 /// Renders the scene with the renderer its mode and model call for.
 pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
+    let estimator = estimator_for(scene, options)?;
+    render_with(&scene.camera, estimator.as_ref(), options)
+}
+
+/// The estimator the scene's mode and model call for, after checking the options that every
+/// renderer shares (`spp` range, Riemann sample count). `render` and the part renderer of
+/// [`rows`] both start here, so a part is rendered exactly as the whole image is.
+pub fn estimator_for<'a>(
+    scene: &'a Scene,
+    options: &RenderOptions,
+) -> Result<Box<dyn RadianceEstimator + 'a>> {
     if !(1..=MAX_SPP).contains(&options.spp) {
         return Err(PgtError::Usage(format!(
             "--spp must be between 1 and {MAX_SPP}, got {}",
@@ -105,18 +117,17 @@ pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
         )));
     }
     match scene.render.mode {
-        RenderMode::Opaque => {
-            let renderer = opaque::OpaqueRenderer::new(scene);
-            render_with(&scene.camera, &renderer, options)
-        }
+        RenderMode::Opaque => Ok(Box::new(opaque::OpaqueRenderer::new(scene))),
         RenderMode::Volume => {
             if let Integrator::Riemann { samples: 0 } = options.integrator {
                 return Err(PgtError::Usage(
                     "Riemann sums need at least 1 sample per interval".into(),
                 ));
             }
-            let renderer = volume::VolumeRenderer::new(scene, options.integrator);
-            render_with(&scene.camera, &renderer, options)
+            Ok(Box::new(volume::VolumeRenderer::new(
+                scene,
+                options.integrator,
+            )))
         }
     }
 }
@@ -153,7 +164,6 @@ pub fn render_with(
         None
     };
     let k = options.spp;
-    let inv_n = 1.0 / (k * k) as f64;
     let run = || {
         tiles
             .par_iter()
@@ -162,21 +172,10 @@ pub fn render_with(
                 let mut shadow_rays = 0u64;
                 for py in ty * TILE..((ty + 1) * TILE).min(h) {
                     for px in tx * TILE..((tx + 1) * TILE).min(w) {
-                        let mut radiance = DVec3::ZERO;
-                        let mut error = DVec3::ZERO;
-                        let mut unconverged = false;
-                        for sy in 0..k {
-                            for sx in 0..k {
-                                let x = px as f64 + (sx as f64 + 0.5) / k as f64;
-                                let y = py as f64 + (sy as f64 + 0.5) / k as f64;
-                                let s = estimator.radiance(&camera.ray_at(x, y));
-                                radiance += s.radiance;
-                                error += s.error;
-                                shadow_rays += s.shadow_rays;
-                                unconverged |= s.unconverged;
-                            }
-                        }
-                        out.push((px, py, radiance * inv_n, error * inv_n, unconverged));
+                        let (radiance, error, rays, unconverged) =
+                            render_pixel(camera, estimator, px, py, k);
+                        shadow_rays += rays;
+                        out.push((px, py, radiance, error, unconverged));
                     }
                 }
                 if let Some(bar) = &bar {
@@ -186,14 +185,7 @@ pub fn render_with(
             })
             .collect::<Vec<_>>()
     };
-    let results = match options.threads {
-        Some(n) => rayon::ThreadPoolBuilder::new()
-            .num_threads(n.max(1))
-            .build()
-            .map_err(|e| PgtError::Usage(format!("cannot start {n} threads: {e}")))?
-            .install(run),
-        None => run(),
-    };
+    let results = with_threads(options.threads, run)?;
     if let Some(bar) = &bar {
         bar.finish_and_clear();
     }
@@ -206,17 +198,11 @@ pub fn render_with(
         shadow_rays += rays;
         for (px, py, rad, err, not_converged) in tile {
             let i = py as usize * w as usize + px as usize;
-            let stored = rad.as_vec3();
-            image.pixels[i] = stored.to_array();
-            err_image.pixels[i] = stored_error(rad, stored, err);
+            (image.pixels[i], err_image.pixels[i]) = stored_pixel(rad, err);
             if not_converged {
                 unconverged += 1;
-                let e = err.max_element();
-                // Ties keep the first in row-major order: the same for any thread count.
-                if worst_unconverged.is_none_or(|(x, y, w)| e > w || (e == w && (py, px) < (y, x)))
-                {
-                    worst_unconverged = Some((px, py, e));
-                }
+                worst_unconverged =
+                    worse_unconverged(worst_unconverged, (px, py, err.max_element()));
             }
         }
     }
@@ -242,6 +228,73 @@ pub fn render_with(
             worst_unconverged,
         },
     })
+}
+
+/// One pixel: the mean of k×k stratified samples at the sub-pixel centres (DESIGN.md §1 camera
+/// convention, `--spp k`), as (radiance, error estimate, shadow rays, whether a sample did not
+/// converge). Every renderer of whole
+/// images or parts goes through this one function, so a pixel is the same bits wherever it is
+/// rendered.
+pub fn render_pixel(
+    camera: &Camera,
+    estimator: &dyn RadianceEstimator,
+    px: u32,
+    py: u32,
+    k: u32,
+) -> (DVec3, DVec3, u64, bool) {
+    let inv_n = 1.0 / (k * k) as f64;
+    let mut radiance = DVec3::ZERO;
+    let mut error = DVec3::ZERO;
+    let mut shadow_rays = 0;
+    let mut unconverged = false;
+    for sy in 0..k {
+        for sx in 0..k {
+            let x = px as f64 + (sx as f64 + 0.5) / k as f64;
+            let y = py as f64 + (sy as f64 + 0.5) / k as f64;
+            let s = estimator.radiance(&camera.ray_at(x, y));
+            radiance += s.radiance;
+            error += s.error;
+            shadow_rays += s.shadow_rays;
+            unconverged |= s.unconverged;
+        }
+    }
+    (radiance * inv_n, error * inv_n, shadow_rays, unconverged)
+}
+
+/// The float32 values stored for a pixel's f64 radiance and error estimate (the image and its
+/// `err` layer, which also covers the rounding to float32: [`stored_error`]), shared by
+/// whole-image and part renders so both store the same bits.
+#[inline]
+pub fn stored_pixel(radiance: DVec3, error: DVec3) -> ([f32; 3], [f32; 3]) {
+    let stored = radiance.as_vec3();
+    (stored.to_array(), stored_error(radiance, stored, error))
+}
+
+/// The worse of two unconverged pixels (x, y, largest error estimate): the larger estimate,
+/// ties to the first in row-major order, so the answer is the same for any thread count.
+pub fn worse_unconverged(
+    worst: Option<(u32, u32, f64)>,
+    (px, py, e): (u32, u32, f64),
+) -> Option<(u32, u32, f64)> {
+    match worst {
+        Some((x, y, w)) if !(e > w || (e == w && (py, px) < (y, x))) => worst,
+        _ => Some((px, py, e)),
+    }
+}
+
+/// Runs `work` on a pool of `threads` workers (`--threads`), or on rayon's global pool.
+pub(crate) fn with_threads<T: Send>(
+    threads: Option<usize>,
+    work: impl FnOnce() -> T + Send,
+) -> Result<T> {
+    match threads {
+        Some(n) => Ok(rayon::ThreadPoolBuilder::new()
+            .num_threads(n.max(1))
+            .build()
+            .map_err(|e| PgtError::Usage(format!("cannot start {n} threads: {e}")))?
+            .install(work)),
+        None => Ok(work()),
+    }
 }
 
 /// The `err` value stored for a pixel (DESIGN.md §3: err bounds |stored − true|): the estimate

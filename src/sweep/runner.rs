@@ -16,8 +16,10 @@ use std::time::Instant;
 /// How to run a sweep.
 #[derive(Debug, Clone, Default)]
 pub struct SweepOptions {
-    /// Folder for the images and the reference cache (`DIR/cache`).
+    /// Folder for the images (the CLI passes a temporary folder that becomes the report).
     pub dir: PathBuf,
+    /// Folder of the reference cache; it outlives the sweep (`REPORT/cache` in the CLI).
+    pub cache: PathBuf,
     /// Worker threads of the CPU renders; `None` uses rayon's default.
     pub threads: Option<usize>,
     /// A progress bar for the reference render (the CLI sets it when stderr is a terminal).
@@ -86,31 +88,11 @@ pub fn load_scene(exp: &Experiment) -> Result<Scene> {
     Scene::load(&exp.scene, &load)
 }
 
-/// FNV-1a, 64 bit: a stable hash for the cache key (not cryptographic; a collision would need a
-/// deliberately crafted scene).
-fn fnv1a(bytes: &[u8]) -> u64 {
-    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
-    for &b in bytes {
-        h ^= b as u64;
-        h = h.wrapping_mul(0x0100_0000_01b3);
-    }
-    h
-}
-
 /// The cache key of a reference render: everything that determines its pixels (the loaded
 /// scene with its particles, which covers included particle files, the options, pgt's version).
 pub fn reference_key(scene: &Scene, options: &RenderOptions) -> String {
-    let text = format!(
-        "pgt {} reference v1\n{:?}\n{:?}\n{:?}\n{:?}\nspp {} integrator {:?}",
-        env!("CARGO_PKG_VERSION"),
-        scene.camera,
-        scene.render,
-        scene.lights,
-        scene.particles,
-        options.spp,
-        options.integrator
-    );
-    format!("{:016x}", fnv1a(text.as_bytes()))
+    // The same identity that ties the parts of a cluster render together.
+    crate::parts::render_hash(scene, options)
 }
 
 /// The exact reference (adaptive quadrature, DESIGN.md §3), from the cache or rendered and
@@ -120,8 +102,8 @@ fn cached_reference(
     scene: &Scene,
     options: &SweepOptions,
 ) -> Result<(RgbImage, ReferenceInfo)> {
-    let cache = options.dir.join("cache");
-    std::fs::create_dir_all(&cache).map_err(|e| PgtError::io(&cache, e))?;
+    let cache = &options.cache;
+    std::fs::create_dir_all(cache).map_err(|e| PgtError::io(cache, e))?;
     let ref_options = RenderOptions {
         spp: exp.reference.spp.unwrap_or(1),
         threads: options.threads,

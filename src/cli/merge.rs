@@ -1,0 +1,59 @@
+//! `pgt merge PART... -o OUT`: the whole image from the parts of a cluster render (DESIGN.md §7,
+//! issue 12), bit-identical to a one-machine `pgt render`, err layer included. The checks and
+//! the part format are in [`crate::parts`]: a file that is not a part, a missing or duplicated
+//! part, or parts of different renders exit 2 with a message naming the file, and nothing is
+//! written.
+
+use super::Outcome;
+use crate::image_io::{write_image, ImageFormat, RgbImage};
+use crate::parts::{merge, read_part};
+use clap::Args;
+use std::path::PathBuf;
+
+#[derive(Debug, Args)]
+pub struct MergeArgs {
+    /// The part files written by `pgt render SCENE --tile I/N -o PART.exr`, in any order.
+    #[arg(required = true)]
+    pub parts: Vec<PathBuf>,
+    /// Output image; the format follows the extension (.exr or .png).
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// PNG exposure in stops (2^exposure scales the linear image before encoding).
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
+    pub exposure: f32,
+}
+
+pub fn run(args: MergeArgs) -> anyhow::Result<Outcome> {
+    ImageFormat::from_path(&args.output)?;
+    if !args.exposure.is_finite() {
+        anyhow::bail!("--exposure must be a finite number");
+    }
+    let mut parts = Vec::with_capacity(args.parts.len());
+    for path in &args.parts {
+        parts.push((path.clone(), read_part(path)?));
+    }
+    let (image, error) = merge(&parts)?;
+    let layers: Vec<(&str, &RgbImage)> = error.iter().map(|e| ("err", e)).collect();
+    write_image(&args.output, &image, &layers, args.exposure)?;
+    let mut line = format!(
+        "merged {} parts into {} ({}x{})",
+        parts.len(),
+        args.output.display(),
+        image.width,
+        image.height
+    );
+    if let Some(e) = &error {
+        // The same figures `pgt render` prints for the whole image.
+        let (max, sum) = e
+            .pixels
+            .iter()
+            .flatten()
+            .fold((0.0f64, 0.0f64), |(m, s), &v| {
+                (m.max(v as f64), s + v as f64)
+            });
+        let mean = sum / (3 * e.pixels.len()).max(1) as f64;
+        line += &format!(", error estimate max {max:.3e} mean {mean:.3e}");
+    }
+    eprintln!("{line}");
+    Ok(Outcome::Success)
+}
