@@ -5,7 +5,7 @@
 mod volume_support;
 
 use glam::DVec3;
-use pgt::optics::{models, OpticalModel};
+use pgt::optics::{models, Falloff, Light, OpticalModel};
 use pgt::reference::volume::VolumeRenderer;
 use pgt::reference::{Integrator, RadianceEstimator, Sample};
 use pgt::scene::Scene;
@@ -28,16 +28,28 @@ fn render_f64(scene: &Scene) -> Vec<Sample> {
 /// 1e-6, against the same render at tol 1e-10.
 fn honest_at(model: OpticalModel, seed: u64) {
     let mut rng = Rng::new(seed);
-    let mut s = scene(model, random_particles(&mut rng, 6), two_lights(), SIZE);
-    s.camera = pgt::geometry::Camera::new(
+    let s = scene(model, random_particles(&mut rng, 6), two_lights(), SIZE);
+    check_honest(&format!("{} seed {seed}", model.name()), s, 1e-10);
+}
+
+/// The camera of the honesty scenes.
+fn camera() -> pgt::geometry::Camera {
+    pgt::geometry::Camera::new(
         DVec3::new(0.5, 0.8, -6.0),
         DVec3::ZERO,
         DVec3::Y,
         45.0,
         SIZE,
         SIZE,
-    );
-    s.render.tol = 1e-10;
+    )
+}
+
+/// Renders `s` at `truth_tol` and at tol 1e-4 and 1e-6: err must cover the actual error at
+/// ≥ 99.9 % of pixel channels and meet tol (except at pixels reported as unconverged, at most
+/// 0.1 %), and the result must be within tol of the truth wherever it converged.
+fn check_honest(name: &str, mut s: Scene, truth_tol: f64) {
+    s.camera = camera();
+    s.render.tol = truth_tol;
     let truth = render_f64(&s);
     let covered = truth
         .iter()
@@ -52,15 +64,24 @@ fn honest_at(model: OpticalModel, seed: u64) {
         let got = render_f64(&s);
         let mut violations = 0;
         let mut worst = 0.0f64;
+        let mut unconverged = 0;
         for (pix, (g, t)) in got.iter().zip(&truth).enumerate() {
-            assert!(
-                g.error.max_element() <= tol * (1.0 + 1e-9),
-                "estimate {:?} above tol {tol}",
-                g.error
-            );
+            let reported = g.unconverged || t.unconverged;
+            if reported {
+                // Reported (DESIGN.md §3); its err still has to cover the error, below.
+                unconverged += 1;
+            } else {
+                assert!(
+                    g.error.max_element() <= tol * (1.0 + 1e-9),
+                    "{name}: estimate {:?} above tol {tol}",
+                    g.error
+                );
+            }
             for c in 0..3 {
                 let actual = (g.radiance[c] - t.radiance[c]).abs();
-                worst = worst.max(actual / tol);
+                if !reported {
+                    worst = worst.max(actual / tol);
+                }
                 if actual > g.error[c] + t.error[c] {
                     eprintln!(
                         "  pixel {pix} channel {c}: actual {actual:.3e} > estimate {:.3e}",
@@ -72,17 +93,21 @@ fn honest_at(model: OpticalModel, seed: u64) {
         }
         let mean_estimate =
             got.iter().map(|g| g.error.element_sum()).sum::<f64>() / (3 * SIZE * SIZE) as f64;
-        eprintln!("{model:?} tol {tol}: {violations} violations, worst actual {worst:.3e}·tol, mean estimate {mean_estimate:.3e}");
+        eprintln!("{name} tol {tol}: {violations} violations, worst actual {worst:.3e}·tol, mean estimate {mean_estimate:.3e}, {unconverged} unconverged");
         let allowed = (3 * SIZE * SIZE) as usize / 1000;
         assert!(
             violations <= allowed,
-            "{model:?} tol {tol}: {violations} of {} channels exceed their estimate",
+            "{name} tol {tol}: {violations} of {} channels exceed their estimate",
             3 * SIZE * SIZE
         );
         // And the estimate is not vacuous: the result is within tol of the truth everywhere.
         assert!(
             worst <= 1.0,
-            "{model:?} tol {tol}: worst actual error {worst}·tol"
+            "{name} tol {tol}: worst actual error {worst}·tol"
+        );
+        assert!(
+            unconverged <= allowed / 3,
+            "{name} tol {tol}: {unconverged} pixels did not converge"
         );
     }
 }
@@ -99,4 +124,65 @@ fn error_estimate_is_honest_for_the_single_scatter_model() {
     for seed in [12, 22] {
         honest_at(models::SINGLE_SCATTER, seed);
     }
+}
+
+/// The harder cases of issue 10, each against a tol 1e-9 render: a point light inside the gas.
+#[test]
+fn error_estimate_is_honest_with_a_point_light_inside_the_gas() {
+    for model in [models::LIT, models::SINGLE_SCATTER] {
+        let mut rng = Rng::new(41);
+        let particles = random_particles(&mut rng, 6);
+        let lights = vec![Light::Point {
+            position: DVec3::new(0.15, 0.1, 0.05),
+            intensity: DVec3::new(0.3, 0.2, 0.5),
+            falloff: Falloff::InverseSquare,
+        }];
+        let s = scene(model, particles, lights, SIZE);
+        check_honest(&format!("{} point light inside", model.name()), s, 1e-9);
+    }
+}
+
+/// Shadows that graze spheres: spheres in a row along x, lit along x (each shadows the next),
+/// seen from the side, so the shadow edges (kinks) cross the image.
+#[test]
+fn error_estimate_is_honest_with_grazing_shadows() {
+    let particles = (0..5)
+        .map(|i| {
+            let x = -1.8 + 0.9 * i as f64;
+            particle(
+                DVec3::new(x, 0.05 * i as f64, 0.1 * (i % 2) as f64),
+                0.5 + 0.05 * i as f64,
+                DVec3::new(0.9, 0.4 + 0.1 * i as f64, 0.2),
+                2.5,
+            )
+        })
+        .collect::<Vec<_>>();
+    let lights = vec![
+        Light::Directional {
+            direction: DVec3::new(1.0, 0.02, 0.0).normalize(),
+            irradiance: DVec3::new(1.0, 0.8, 0.6),
+        },
+        Light::Point {
+            position: DVec3::new(-3.0, 0.1, 0.05),
+            intensity: DVec3::new(4.0, 4.0, 8.0),
+            falloff: Falloff::InverseSquare,
+        },
+    ];
+    for model in [models::LIT, models::SINGLE_SCATTER] {
+        let s = scene(model, particles.clone(), lights.clone(), SIZE);
+        check_honest(&format!("{} grazing", model.name()), s, 1e-9);
+    }
+}
+
+/// Θmax from 0.99 to 1 − 1e-6 (σ = −ln(1 − Θmax)/(2r)), overlapping, two lights.
+#[test]
+fn error_estimate_is_honest_near_opacity_one() {
+    let mut rng = Rng::new(43);
+    let mut particles = random_particles(&mut rng, 5);
+    for (i, p) in particles.iter_mut().enumerate() {
+        let opacity = 1.0 - 10f64.powi(-2 - i as i32);
+        p.sigma = pgt::optics::extinction::sigma_from_opacity(opacity, p.radius);
+    }
+    let s = scene(models::LIT, particles, two_lights(), SIZE);
+    check_honest("lit near opacity 1", s, 1e-9);
 }

@@ -216,6 +216,9 @@ fn read_or_render(path: &Path, layer: Option<&str>) -> anyhow::Result<ReadImage>
         path.display(),
         out.stats.seconds
     );
+    if let Some(w) = super::render::unconverged_warning(&out.stats, scene.render.tol) {
+        eprintln!("warning: {w}");
+    }
     Ok(ReadImage {
         image: out.image,
         channels: 3,

@@ -2,6 +2,7 @@
 //! [`Outcome`]; `main` maps it and errors to exit codes 0 / 1 / 2.
 
 pub mod approx;
+pub mod bench;
 pub mod camera;
 pub mod compare;
 pub mod export;
@@ -47,6 +48,8 @@ pub enum Command {
     Info(info::InfoArgs),
     /// Generate synthetic data sets (`pgt gen random`).
     Gen(gen::GenArgs),
+    /// The speed of the reference on standard workloads, as one table of ratios.
+    Bench(bench::BenchArgs),
     /// Join the parts of a cluster render (`pgt render --tile I/N`) into the whole image.
     Merge(merge::MergeArgs),
     /// The camera as view and projection matrices per graphics API (OpenGL, Vulkan, WebGPU, Direct3D).
@@ -64,6 +67,7 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
         Command::Sweep(args) => sweep::run(args),
         Command::Info(args) => info::run(args),
         Command::Gen(args) => gen::run(args),
+        Command::Bench(args) => bench::run(args),
         Command::Merge(args) => merge::run(args),
         Command::Camera(args) => camera::run(args),
         Command::Export(args) => export::run(args),

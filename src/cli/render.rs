@@ -102,7 +102,20 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
         line += &format!(", error estimate max {max:.3e} mean {mean:.3e}");
     }
     eprintln!("{line}");
+    if let Some(warning) = unconverged_warning(s, scene.render.tol) {
+        eprintln!("warning: {warning}");
+    }
     Ok(Outcome::Success)
+}
+
+/// DESIGN.md §3: a pixel that does not converge is reported, not hidden. The count and the pixel
+/// with the largest error estimate, or `None` when every pixel reached `tol`.
+pub fn unconverged_warning(stats: &reference::RenderStats, tol: f64) -> Option<String> {
+    let (x, y, e) = stats.worst_unconverged?;
+    Some(format!(
+        "{} pixel(s) did not reach tol {tol:e}; the worst is ({x}, {y}) with error estimate {e:.3e} (its err value says how far off it may be)",
+        stats.unconverged
+    ))
 }
 
 /// `--tile I/N`: renders and writes one part (`pgt::parts`), with a one-line summary.

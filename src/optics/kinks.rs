@@ -43,38 +43,9 @@ pub fn shadow_tangencies(
     if bvh.is_empty() || !(t_hi > t_lo) || !t_lo.is_finite() || !t_hi.is_finite() {
         return;
     }
-    let (y0, y1) = (ray.at(t_lo), ray.at(t_hi));
-    let mut poly = [DVec3::ZERO; 4];
-    let n_vertices = match *light {
-        Light::Directional { direction, .. } => {
-            let root = &bvh.nodes[0];
-            let centre = 0.5 * (root.min + root.max);
-            // Far enough along the light's direction to leave the root box from any point of
-            // the segment.
-            let reach =
-                (root.max - root.min).length() + (y0 - centre).length() + (y1 - centre).length();
-            poly = [y0, y1, y1 - direction * reach, y0 - direction * reach];
-            4
-        }
-        Light::Point { position, .. } => {
-            poly[..3].copy_from_slice(&[y0, y1, position]);
-            3
-        }
-    };
-    let poly = &poly[..n_vertices];
-    let mut stack = vec![0u32];
-    while let Some(n) = stack.pop() {
-        let node = &bvh.nodes[n as usize];
-        if !polygon_overlaps_box(poly, node.min, node.max) {
-            continue;
-        }
-        if node.count == 0 {
-            stack.push(node.first);
-            stack.push(node.first + 1);
-            continue;
-        }
-        let first = node.first as usize;
-        for &i in &bvh.indices[first..first + node.count as usize] {
+    let poly = swept_polygon(bvh, light, ray.at(t_lo), ray.at(t_hi));
+    for_each_swept_leaf(bvh, &poly, |leaf| {
+        for &i in leaf {
             let p = &particles[i as usize];
             if !(p.sigma > 0.0) {
                 continue;
@@ -92,9 +63,49 @@ pub fn shadow_tangencies(
                     .filter(|&t| t > t_lo && t < t_hi),
             );
         }
-    }
+    });
     out.sort_unstable_by(f64::total_cmp);
     out.dedup();
+}
+
+/// The planar convex polygon that holds every shadow ray from a point of the segment [y0, y1]
+/// towards `light`: a parallelogram reaching past the root box of `bvh` for a directional light,
+/// the triangle (y0, y1, p) for a point light at p.
+pub(crate) fn swept_polygon(bvh: &Bvh, light: &Light, y0: DVec3, y1: DVec3) -> SweptPolygon {
+    match *light {
+        Light::Directional { direction, .. } => {
+            let root = &bvh.nodes[0];
+            let centre = 0.5 * (root.min + root.max);
+            // Far enough along the light's direction to leave the root box from any point of
+            // the segment.
+            let reach =
+                (root.max - root.min).length() + (y0 - centre).length() + (y1 - centre).length();
+            SweptPolygon::new(&[y0, y1, y1 - direction * reach, y0 - direction * reach])
+        }
+        Light::Point { position, .. } => SweptPolygon::new(&[y0, y1, position]),
+    }
+}
+
+/// Calls `visit` with the sphere indices of every BVH leaf whose box the polygon `poly` (from
+/// [`swept_polygon`]) may overlap (a conservative separating-axis test).
+pub(crate) fn for_each_swept_leaf(bvh: &Bvh, poly: &SweptPolygon, mut visit: impl FnMut(&[u32])) {
+    if bvh.is_empty() {
+        return;
+    }
+    let mut stack = vec![0u32];
+    while let Some(n) = stack.pop() {
+        let node = &bvh.nodes[n as usize];
+        if !poly.overlaps_box(node.min, node.max) {
+            continue;
+        }
+        if node.count == 0 {
+            stack.push(node.first);
+            stack.push(node.first + 1);
+            continue;
+        }
+        let first = node.first as usize;
+        visit(&bvh.indices[first..first + node.count as usize]);
+    }
 }
 
 /// Roots of the ray against the cylinder of radius r about c + s·ω (ω unit, towards the light),
@@ -162,45 +173,84 @@ fn solve_quadratic(a: f64, b: f64, c: f64) -> [Option<f64>; 2] {
     ]
 }
 
-/// Separating-axis test of a planar convex polygon against an axis-aligned box (the box faces,
-/// the polygon's plane, and the cross products of its edges with the box axes). Conservative:
-/// a relative slack keeps round-off from separating what touches.
-fn polygon_overlaps_box(poly: &[DVec3], min: DVec3, max: DVec3) -> bool {
-    let centre = 0.5 * (min + max);
-    let half = 0.5 * (max - min);
-    if !(half.min_element() >= 0.0) {
-        return false;
+/// A planar convex polygon (3 or 4 vertices) prepared for separating-axis tests against
+/// axis-aligned boxes: the candidate axes (the polygon's normal, the box faces, the cross
+/// products of its edges with the box axes) and the polygon's extent along each, computed once,
+/// so that a box costs two dot products per axis.
+#[derive(Debug, Clone)]
+pub(crate) struct SweptPolygon {
+    axes: [DVec3; 16],
+    /// The polygon's projection [lo, hi] on each axis, and max |v·axis| over its vertices
+    /// (for the round-off slack).
+    lo: [f64; 16],
+    hi: [f64; 16],
+    magnitude: [f64; 16],
+    count: usize,
+}
+
+impl SweptPolygon {
+    fn new(poly: &[DVec3]) -> SweptPolygon {
+        let mut p = SweptPolygon {
+            axes: [DVec3::ZERO; 16],
+            lo: [0.0; 16],
+            hi: [0.0; 16],
+            magnitude: [0.0; 16],
+            count: 0,
+        };
+        let e0 = poly[1] - poly[0];
+        let e1 = poly[2] - poly[1];
+        // The plane first: the sweep is thin across it, so it separates most boxes at once.
+        p.push(poly, e0.cross(e1));
+        for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
+            p.push(poly, axis);
+        }
+        for i in 0..poly.len() {
+            let edge = poly[(i + 1) % poly.len()] - poly[i];
+            for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
+                p.push(poly, edge.cross(axis));
+            }
+        }
+        p
     }
-    let separated = |axis: DVec3| {
-        let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+
+    fn push(&mut self, poly: &[DVec3], axis: DVec3) {
+        let (mut lo, mut hi, mut magnitude) = (f64::INFINITY, f64::NEG_INFINITY, 0.0f64);
         for v in poly {
-            let s = (*v - centre).dot(axis);
+            let s = v.dot(axis);
             lo = lo.min(s);
             hi = hi.max(s);
+            magnitude = magnitude.max(s.abs());
         }
-        let extent = half.dot(axis.abs());
-        let slack = 1e-9 * (extent + lo.abs().max(hi.abs()));
-        lo > extent + slack || hi < -extent - slack
-    };
-    for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
-        if separated(axis) {
+        let k = self.count;
+        self.axes[k] = axis;
+        self.lo[k] = lo;
+        self.hi[k] = hi;
+        self.magnitude[k] = magnitude;
+        self.count += 1;
+    }
+
+    /// Whether the polygon may overlap the box [min, max]. Conservative: a relative slack keeps
+    /// round-off from separating what touches (also the round-off of projecting polygon and box
+    /// separately, which grows with the distance from the origin).
+    pub(crate) fn overlaps_box(&self, min: DVec3, max: DVec3) -> bool {
+        let centre = 0.5 * (min + max);
+        let half = 0.5 * (max - min);
+        if !(half.min_element() >= 0.0) {
             return false;
         }
-    }
-    let e0 = poly[1] - poly[0];
-    let e1 = poly[2] - poly[1];
-    if separated(e0.cross(e1)) {
-        return false;
-    }
-    for i in 0..poly.len() {
-        let edge = poly[(i + 1) % poly.len()] - poly[i];
-        for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
-            if separated(edge.cross(axis)) {
+        for k in 0..self.count {
+            let axis = self.axes[k];
+            let c = centre.dot(axis);
+            let (lo, hi) = (self.lo[k] - c, self.hi[k] - c);
+            let extent = half.dot(axis.abs());
+            let slack =
+                1e-9 * (extent + lo.abs().max(hi.abs())) + 1e-12 * (self.magnitude[k] + c.abs());
+            if lo > extent + slack || hi < -extent - slack {
                 return false;
             }
         }
+        true
     }
-    true
 }
 
 #[cfg(test)]

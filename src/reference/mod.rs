@@ -5,6 +5,7 @@ pub mod opaque;
 pub mod quadrature;
 pub mod riemann;
 pub mod rows;
+pub mod shadow;
 pub mod volume;
 
 use crate::error::{PgtError, Result};
@@ -24,6 +25,9 @@ pub struct Sample {
     pub error: DVec3,
     /// Shadow rays traced for this sample (for the rays-per-second figure).
     pub shadow_rays: u64,
+    /// The quadrature stopped before reaching `tol` (segment cap, or a segment that cannot be
+    /// split in f64, e.g. a ray through a point light inside gas): `error` is what it reached.
+    pub unconverged: bool,
 }
 
 /// Something that computes the radiance along camera rays: one per mode/model.
@@ -78,6 +82,10 @@ pub struct RenderStats {
     /// Largest and mean per-pixel, per-channel error estimate (`None` without estimates).
     pub max_error: Option<f64>,
     pub mean_error: Option<f64>,
+    /// Pixels where a sample did not reach `tol` (DESIGN.md §3: reported, not hidden).
+    pub unconverged: u64,
+    /// The unconverged pixel with the largest error estimate: (x, y, its largest channel).
+    pub worst_unconverged: Option<(u32, u32, f64)>,
 }
 
 /// A finished reference render.
@@ -164,9 +172,10 @@ pub fn render_with(
                 let mut shadow_rays = 0u64;
                 for py in ty * TILE..((ty + 1) * TILE).min(h) {
                     for px in tx * TILE..((tx + 1) * TILE).min(w) {
-                        let (radiance, error, rays) = render_pixel(camera, estimator, px, py, k);
+                        let (radiance, error, rays, unconverged) =
+                            render_pixel(camera, estimator, px, py, k);
                         shadow_rays += rays;
-                        out.push((px, py, radiance, error));
+                        out.push((px, py, radiance, error, unconverged));
                     }
                 }
                 if let Some(bar) = &bar {
@@ -183,11 +192,18 @@ pub fn render_with(
     let mut image = RgbImage::new(w, h);
     let mut err_image = RgbImage::new(w, h);
     let mut shadow_rays = 0;
+    let mut unconverged = 0;
+    let mut worst_unconverged: Option<(u32, u32, f64)> = None;
     for (tile, rays) in results {
         shadow_rays += rays;
-        for (px, py, rad, err) in tile {
+        for (px, py, rad, err, not_converged) in tile {
             let i = py as usize * w as usize + px as usize;
             (image.pixels[i], err_image.pixels[i]) = stored_pixel(rad, err);
+            if not_converged {
+                unconverged += 1;
+                worst_unconverged =
+                    worse_unconverged(worst_unconverged, (px, py, err.max_element()));
+            }
         }
     }
     let pixels = w as u64 * h as u64;
@@ -208,12 +224,15 @@ pub fn render_with(
             seconds: start.elapsed().as_secs_f64(),
             max_error,
             mean_error,
+            unconverged,
+            worst_unconverged,
         },
     })
 }
 
 /// One pixel: the mean of k×k stratified samples at the sub-pixel centres (DESIGN.md §1 camera
-/// convention, `--spp k`), as (radiance, error estimate, shadow rays). Every renderer of whole
+/// convention, `--spp k`), as (radiance, error estimate, shadow rays, whether a sample did not
+/// converge). Every renderer of whole
 /// images or parts goes through this one function, so a pixel is the same bits wherever it is
 /// rendered.
 pub fn render_pixel(
@@ -222,11 +241,12 @@ pub fn render_pixel(
     px: u32,
     py: u32,
     k: u32,
-) -> (DVec3, DVec3, u64) {
+) -> (DVec3, DVec3, u64, bool) {
     let inv_n = 1.0 / (k * k) as f64;
     let mut radiance = DVec3::ZERO;
     let mut error = DVec3::ZERO;
     let mut shadow_rays = 0;
+    let mut unconverged = false;
     for sy in 0..k {
         for sx in 0..k {
             let x = px as f64 + (sx as f64 + 0.5) / k as f64;
@@ -235,16 +255,31 @@ pub fn render_pixel(
             radiance += s.radiance;
             error += s.error;
             shadow_rays += s.shadow_rays;
+            unconverged |= s.unconverged;
         }
     }
-    (radiance * inv_n, error * inv_n, shadow_rays)
+    (radiance * inv_n, error * inv_n, shadow_rays, unconverged)
 }
 
 /// The float32 values stored for a pixel's f64 radiance and error estimate (the image and its
-/// `err` layer), shared by whole-image and part renders so both store the same bits.
+/// `err` layer, which also covers the rounding to float32: [`stored_error`]), shared by
+/// whole-image and part renders so both store the same bits.
 #[inline]
 pub fn stored_pixel(radiance: DVec3, error: DVec3) -> ([f32; 3], [f32; 3]) {
-    (radiance.as_vec3().to_array(), error.as_vec3().to_array())
+    let stored = radiance.as_vec3();
+    (stored.to_array(), stored_error(radiance, stored, error))
+}
+
+/// The worse of two unconverged pixels (x, y, largest error estimate): the larger estimate,
+/// ties to the first in row-major order, so the answer is the same for any thread count.
+pub fn worse_unconverged(
+    worst: Option<(u32, u32, f64)>,
+    (px, py, e): (u32, u32, f64),
+) -> Option<(u32, u32, f64)> {
+    match worst {
+        Some((x, y, w)) if !(e > w || (e == w && (py, px) < (y, x))) => worst,
+        _ => Some((px, py, e)),
+    }
 }
 
 /// Runs `work` on a pool of `threads` workers (`--threads`), or on rayon's global pool.
@@ -259,5 +294,28 @@ pub(crate) fn with_threads<T: Send>(
             .map_err(|e| PgtError::Usage(format!("cannot start {n} threads: {e}")))?
             .install(work)),
         None => Ok(work()),
+    }
+}
+
+/// The `err` value stored for a pixel (DESIGN.md §3: err bounds |stored − true|): the estimate
+/// plus the rounding of the f64 radiance to the stored f32 (|f32(L) − L|, at most half an ulp),
+/// per channel, rounded up to the next f32 so that storing it cannot make it smaller.
+fn stored_error(radiance: DVec3, stored: glam::Vec3, error: DVec3) -> [f32; 3] {
+    let mut out = [0.0f32; 3];
+    for c in 0..3 {
+        let bound = error[c] + (stored[c] as f64 - radiance[c]).abs();
+        out[c] = round_up_f32(bound);
+    }
+    out
+}
+
+/// The smallest f32 ≥ v (v ≥ 0; NaN and +∞ pass through).
+fn round_up_f32(v: f64) -> f32 {
+    let f = v as f32;
+    if (f as f64) < v && f.is_finite() {
+        // Positive and finite here (v ≥ 0): the next representable f32 above.
+        f32::from_bits(f.to_bits() + 1)
+    } else {
+        f
     }
 }

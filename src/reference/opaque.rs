@@ -3,6 +3,7 @@
 
 use super::{RadianceEstimator, Sample};
 use crate::geometry::{Bvh, Ray};
+use crate::optics::light::Light;
 use crate::optics::particle::Particle;
 use crate::scene::Scene;
 use glam::DVec3;
@@ -61,9 +62,11 @@ impl<'a> OpaqueRenderer<'a> {
                 continue;
             };
             let cos = n.dot(inc.toward);
-            // Interior surfaces (the eye is inside the sphere): a ray towards the light from the
-            // inside wall, on the side the wall faces, passes through the sphere itself.
-            if cos <= 0.0 || !entering {
+            // An interior surface (the eye is inside the sphere) is lit only by a point light
+            // inside the same sphere (DESIGN.md §2, opaque mode): light from outside would have
+            // to pass through the opaque sphere. From outside, a light inside this sphere lies
+            // behind the surface (cos < 0); one inside another sphere is blocked by it below.
+            if cos <= 0.0 || (!entering && !light_inside(light, p)) {
                 continue;
             }
             rays += 1;
@@ -81,6 +84,14 @@ impl<'a> OpaqueRenderer<'a> {
             radiance += inc.irradiance * brdf_cos;
         }
         (radiance, rays)
+    }
+}
+
+/// Whether `light` is a point light strictly inside sphere `p`.
+fn light_inside(light: &Light, p: &Particle) -> bool {
+    match *light {
+        Light::Point { position, .. } => (position - p.center).length() < p.radius,
+        Light::Directional { .. } => false,
     }
 }
 
@@ -102,6 +113,7 @@ impl RadianceEstimator for OpaqueRenderer<'_> {
             radiance,
             error: DVec3::ZERO,
             shadow_rays,
+            unconverged: false,
         }
     }
 }
@@ -110,7 +122,7 @@ impl RadianceEstimator for OpaqueRenderer<'_> {
 mod tests {
     use super::*;
     use crate::geometry::Camera;
-    use crate::optics::light::{Falloff, Light};
+    use crate::optics::light::Falloff;
     use crate::scene::{RenderMode, RenderSettings};
     use approx::assert_relative_eq;
 
@@ -305,5 +317,56 @@ mod tests {
         s.render.ambient = 0.5;
         let got = centre_radiance(&s);
         assert_relative_eq!(got, DVec3::splat(0.5), max_relative = 1e-15);
+    }
+
+    #[test]
+    fn eye_and_point_light_inside_one_sphere_light_the_inner_wall_and_nothing_outside() {
+        // Eye at the centre of a sphere of radius 2 looking +z: the inner wall at (0, 0, 2),
+        // inward normal −z. A point light at (0, 0, 1): d = 1, cosθ = 1, L = I/d²·cosθ·C/π.
+        let i = DVec3::new(3.0, 5.0, 7.0);
+        let light = Light::Point {
+            position: DVec3::new(0.0, 0.0, 1.0),
+            intensity: i,
+            falloff: Falloff::InverseSquare,
+        };
+        let mut s = scene(
+            vec![
+                particle(DVec3::ZERO, 2.0),
+                particle(DVec3::new(0.0, 6.0, 0.0), 1.0),
+            ],
+            vec![light],
+        );
+        s.particles[0].color = DVec3::new(0.5, 1.0, 0.25);
+        let r = OpaqueRenderer::new(&s);
+        let wall = r.radiance(&Ray::new(DVec3::ZERO, DVec3::Z)).radiance;
+        assert_relative_eq!(wall, i * s.particles[0].color / PI, max_relative = 1e-14);
+        // Off-axis: the wall at (0, 2 sin a, 2 cos a); the light reaches it at an angle.
+        let dir = DVec3::new(0.0, 0.6, 0.8);
+        let x = dir * 2.0;
+        let to_light = DVec3::new(0.0, 0.0, 1.0) - x;
+        let cos = (-dir).dot(to_light.normalize());
+        let expected = i / to_light.length_squared() * cos * s.particles[0].color / PI;
+        let got = r.radiance(&Ray::new(DVec3::ZERO, dir)).radiance;
+        assert_relative_eq!(got, expected, max_relative = 1e-12);
+        // A directional light does not reach the inner wall.
+        s.lights.push(Light::Directional {
+            direction: DVec3::Z,
+            irradiance: DVec3::ONE,
+        });
+        let r = OpaqueRenderer::new(&s);
+        let both = r.radiance(&Ray::new(DVec3::ZERO, DVec3::Z)).radiance;
+        assert_relative_eq!(both, wall, max_relative = 1e-14);
+        // The sphere at (0, 6, 0), seen from outside, gets nothing from the light inside the
+        // big sphere (its lit side faces the light, but the big sphere is in the way).
+        s.lights.pop();
+        let r = OpaqueRenderer::new(&s);
+        let outside = r
+            .radiance(&Ray::new(DVec3::new(0.0, 6.0, -10.0), DVec3::Z))
+            .radiance;
+        assert_eq!(outside, DVec3::ZERO);
+        let below = r
+            .radiance(&Ray::new(DVec3::new(0.0, 3.0, 0.0), DVec3::Y))
+            .radiance;
+        assert_eq!(below, DVec3::ZERO);
     }
 }

@@ -66,6 +66,24 @@ const WG: [f64; 4] = [
     0.417_959_183_673_469_387_755_102_040_816_327,
 ];
 
+/// Kronrod abscissae of G3–K7 on [−1, 1] (positive half, then 0) and their weights.
+#[allow(clippy::excessive_precision)] // the digits as published (Kronrod 1965, Piessens 1983)
+const XGK7: [f64; 4] = [
+    0.960_491_268_708_020_283_423_507_092_629_080,
+    0.774_596_669_241_483_377_035_853_079_956_480,
+    0.434_243_749_346_802_558_002_071_502_844_628,
+    0.0,
+];
+#[allow(clippy::excessive_precision)] // the digits as published (Kronrod 1965, Piessens 1983)
+const WGK7: [f64; 4] = [
+    0.104_656_226_026_467_265_193_823_857_192_073,
+    0.268_488_089_868_333_440_728_569_280_666_710,
+    0.401_397_414_775_962_222_905_051_818_618_432,
+    0.450_916_538_658_474_142_345_110_087_045_571,
+];
+/// Gauss weights of the 3-point rule, for XGK7[1] and the centre.
+const WG3: [f64; 2] = [5.0 / 9.0, 8.0 / 9.0];
+
 /// Multiplier of the error estimate of a segment that contains a known kink.
 pub const KINK_SAFETY: f64 = 2.0;
 
@@ -79,32 +97,71 @@ pub struct RuleResult {
     pub error: DVec3,
 }
 
+/// A Gauss–Kronrod pair on [−1, 1]: the Kronrod abscissae (positive half, then 0), their
+/// weights, and the Gauss weights of the nodes at odd positions of `xgk` and of the centre.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Rule {
+    xgk: &'static [f64],
+    wgk: &'static [f64],
+    wg: &'static [f64],
+}
+
+impl Rule {
+    /// G7–K15 (QUADPACK `qk15`).
+    pub const K15: Rule = Rule {
+        xgk: &XGK,
+        wgk: &WGK,
+        wg: &WG,
+    };
+    /// G3–K7: Kronrod's extension of the 3-point Gauss rule (exact to degree 9 at the Kronrod
+    /// nodes, 5 at the Gauss nodes).
+    pub const K7: Rule = Rule {
+        xgk: &XGK7,
+        wgk: &WGK7,
+        wg: &WG3,
+    };
+
+    /// Integrand evaluations per segment.
+    pub const fn nodes(&self) -> usize {
+        2 * self.xgk.len() - 1
+    }
+}
+
 /// G7–K15 on [lo, hi] with the error estimate described in the module documentation.
 pub fn gauss_kronrod_15(f: &mut impl FnMut(f64) -> DVec3, lo: f64, hi: f64) -> RuleResult {
+    gauss_kronrod(Rule::K15, f, lo, hi)
+}
+
+/// A Gauss–Kronrod pair on [lo, hi]: the Kronrod value and the error estimate described in the
+/// module documentation (the same formula for both pairs; for G3–K7 QUADPACK's heuristic only
+/// ever raises the plain |K − G| further, it never lowers it).
+pub fn gauss_kronrod(rule: Rule, f: &mut impl FnMut(f64) -> DVec3, lo: f64, hi: f64) -> RuleResult {
     let centre = 0.5 * (lo + hi);
     let half = 0.5 * (hi - lo);
+    let n = rule.xgk.len() - 1;
     let mut fv = [DVec3::ZERO; 15];
-    for j in 0..7 {
-        let dx = half * XGK[j];
+    for j in 0..n {
+        let dx = half * rule.xgk[j];
         fv[2 * j] = f(centre - dx);
         fv[2 * j + 1] = f(centre + dx);
     }
-    fv[14] = f(centre);
-    let mut resk = WGK[7] * fv[14];
-    let mut resg = WG[3] * fv[14];
-    for j in 0..7 {
+    let fc = f(centre);
+    let fv = &fv[..2 * n];
+    let mut resk = rule.wgk[n] * fc;
+    let mut resg = rule.wg[rule.wg.len() - 1] * fc;
+    for j in 0..n {
         let pair = fv[2 * j] + fv[2 * j + 1];
-        resk += WGK[j] * pair;
+        resk += rule.wgk[j] * pair;
         if j % 2 == 1 {
-            resg += WG[j / 2] * pair;
+            resg += rule.wg[j / 2] * pair;
         }
     }
     let mean = 0.5 * resk;
-    let mut resabs = WGK[7] * fv[14].abs();
-    let mut resasc = WGK[7] * (fv[14] - mean).abs();
-    for j in 0..7 {
-        resabs += WGK[j] * (fv[2 * j].abs() + fv[2 * j + 1].abs());
-        resasc += WGK[j] * ((fv[2 * j] - mean).abs() + (fv[2 * j + 1] - mean).abs());
+    let mut resabs = rule.wgk[n] * fc.abs();
+    let mut resasc = rule.wgk[n] * (fc - mean).abs();
+    for j in 0..n {
+        resabs += rule.wgk[j] * (fv[2 * j].abs() + fv[2 * j + 1].abs());
+        resasc += rule.wgk[j] * ((fv[2 * j] - mean).abs() + (fv[2 * j + 1] - mean).abs());
     }
     let h = half.abs();
     let diff = ((resk - resg) * h).abs();
@@ -118,9 +175,9 @@ pub fn gauss_kronrod_15(f: &mut impl FnMut(f64) -> DVec3, lo: f64, hi: f64) -> R
         }
     }
     for c in 0..3 {
-        // The channels share their nodes: a G7–K15 difference that cancels by luck in one
-        // channel does not mean that channel is resolved. Each channel's estimate is at least
-        // the worst channel's error relative to its variation (resasc), scaled to its own.
+        // The channels share their nodes: a Gauss–Kronrod difference that cancels by luck in
+        // one channel does not mean that channel is resolved. Each channel's estimate is at
+        // least the worst channel's error relative to its variation (resasc), scaled to its own.
         error[c] = error[c].max(relative * resasc[c]);
         error[c] = error[c].max(50.0 * f64::EPSILON * resabs[c]);
     }
@@ -135,8 +192,19 @@ pub fn gauss_kronrod_15(f: &mut impl FnMut(f64) -> DVec3, lo: f64, hi: f64) -> R
 /// `optics::kinks`) becomes f(g(s))·g′(s) ~ s·√s·…, smooth enough for the rule to converge
 /// fast, and a smooth integrand stays smooth (a cubic change of variable).
 pub fn gauss_kronrod_15_smoothed(f: &mut impl FnMut(f64) -> DVec3, lo: f64, hi: f64) -> RuleResult {
+    gauss_kronrod_smoothed(Rule::K15, f, lo, hi)
+}
+
+/// [`gauss_kronrod`] after the endpoint-smoothing substitution of [`gauss_kronrod_15_smoothed`].
+pub fn gauss_kronrod_smoothed(
+    rule: Rule,
+    f: &mut impl FnMut(f64) -> DVec3,
+    lo: f64,
+    hi: f64,
+) -> RuleResult {
     let w = hi - lo;
-    gauss_kronrod_15(
+    gauss_kronrod(
+        rule,
         &mut |s| {
             let g = s * s * (3.0 - 2.0 * s);
             let dg = 6.0 * s * (1.0 - s);
@@ -206,6 +274,18 @@ pub fn integrate_adaptive(
     pieces: &[Piece],
     tol: f64,
     max_segments: usize,
+    f: impl FnMut(usize, f64) -> DVec3,
+    kink_in: impl Fn(usize, f64, f64) -> Option<f64>,
+) -> AdaptiveResult {
+    integrate_adaptive_with(Rule::K15, pieces, tol, max_segments, f, kink_in)
+}
+
+/// [`integrate_adaptive`] with the Gauss–Kronrod pair `rule` on every segment.
+pub fn integrate_adaptive_with(
+    rule: Rule,
+    pieces: &[Piece],
+    tol: f64,
+    max_segments: usize,
     mut f: impl FnMut(usize, f64) -> DVec3,
     kink_in: impl Fn(usize, f64, f64) -> Option<f64>,
 ) -> AdaptiveResult {
@@ -219,9 +299,9 @@ pub fn integrate_adaptive(
             let hair = (hi - lo) * 1e-9;
             let near_kink = kink_in(tag, lo - hair, hi + hair).is_some();
             let r = if near_kink {
-                gauss_kronrod_15_smoothed(&mut |u| f(tag, u), lo, hi)
+                gauss_kronrod_smoothed(rule, &mut |u| f(tag, u), lo, hi)
             } else {
-                gauss_kronrod_15(&mut |u| f(tag, u), lo, hi)
+                gauss_kronrod(rule, &mut |u| f(tag, u), lo, hi)
             };
             let safety = if near_kink { KINK_SAFETY } else { 1.0 };
             Segment {
@@ -240,7 +320,7 @@ pub fn integrate_adaptive(
             continue;
         }
         let s = evaluate(p.lo, p.hi, p.weight, p.tag, &mut f);
-        evaluations += NODES_PER_SEGMENT;
+        evaluations += rule.nodes();
         total_error += s.error;
         heap.push(Priority(s.error.max_element(), segments.len()));
         segments.push(s);
@@ -273,7 +353,7 @@ pub fn integrate_adaptive(
         total_error -= s.error;
         for (lo, hi) in [(s.lo, mid), (mid, s.hi)] {
             let child = evaluate(lo, hi, s.weight, s.tag, &mut f);
-            evaluations += NODES_PER_SEGMENT;
+            evaluations += rule.nodes();
             total_error += child.error;
             heap.push(Priority(child.error.max_element(), segments.len()));
             segments.push(child);

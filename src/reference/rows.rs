@@ -4,7 +4,9 @@
 //! of the scene (DESIGN.md §3: bit-identical for any thread count), so the rows of a part hold
 //! exactly the bits the one-machine render holds there.
 
-use super::{estimator_for, render_pixel, stored_pixel, RenderOptions, RenderStats};
+use super::{
+    estimator_for, render_pixel, stored_pixel, worse_unconverged, RenderOptions, RenderStats,
+};
 use crate::error::{PgtError, Result};
 use crate::image_io::RgbImage;
 use crate::scene::Scene;
@@ -44,17 +46,23 @@ pub fn render_rows(scene: &Scene, options: &RenderOptions, rows: &[u32]) -> Resu
                 let mut radiance = Vec::with_capacity(w as usize);
                 let mut error = Vec::with_capacity(w as usize);
                 let mut shadow_rays = 0u64;
+                let (mut unconverged, mut worst) = (0u64, None);
                 for px in 0..w {
-                    let (rad, err, rays) = render_pixel(camera, estimator.as_ref(), px, py, k);
+                    let (rad, err, rays, not_converged) =
+                        render_pixel(camera, estimator.as_ref(), px, py, k);
                     let (r, e) = stored_pixel(rad, err);
                     radiance.push(r);
                     error.push(e);
                     shadow_rays += rays;
+                    if not_converged {
+                        unconverged += 1;
+                        worst = worse_unconverged(worst, (px, py, err.max_element()));
+                    }
                 }
                 if let Some(bar) = &bar {
                     bar.inc(1);
                 }
-                (radiance, error, shadow_rays)
+                (radiance, error, shadow_rays, unconverged, worst)
             })
             .collect::<Vec<_>>()
     };
@@ -68,10 +76,15 @@ pub fn render_rows(scene: &Scene, options: &RenderOptions, rows: &[u32]) -> Resu
     image.pixels.clear();
     err_image.pixels.clear();
     let mut shadow_rays = 0;
-    for (radiance, error, rays) in results {
+    let (mut unconverged, mut worst_unconverged) = (0, None);
+    for (radiance, error, rays, row_unconverged, row_worst) in results {
         image.pixels.extend(radiance);
         err_image.pixels.extend(error);
         shadow_rays += rays;
+        unconverged += row_unconverged;
+        if let Some(p) = row_worst {
+            worst_unconverged = worse_unconverged(worst_unconverged, p);
+        }
     }
     let pixels = w as u64 * height as u64;
     let (error, max_error, mean_error) = if estimator.estimates_error() {
@@ -92,6 +105,8 @@ pub fn render_rows(scene: &Scene, options: &RenderOptions, rows: &[u32]) -> Resu
             seconds: start.elapsed().as_secs_f64(),
             max_error,
             mean_error,
+            unconverged,
+            worst_unconverged,
         },
     })
 }

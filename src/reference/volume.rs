@@ -53,9 +53,21 @@
 //! naive "Q at the entry point" would give L_l,rest, which no finite Θmax approaches. An eye
 //! inside a Θmax = 1 particle sees its colour (c = ∞). Several Θmax = 1 particles entered at the
 //! same point act as one (mean colour, largest c).
+//!
+//! **Huge σ.** Where the skin depth 1/σ falls below about 1e6 f64 spacings of positions at the
+//! entry point (and the interval is optically deep), node positions and shadow chords can no
+//! longer resolve it: the quadrature would collapse onto the entry point. Such an interval is
+//! replaced by the same σ → ∞ limit, its particles of unresolved σ taking the place of the
+//! Θmax = 1 ones, and the O(1/σ) remainder goes into err (`VolumeRenderer::limit_remainder`).
+//! Finite σ that overflow their sum in an overlap are the limit the same way.
+//!
+//! **Shadow rays** test only the candidate occluders of their camera-ray interval
+//! (`reference::shadow`): one BVH query per interval and light, the same hits as a traversal of
+//! the whole BVH.
 
-use super::quadrature::{integrate_adaptive, Piece};
+use super::quadrature::{integrate_adaptive_with, Piece, Rule};
 use super::riemann::midpoint_sum;
+use super::shadow::Occluders;
 use super::{Integrator, RadianceEstimator, Sample};
 use crate::geometry::{Bvh, Hit, Ray};
 use crate::optics::emission::{composite, composite_by, opacity};
@@ -65,6 +77,9 @@ use crate::optics::model::{LightNeed, Model};
 use crate::optics::source::{surface_limit_weight, LightSample, SourceParams};
 use crate::scene::Scene;
 use glam::DVec3;
+
+/// The Gauss–Kronrod pair of the lit and single-scatter integrals (see `integrate_per_light`).
+pub const QUADRATURE_RULE: Rule = Rule::K15;
 
 /// Segments per pixel and light at most; beyond it the remaining error estimate is reported as
 /// it stands (the pixel then may miss `tol`, and says so in its `err` value).
@@ -90,6 +105,8 @@ struct ShadowScratch {
     cut: IntervalScratch,
     lights: Vec<LightSample>,
     rays: u64,
+    /// Candidate occluders per interval of the camera ray, for the light being integrated.
+    occluders: Vec<Occluders>,
 }
 
 impl<'a> VolumeRenderer<'a> {
@@ -130,20 +147,32 @@ impl<'a> VolumeRenderer<'a> {
         };
         sh.rays += 1;
         self.bvh.all_hits(&ray, 0.0, inc.distance, &mut sh.hits);
+        Some(self.shadow_composite(inc.distance, inc.irradiance, skip, sh))
+    }
+
+    /// The emission model along a shadow ray of length `distance` whose hits are in `sh.hits`,
+    /// with the light's `irradiance` as background (DESIGN.md §2, lit model).
+    fn shadow_composite(
+        &self,
+        distance: f64,
+        irradiance: DVec3,
+        skip: impl Fn(u32) -> bool,
+        sh: &mut ShadowScratch,
+    ) -> LightSample {
         self.cutter.cut(
             &sh.hits,
             0.0,
-            inc.distance,
+            distance,
             skip,
             &mut sh.cut,
             &mut sh.intervals,
         );
-        let c = composite(&sh.intervals, inc.irradiance);
-        Some(LightSample {
+        let c = composite(&sh.intervals, irradiance);
+        LightSample {
             radiance: c.radiance,
-            irradiance: inc.irradiance,
+            irradiance,
             transmittance: c.transmittance,
-        })
+        }
     }
 
     /// Q(x) of the scene's model (DESIGN.md §2) at a point inside interval `iv`.
@@ -157,12 +186,46 @@ impl<'a> VolumeRenderer<'a> {
         self.model.source(&self.params, iv, &sh.lights)
     }
 
-    /// The part of Q(x) that light `l` contributes (Q is linear in the lights, DESIGN.md §2):
-    /// lit w·L_l(x); single-scatter α(x)·E_l(x)·T_l(x)/4π.
-    fn light_source(&self, x: DVec3, iv: &Interval, l: usize, sh: &mut ShadowScratch) -> DVec3 {
-        let Some(s) = self.light_sample(x, l, |_| false, sh) else {
+    /// The part of Q(x) that light `l` contributes at x = ray.at(t) in interval `k` (Q is
+    /// linear in the lights, DESIGN.md §2): lit w·L_l(x); single-scatter α(x)·E_l(x)·T_l(x)/4π.
+    /// The shadow ray tests only the candidate occluders of interval `k` (`reference::shadow`),
+    /// gathered on first use.
+    fn light_source(
+        &self,
+        ray: &Ray,
+        t: f64,
+        (k, iv): (usize, &Interval),
+        l: usize,
+        sh: &mut ShadowScratch,
+    ) -> DVec3 {
+        let x = ray.at(t);
+        let light = &self.scene.lights[l];
+        let Some(inc) = light.incident_at(x) else {
             return DVec3::ZERO;
         };
+        if !inc.irradiance.is_finite() {
+            return DVec3::ZERO;
+        }
+        if sh.occluders.len() <= k {
+            sh.occluders.resize_with(k + 1, Occluders::default);
+        }
+        if !sh.occluders[k].covers(k, l, t) {
+            sh.occluders[k].gather(
+                &self.bvh,
+                self.cutter.particles(),
+                ray,
+                (k, l),
+                light,
+                (iv.t0, iv.t1),
+            );
+        }
+        let shadow_ray = Ray {
+            origin: x,
+            direction: inc.toward,
+        };
+        sh.rays += 1;
+        sh.occluders[k].hits(&shadow_ray, inc.distance, &mut sh.hits);
+        let s = self.shadow_composite(inc.distance, inc.irradiance, |_| false, sh);
         self.model.light_source(&self.params, iv, &s)
     }
 
@@ -177,10 +240,11 @@ impl<'a> VolumeRenderer<'a> {
         intervals: &[Interval],
         pieces: &[Piece],
         sh: &mut ShadowScratch,
-    ) -> (DVec3, DVec3) {
+    ) -> (DVec3, DVec3, bool) {
         let render = &self.scene.render;
         let mut value = DVec3::ZERO;
         let mut error = DVec3::ZERO;
+        let mut unconverged = false;
         let k = self.model.emission_factor(&self.params);
         if k != 0.0 {
             for p in pieces {
@@ -188,13 +252,11 @@ impl<'a> VolumeRenderer<'a> {
             }
         }
         let (Some(first), Some(last)) = (intervals.first(), intervals.last()) else {
-            return (value, error);
+            return (value, error, unconverged);
         };
         let m = self.scene.lights.len();
-        let t_of = |k: usize, u: f64| {
-            let iv = &intervals[k];
-            (iv.t0 - (-u).ln_1p() / iv.sigma).clamp(iv.t0, iv.t1)
-        };
+        // pieces[k] spans the whole of interval k in u: [0, U_k] (built so by the caller).
+        let t_of = |k: usize, u: f64| t_at(&intervals[k], pieces[k].hi, u);
         let mut kinks = Vec::new();
         let mut split = Vec::with_capacity(pieces.len());
         for (l, light) in self.scene.lights.iter().enumerate() {
@@ -241,25 +303,51 @@ impl<'a> VolumeRenderer<'a> {
                 let u = opacity(iv.sigma * (t - iv.t0));
                 (u > lo && u < hi).then_some(u)
             };
-            let r = integrate_adaptive(
+            let tol = render.tol / m as f64;
+            let r = integrate_adaptive_with(
+                QUADRATURE_RULE,
                 &split,
-                render.tol / m as f64,
+                tol,
                 MAX_SEGMENTS,
-                |k, u| self.light_source(ray.at(t_of(k, u)), &intervals[k], l, sh),
+                |k, u| self.light_source(ray, t_of(k, u), (k, &intervals[k]), l, sh),
                 kink_in,
             );
             value += r.value;
             error += r.error;
+            unconverged |= !r.converged;
         }
-        (value, error)
+        (value, error, unconverged)
+    }
+
+    /// A bound on |finite-σ integral − σ → ∞ limit| for a dense interval (per channel, before
+    /// the transmittance in front of it). The limit neglects the variation of Q over a few skin
+    /// depths, whose first-order term is O(1/σ) against the geometry of the entry (the interval
+    /// length Δ = 2r·μ_in for a sphere entered from outside), i.e. O(1/τ) relative to the
+    /// largest source: err = F·Qmax/τ with F = [`LIMIT_REMAINDER_FACTOR`], generous against the
+    /// curvature and light-angle factors, and Qmax ≥ Q for every model of DESIGN.md §2 (the
+    /// emission colour, plus every light's unoccluded irradiance weighted by 1 + albedo, plus
+    /// the limit value itself). Where the limit applies, τ ≥ 1e7 or so, and the term is tiny.
+    fn limit_remainder(&self, ray: &Ray, iv: &Interval, q: DVec3) -> DVec3 {
+        let x = ray.at(iv.t0);
+        let mut q_max = iv.emission + q.abs();
+        for light in &self.scene.lights {
+            if let Some(inc) = light.incident_at(x) {
+                q_max += (DVec3::ONE + iv.albedo) * inc.irradiance;
+            }
+        }
+        let tau = iv.sigma * iv.length();
+        q_max * (LIMIT_REMAINDER_FACTOR / tau).min(1.0)
     }
 
     /// Q∞, the σ → ∞ limit of the source of a Θmax = 1 interval (module documentation).
+    /// Particles with σ ≥ `sigma_opaque` count as Θmax = 1 here (∞ for a Θmax = 1 interval; the
+    /// resolution limit of `beyond_resolution` for a huge but finite σ).
     fn opaque_source(
         &self,
         ray: &Ray,
         iv: &Interval,
         hits: &[Hit],
+        sigma_opaque: f64,
         sh: &mut ShadowScratch,
     ) -> DVec3 {
         if self.model.light_need() == LightNeed::None {
@@ -270,7 +358,7 @@ impl<'a> VolumeRenderer<'a> {
         // The Θmax = 1 particles active just after t0 (all start at t0: it is the first such
         // interval); whether the ray entered each through its surface there, and its normal.
         let is_opaque_here = |h: &Hit| {
-            particles[h.index as usize].sigma == f64::INFINITY
+            particles[h.index as usize].sigma >= sigma_opaque
                 && h.chord.t_enter.max(0.0) <= iv.t0
                 && h.chord.t_exit > iv.t0
         };
@@ -321,6 +409,50 @@ impl<'a> VolumeRenderer<'a> {
     }
 }
 
+/// Optical depth from which an interval whose skin depth the ray parameter cannot resolve is
+/// replaced by its σ → ∞ limit: its transmittance e^{−τ} < 1e-30 is far below any tolerance.
+const LIMIT_MIN_DEPTH: f64 = 70.0;
+/// σ·δ (δ: the f64 resolution of positions near the entry point) from which the quadrature in u
+/// can no longer resolve the skin depth 1/σ: node positions, shadow chords and the particle's
+/// own optical depth along them carry a relative error of this order.
+const RESOLUTION_LIMIT: f64 = 1e-6;
+/// A particle active where a dense interval starts takes part in its σ → ∞ limit (its shadow
+/// chord is replaced by the limit's) when its own σ is at least this part of the unresolved σ:
+/// a thinner one adds an optical depth below 1e-3·RESOLUTION_LIMIT over the positions the
+/// limit stands for.
+const LIMIT_MEMBER_FRACTION: f64 = 1e-3;
+/// Coefficient of the first-order remainder of the σ → ∞ limit, err = F·Qmax/τ (see
+/// `VolumeRenderer::limit_remainder`).
+const LIMIT_REMAINDER_FACTOR: f64 = 1e3;
+
+/// Whether interval `iv` (finite σ) is too dense for the quadrature: its skin depth 1/σ is
+/// within 1/[`RESOLUTION_LIMIT`] f64 spacings of the ray parameter near its start, and it is
+/// optically deep. Then the σ → ∞ limit is the better answer (DESIGN.md §3: "very large σ
+/// converge to the Θmax = 1 limit, never to a collapsed quadrature"). Returns the σ from which a
+/// particle counts as part of that limit: the particles whose own skin depth is unresolved.
+fn beyond_resolution(ray: &Ray, iv: &Interval) -> Option<f64> {
+    let sigma_unresolved = unresolved_sigma(ray, iv);
+    (iv.sigma >= sigma_unresolved && iv.sigma * iv.length() >= LIMIT_MIN_DEPTH)
+        .then_some(sigma_unresolved * LIMIT_MEMBER_FRACTION)
+}
+
+/// The σ whose skin depth is [`RESOLUTION_LIMIT`] of the f64 resolution δ of positions at the
+/// start of `iv` (x = o + t·d rounds by about 8ε·(|o| + |t|)).
+fn unresolved_sigma(ray: &Ray, iv: &Interval) -> f64 {
+    let delta = 8.0 * f64::EPSILON * (ray.origin.abs().max_element() + iv.t0.abs());
+    RESOLUTION_LIMIT / delta.max(f64::MIN_POSITIVE)
+}
+
+/// The ray parameter t(u) = t0 − ln(1 − u)/σ of interval `iv` (module documentation), with u
+/// clamped to [0, U], U = 1 − e^{−σΔ} the interval's end. Callers widen segments by a hair to
+/// see kinks at their ends; for an optical depth above ~37, U rounds to 1 and u a hair above it
+/// would make ln_1p(−u) NaN.
+fn t_at(iv: &Interval, u_max: f64, u: f64) -> f64 {
+    // max/min rather than clamp: never a panic, whatever u_max is.
+    let u = u.max(0.0).min(u_max);
+    (iv.t0 - (-u).ln_1p() / iv.sigma).clamp(iv.t0, iv.t1)
+}
+
 impl RadianceEstimator for VolumeRenderer<'_> {
     fn radiance(&self, ray: &Ray) -> Sample {
         let render = &self.scene.render;
@@ -344,6 +476,7 @@ impl RadianceEstimator for VolumeRenderer<'_> {
                     .radiance,
                 error: DVec3::ZERO,
                 shadow_rays: 0,
+                unconverged: false,
             };
         }
         let mut sh = ShadowScratch::default();
@@ -352,9 +485,20 @@ impl RadianceEstimator for VolumeRenderer<'_> {
         let mut transmittance = 1.0;
         let mut end = DVec3::ZERO;
         let mut finite = intervals.len();
+        let mut limit_error = DVec3::ZERO;
         for (k, iv) in intervals.iter().enumerate() {
             if iv.sigma.is_infinite() {
-                end = transmittance * self.opaque_source(ray, iv, &hits, &mut sh);
+                // Θmax = 1 particles, or finite σ that overflowed their sum: both are the limit.
+                let sigma_opaque = unresolved_sigma(ray, iv) * LIMIT_MEMBER_FRACTION;
+                end = transmittance * self.opaque_source(ray, iv, &hits, sigma_opaque, &mut sh);
+                finite = k;
+                transmittance = 0.0;
+                break;
+            }
+            if let Some(sigma_opaque) = beyond_resolution(ray, iv) {
+                let q = self.opaque_source(ray, iv, &hits, sigma_opaque, &mut sh);
+                end = transmittance * q;
+                limit_error = transmittance * self.limit_remainder(ray, iv, q);
                 finite = k;
                 transmittance = 0.0;
                 break;
@@ -370,7 +514,7 @@ impl RadianceEstimator for VolumeRenderer<'_> {
         }
         let background = transmittance * render.background;
         let intervals = &intervals[..finite];
-        let (value, error) = match self.integrator {
+        let (value, error, unconverged) = match self.integrator {
             Integrator::Riemann { samples } => {
                 let mut sum = DVec3::ZERO;
                 for p in &pieces {
@@ -380,14 +524,15 @@ impl RadianceEstimator for VolumeRenderer<'_> {
                             self.source(ray.at(t), iv, &mut sh)
                         });
                 }
-                (sum, DVec3::ZERO)
+                (sum, DVec3::ZERO, false)
             }
             Integrator::Adaptive => self.integrate_per_light(ray, intervals, &pieces, &mut sh),
         };
         Sample {
             radiance: background + end + value,
-            error,
+            error: error + limit_error,
             shadow_rays: sh.rays,
+            unconverged: unconverged || !(value + end).is_finite(),
         }
     }
 
@@ -395,5 +540,31 @@ impl RadianceEstimator for VolumeRenderer<'_> {
     /// Riemann sums have no estimate, so no `err` layer is written for them.
     fn estimates_error(&self) -> bool {
         matches!(self.integrator, Integrator::Adaptive)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn t_of_u_stays_in_the_interval_for_deep_intervals() {
+        // Optical depth 50: U = 1 − e^{−50} rounds to 1; a segment end widened by a hair lies
+        // above it and must give the interval's end, not NaN.
+        let iv = Interval {
+            t0: 2.0,
+            t1: 3.0,
+            sigma: 50.0,
+            emission: DVec3::ONE,
+            albedo: DVec3::ONE,
+        };
+        let u_max = crate::optics::emission::opacity(iv.sigma * iv.length());
+        assert_eq!(u_max, 1.0);
+        for u in [u_max, u_max + 1e-9, 1.5, f64::INFINITY] {
+            assert_eq!(t_at(&iv, u_max, u), iv.t1, "u = {u}");
+        }
+        assert_eq!(t_at(&iv, u_max, -1e-9), iv.t0);
+        let mid = t_at(&iv, u_max, 0.5);
+        assert!((mid - (2.0 + std::f64::consts::LN_2 / 50.0)).abs() < 1e-15);
     }
 }

@@ -1,0 +1,377 @@
+//! `pgt bench`: the speed of the exact reference on standard workloads, as one table of ratios
+//! (DESIGN.md §7), so that one run on a noisy machine shows what changed.
+//!
+//! | workload | scene |
+//! |---|---|
+//! | `1uun` | 1UUN chains A+B (2,758 atoms) from `DATA/pdb/1uun_opm_oriented.pdb`, or, where the file is missing, a generated protein-sized set (2,758 spheres, radii 1.2–1.9 Å, one per 20 Å³) |
+//! | `random` | the random set of `pgt gen random` with its defaults (73,642 spheres) |
+//! | `million` | 1,000,000 random spheres (`pgt gen random --count 1000000`), emission model only |
+//! | `million-lit` | the same, lit (not in the default list: minutes on two cores) |
+//!
+//! Every scene is the bare-file default (DESIGN.md §1): the camera frames the bounding sphere,
+//! the thesis's two directional lights (green down, blue up), black background, Θmax = 0.5, lit
+//! model, `tol` 1e-4. Each lit workload is rendered three times: adaptive (the reference), the
+//! thesis's Riemann sums with 100 samples per interval, and the emission model, and the table
+//! gives the adaptive time as a ratio to both. `--accuracy` adds a tol 1e-9 render and the
+//! largest error of the adaptive and Riemann images against it (the target: adaptive ≥ 100×
+//! smaller).
+
+use super::Outcome;
+use crate::formats::random::{generate, RandomSpec, SplitMix64, THESIS_COUNT};
+use crate::optics::extinction::sigma_from_opacity;
+use crate::optics::model::LightNeed;
+use crate::optics::models;
+use crate::reference::{self, Integrator, RenderOptions, RenderOutput};
+use crate::scene::{
+    default_camera, thesis_lights, OpticalModel, Particle, RenderSettings, Scene, SceneLoadOptions,
+};
+use anyhow::Context;
+use clap::{Args, ValueEnum};
+use glam::DVec3;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+
+/// Θmax of every bench particle.
+const OPACITY: f64 = 0.5;
+/// Quadrature tolerance of the bench's lit renders.
+const TOL: f64 = 1e-4;
+/// Tolerance of the `--accuracy` truth.
+const TRUTH_TOL: f64 = 1e-9;
+/// Samples per interval of the Riemann baseline (the thesis's scheme).
+const RIEMANN_SAMPLES: u32 = 100;
+/// Atoms of 1UUN chains A+B, and of the generated stand-in.
+const PROTEIN_ATOMS: usize = 2758;
+/// Å³ per atom of the stand-in: about a protein's density.
+const VOLUME_PER_ATOM: f64 = 20.0;
+/// Spheres of the `million` workloads.
+const MILLION: usize = 1_000_000;
+
+/// A standard workload of `pgt bench`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum Workload {
+    /// 1UUN chains A+B, lit (or a generated protein-sized set).
+    #[value(name = "1uun")]
+    Protein,
+    /// The random set (73,642 spheres), lit.
+    Random,
+    /// 1,000,000 random spheres, emission model.
+    Million,
+    /// 1,000,000 random spheres, lit.
+    MillionLit,
+}
+
+/// Options of `pgt bench`.
+#[derive(Debug, Args)]
+pub struct BenchArgs {
+    /// Image side in pixels (square images).
+    #[arg(long, default_value_t = 512)]
+    pub size: u32,
+    /// Workloads to run, comma-separated.
+    #[arg(long, value_enum, value_delimiter = ',', default_values = ["1uun", "random", "million"])]
+    pub workloads: Vec<Workload>,
+    /// Skip the Riemann-100 and emission baselines (only the adaptive renders).
+    #[arg(long)]
+    pub no_baselines: bool,
+    /// Also render a tol 1e-9 truth and report the largest errors against it.
+    #[arg(long)]
+    pub accuracy: bool,
+    /// Worker threads (default: rayon's, one per core).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Folder with `pdb/1uun_opm_oriented.pdb` (default `../shared/data`).
+    #[arg(long, default_value = "../shared/data")]
+    pub data: PathBuf,
+}
+
+/// One line of the table.
+struct Row {
+    workload: String,
+    renderer: String,
+    size: u32,
+    spheres: usize,
+    out: RenderOutput,
+    /// Wall seconds of the whole render, BVH build included (`out.stats.seconds` is the
+    /// pixels alone).
+    wall: f64,
+    /// Seconds of the Riemann-100 and emission renders of the same scene, where run.
+    riemann: Option<f64>,
+    emission: Option<f64>,
+    /// Largest |value − truth| over pixels and channels, where `--accuracy` asked for it.
+    max_error: Option<f64>,
+}
+
+pub fn run(args: BenchArgs) -> anyhow::Result<Outcome> {
+    crate::scene::check_image_size(args.size as i64, args.size as i64)
+        .map_err(|e| anyhow::anyhow!("--size: {e}"))?;
+    let mut rows = Vec::new();
+    for &w in &args.workloads {
+        let (name, scene) = workload_scene(w, args.size, &args.data)?;
+        eprintln!(
+            "bench: {name}, {} spheres, {}x{}",
+            scene.particles.len(),
+            args.size,
+            args.size
+        );
+        rows.extend(bench_scene(&name, &scene, &args)?);
+    }
+    print!("{}", table(&rows));
+    Ok(Outcome::Success)
+}
+
+/// Renders `scene` with `integrator` (and `model` instead of the scene's, if given).
+fn render(
+    scene: &Scene,
+    model: Option<OpticalModel>,
+    integrator: Integrator,
+    tol: f64,
+    threads: Option<usize>,
+) -> anyhow::Result<(RenderOutput, f64)> {
+    let start = std::time::Instant::now();
+    let mut s = scene.clone();
+    if let Some(m) = model {
+        s.render.model = m;
+    }
+    s.render.tol = tol;
+    let options = RenderOptions {
+        spp: 1,
+        threads,
+        progress: false,
+        integrator,
+    };
+    let out = reference::render(&s, &options)?;
+    Ok((out, start.elapsed().as_secs_f64()))
+}
+
+/// The rows of one workload: adaptive, and (unless skipped) Riemann-100 and emission.
+fn bench_scene(name: &str, scene: &Scene, args: &BenchArgs) -> anyhow::Result<Vec<Row>> {
+    let threads = args.threads;
+    let row = |renderer: &str, (out, wall): (RenderOutput, f64)| Row {
+        workload: name.to_string(),
+        renderer: renderer.to_string(),
+        size: args.size,
+        spheres: scene.particles.len(),
+        out,
+        wall,
+        riemann: None,
+        emission: None,
+        max_error: None,
+    };
+    let lit = scene.render.model.light_need() != LightNeed::None;
+    if !lit {
+        let out = render(scene, None, Integrator::Adaptive, TOL, threads)?;
+        return Ok(vec![row("emission", out)]);
+    }
+    let mut adaptive = row(
+        "adaptive tol 1e-4",
+        render(scene, None, Integrator::Adaptive, TOL, threads)?,
+    );
+    let mut rows = Vec::new();
+    if !args.no_baselines {
+        let samples = Integrator::Riemann {
+            samples: RIEMANN_SAMPLES,
+        };
+        let mut riemann = row("riemann-100", render(scene, None, samples, TOL, threads)?);
+        let emission = row(
+            "emission",
+            render(
+                scene,
+                Some(models::EMISSION),
+                Integrator::Adaptive,
+                TOL,
+                threads,
+            )?,
+        );
+        adaptive.riemann = Some(riemann.wall);
+        adaptive.emission = Some(emission.wall);
+        riemann.riemann = Some(riemann.wall);
+        riemann.emission = Some(emission.wall);
+        if args.accuracy {
+            let (truth, _) = render(scene, None, Integrator::Adaptive, TRUTH_TOL, threads)?;
+            adaptive.max_error = Some(max_difference(&adaptive.out, &truth));
+            riemann.max_error = Some(max_difference(&riemann.out, &truth));
+        }
+        rows.push(adaptive);
+        rows.push(riemann);
+        rows.push(emission);
+    } else {
+        rows.push(adaptive);
+    }
+    Ok(rows)
+}
+
+/// Largest |a − b| over pixels and channels.
+fn max_difference(a: &RenderOutput, b: &RenderOutput) -> f64 {
+    a.image
+        .pixels
+        .iter()
+        .zip(&b.image.pixels)
+        .flat_map(|(p, q)| (0..3).map(move |c| (p[c] as f64 - q[c] as f64).abs()))
+        .fold(0.0, f64::max)
+}
+
+/// The scene of a workload and its name in the table.
+fn workload_scene(w: Workload, size: u32, data: &Path) -> anyhow::Result<(String, Scene)> {
+    match w {
+        Workload::Protein => {
+            let pdb = data.join("pdb").join("1uun_opm_oriented.pdb");
+            if pdb.is_file() {
+                Ok(("1UUN A+B".into(), protein_scene(&pdb, size)?))
+            } else {
+                eprintln!(
+                    "bench: {} not found; using a generated protein-sized set",
+                    pdb.display()
+                );
+                let particles = protein_like();
+                Ok(("protein-like".into(), bare_scene(particles, size)))
+            }
+        }
+        Workload::Random => Ok((
+            "random 73,642".into(),
+            bare_scene(random_set(THESIS_COUNT), size),
+        )),
+        Workload::Million | Workload::MillionLit => {
+            let mut s = bare_scene(random_set(MILLION), size);
+            if w == Workload::Million {
+                s.render.model = models::EMISSION;
+            }
+            Ok(("random 1,000,000".into(), s))
+        }
+    }
+}
+
+/// 1UUN chains A and B with the bare-file defaults (DESIGN.md §1), through the scene loader.
+fn protein_scene(pdb: &Path, size: u32) -> anyhow::Result<Scene> {
+    let text = format!(
+        "[render]\ntol = {TOL:e}\n\n[defaults]\nopacity = {OPACITY}\n\n\
+         [[lights]]\ntype = \"directional\"\ndirection = [0.0, -1.0, 0.0]\nirradiance = [0.0, 1.0, 0.0]\n\n\
+         [[lights]]\ntype = \"directional\"\ndirection = [0.0, 1.0, 0.0]\nirradiance = [0.0, 0.0, 1.0]\n\n\
+         [[include]]\npath = {:?}\nchains = [\"A\", \"B\"]\n",
+        pdb.display().to_string()
+    );
+    let options = SceneLoadOptions {
+        size: Some((size, size)),
+        ..SceneLoadOptions::default()
+    };
+    Scene::from_toml_str(&text, Path::new("bench.toml"), &options)
+        .with_context(|| format!("loading {}", pdb.display()))
+}
+
+/// The default scene of a bare particle file (DESIGN.md §1) around `particles`, lit, tol 1e-4.
+fn bare_scene(particles: Vec<Particle>, size: u32) -> Scene {
+    Scene {
+        source: PathBuf::from("bench"),
+        camera: default_camera(&particles, size, size),
+        render: RenderSettings {
+            tol: TOL,
+            ..RenderSettings::default()
+        },
+        lights: thesis_lights(),
+        particles,
+        warnings: Vec::new(),
+    }
+}
+
+fn particle(center: DVec3, radius: f64, color: DVec3) -> Particle {
+    Particle {
+        center,
+        radius,
+        color,
+        sigma: sigma_from_opacity(OPACITY, radius),
+        albedo: color,
+        ks: 0.0,
+        shininess: 32.0,
+    }
+}
+
+/// `pgt gen random --count n` with its other defaults.
+fn random_set(count: usize) -> Vec<Particle> {
+    let spec = RandomSpec {
+        count,
+        ..RandomSpec::default()
+    };
+    generate(&spec)
+        .into_iter()
+        .map(|p| particle(p.center, p.radius, p.color))
+        .collect()
+}
+
+/// A protein-sized stand-in for 1UUN: 2,758 spheres, radii in [1.2, 1.9] Å, centres uniform in
+/// a cube of 2,758·20 Å³, random colours.
+fn protein_like() -> Vec<Particle> {
+    let side = (PROTEIN_ATOMS as f64 * VOLUME_PER_ATOM).cbrt();
+    let mut rng = SplitMix64::new(1);
+    let vec3 = |rng: &mut SplitMix64, scale: f64| {
+        DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * scale
+    };
+    (0..PROTEIN_ATOMS)
+        .map(|_| {
+            let r = 1.2 + 0.7 * rng.next_f64();
+            let c = vec3(&mut rng, side);
+            let color = vec3(&mut rng, 1.0);
+            particle(c, r, color)
+        })
+        .collect()
+}
+
+/// Peak resident memory of this process in MiB (Linux `VmHWM`), where the system says.
+fn peak_memory_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
+}
+
+/// The table: one row per render, ratios of each time to the Riemann-100 and emission renders
+/// of the same scene.
+fn table(rows: &[Row]) -> String {
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{:<18} {:<18} {:>5} {:>9} {:>9} {:>8} {:>10} {:>8} {:>9} {:>9} {:>10} {:>10}",
+        "workload",
+        "renderer",
+        "size",
+        "spheres",
+        "time s",
+        "setup s",
+        "shadow/px",
+        "Mrays/s",
+        "/riemann",
+        "/emission",
+        "max err",
+        "vs truth"
+    );
+    for r in rows {
+        let st = &r.out.stats;
+        let rays = st.primary_rays + st.shadow_rays;
+        let ratio = |base: Option<f64>| {
+            base.map_or("-".to_string(), |b| format!("{:.3}", r.wall / b.max(1e-9)))
+        };
+        let opt = |v: Option<f64>| v.map_or("-".to_string(), |v| format!("{v:.2e}"));
+        let _ = writeln!(
+            s,
+            "{:<18} {:<18} {:>5} {:>9} {:>9.2} {:>8.2} {:>10.1} {:>8.2} {:>9} {:>9} {:>10} {:>10}",
+            r.workload,
+            r.renderer,
+            r.size,
+            r.spheres,
+            r.wall,
+            r.wall - st.seconds,
+            st.shadow_rays as f64 / st.pixels.max(1) as f64,
+            rays as f64 / st.seconds.max(1e-9) / 1e6,
+            ratio(r.riemann),
+            ratio(r.emission),
+            opt(st.max_error),
+            opt(r.max_error),
+        );
+    }
+    for r in rows {
+        if let Some(w) = super::render::unconverged_warning(&r.out.stats, TOL) {
+            let _ = writeln!(s, "warning: {} {}: {w}", r.workload, r.renderer);
+        }
+    }
+    if let Some(mib) = peak_memory_mib() {
+        let _ = writeln!(s, "peak resident memory {mib:.0} MiB");
+    }
+    s
+}
