@@ -516,13 +516,17 @@ fn run_pass(
             }
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("pgt method"),
-                timestamp_writes: up.timestamps.as_ref().map(|(set, _)| {
-                    wgpu::ComputePassTimestampWrites {
+                // The first band's start and the last band's end (wgpu refuses a pass with
+                // neither index, so the bands between carry none).
+                timestamp_writes: up
+                    .timestamps
+                    .as_ref()
+                    .filter(|_| k == 0 || k == last)
+                    .map(|(set, _)| wgpu::ComputePassTimestampWrites {
                         query_set: set,
                         beginning_of_pass_write_index: (k == 0).then_some(0),
                         end_of_pass_write_index: (k == last).then_some(1),
-                    }
-                }),
+                    }),
             });
             pass.set_pipeline(&pipeline.pipeline);
             pass.set_bind_group(0, &band.bind_group, &[]);
