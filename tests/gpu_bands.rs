@@ -58,7 +58,12 @@ fn banded_images_are_bit_identical_to_one_band() {
             pgt::optics::models::LIT,
             RenderMode::Volume,
         ),
-        ("sorted-blend", &[], pgt::optics::models::EMISSION, RenderMode::Volume),
+        (
+            "sorted-blend",
+            &[],
+            pgt::optics::models::EMISSION,
+            RenderMode::Volume,
+        ),
         ("opaque", &[], pgt::optics::models::LIT, RenderMode::Opaque),
     ];
     for &(method, values, model, mode) in cases {
@@ -69,13 +74,18 @@ fn banded_images_are_bit_identical_to_one_band() {
             assert!(whole.passes > 1, "the case is meant to take several passes");
         }
         assert!(
-            whole.image.pixels.iter().flatten().any(|&v| v != whole.image.pixels[0][0]),
+            whole
+                .image
+                .pixels
+                .iter()
+                .flatten()
+                .any(|&v| v != whole.image.pixels[0][0]),
             "{method}: a blank image proves nothing"
         );
         // 1 row a band (fewer than a workgroup), 3 rows, 8 (one workgroup), 16 (two), 28.
         for rows in [1u64, 3, 8, 16, 28] {
-            let banded = dispatch::run_with_limit(ctx, &pipeline, &buffers, &frame, rows * row)
-                .unwrap();
+            let banded =
+                dispatch::run_with_limit(ctx, &pipeline, &buffers, &frame, rows * row).unwrap();
             let differing = whole
                 .image
                 .pixels
@@ -103,7 +113,9 @@ fn scene_buffers_beyond_the_limit_are_refused_with_the_limit_and_the_size() {
         .unwrap_err()
         .to_string();
     assert!(
-        e.contains("the particle buffer needs 320 bytes, the adapter allows 256 bytes per storage buffer"),
+        e.contains(
+            "the particle buffer needs 320 bytes, the adapter allows 256 bytes per storage buffer"
+        ),
         "{e}"
     );
     // The scene fits in 512 bytes, a row of 64 pixels (1 KiB) does not.

@@ -304,7 +304,12 @@ impl Band {
             contents: bytemuck::bytes_of(frame),
             usage: U::UNIFORM | U::COPY_DST,
         });
-        let output = buffer(ctx, "pgt output", bytes, U::STORAGE | U::COPY_SRC | U::COPY_DST);
+        let output = buffer(
+            ctx,
+            "pgt output",
+            bytes,
+            U::STORAGE | U::COPY_SRC | U::COPY_DST,
+        );
         // In BINDINGS order: frame, particles, nodes, leaf_indices, lights, output, stats.
         let resources = [
             &frame_buf,
@@ -410,7 +415,12 @@ impl Upload {
                 nodes: storage(ctx, "pgt bvh nodes", &scene.nodes),
                 indices: storage(ctx, "pgt bvh indices", &scene.leaf_indices),
                 lights: storage(ctx, "pgt lights", &scene.lights),
-                stats: buffer(ctx, "pgt stats", STATS_BYTES, U::STORAGE | U::COPY_SRC | U::COPY_DST),
+                stats: buffer(
+                    ctx,
+                    "pgt stats",
+                    STATS_BYTES,
+                    U::STORAGE | U::COPY_SRC | U::COPY_DST,
+                ),
             };
             let bands: Vec<Band> = rows
                 .iter()
@@ -518,15 +528,13 @@ fn run_pass(
                 label: Some("pgt method"),
                 // The first band's start and the last band's end (wgpu refuses a pass with
                 // neither index, so the bands between carry none).
-                timestamp_writes: up
-                    .timestamps
-                    .as_ref()
-                    .filter(|_| k == 0 || k == last)
-                    .map(|(set, _)| wgpu::ComputePassTimestampWrites {
+                timestamp_writes: up.timestamps.as_ref().filter(|_| k == 0 || k == last).map(
+                    |(set, _)| wgpu::ComputePassTimestampWrites {
                         query_set: set,
                         beginning_of_pass_write_index: (k == 0).then_some(0),
                         end_of_pass_write_index: (k == last).then_some(1),
-                    }),
+                    },
+                ),
             });
             pass.set_pipeline(&pipeline.pipeline);
             pass.set_bind_group(0, &band.bind_group, &[]);
@@ -557,9 +565,12 @@ fn run_pass(
 fn read_image(ctx: &GpuContext, up: &Upload, width: u32, height: u32) -> Result<RgbImage> {
     let mut image = RgbImage::new(width, height);
     for band in &up.bands {
-        copy_bands(ctx, "reading the image back", std::slice::from_ref(band), |b| {
-            Some((&b.output, &up.out_read))
-        })?;
+        copy_bands(
+            ctx,
+            "reading the image back",
+            std::slice::from_ref(band),
+            |b| Some((&b.output, &up.out_read)),
+        )?;
         let data = read_back(ctx, &up.out_read, band.bytes)?;
         ctx.check_uncaptured("reading the image back")?;
         let floats: &[[f32; 4]] = bytemuck::try_cast_slice(&data)
@@ -707,7 +718,10 @@ mod tests {
         let b = bands(10, 45, 10 * 16 * 20).unwrap();
         assert_eq!(b, vec![(0, 16), (16, 16), (32, 13)]);
         // Fewer rows than a workgroup fit: as many as fit.
-        assert_eq!(bands(10, 7, 10 * 16 * 3).unwrap(), vec![(0, 3), (3, 3), (6, 1)]);
+        assert_eq!(
+            bands(10, 7, 10 * 16 * 3).unwrap(),
+            vec![(0, 3), (3, 3), (6, 1)]
+        );
         // 8192² in lavapipe's 128 MiB: 8 bands of 1024 rows.
         let b = bands(8192, 8192, 128 << 20).unwrap();
         assert_eq!(b.len(), 8);
@@ -718,7 +732,10 @@ mod tests {
     fn a_row_beyond_the_limit_is_an_error_with_both_sizes() {
         let e = bands(1000, 10, 1000).unwrap_err().to_string();
         assert!(e.contains("one image row of 1000 pixels"), "{e}");
-        assert!(e.contains("needs 15.6 KiB, the adapter allows 1000 bytes"), "{e}");
+        assert!(
+            e.contains("needs 15.6 KiB, the adapter allows 1000 bytes"),
+            "{e}"
+        );
         assert_eq!(human_bytes(128 << 20), "128.0 MiB");
     }
 }

@@ -490,7 +490,9 @@ mod tests {
             ),
         ];
         for (text, line, message) in cases {
-            let err = Gate::parse(text, Path::new("g.toml")).unwrap_err().to_string();
+            let err = Gate::parse(text, Path::new("g.toml"))
+                .unwrap_err()
+                .to_string();
             assert!(err.starts_with(&format!("g.toml:{line}: ")), "{err}");
             assert!(err.contains(message), "{err}");
         }

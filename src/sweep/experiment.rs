@@ -499,7 +499,9 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(
-            err.starts_with("dir/exp.toml:4: samples: expected whole numbers from 1 to 16777216, got \"all\""),
+            err.starts_with(
+                "dir/exp.toml:4: samples: expected whole numbers from 1 to 16777216, got \"all\""
+            ),
             "{err}"
         );
         let err = parse(
@@ -578,10 +580,26 @@ mod tests {
         let runs = "[[approximations]]\nmethod = \"riemann\"\nsamples = 1\n";
         let cases = [
             ("size = [0, 16]\n", 2, "size: image size must be between 1"),
-            ("data_range = -1.0\n", 2, "data_range must be a finite number > 0, got -1"),
-            ("data_range = nan\n", 2, "data_range must be a finite number > 0, got NaN"),
-            ("[reference]\nspp = 0\n", 2, "reference.spp must be between 1 and 64, got 0"),
-            ("[reference]\ntol = -1e-5\n", 2, "reference.tol must be a finite number > 0"),
+            (
+                "data_range = -1.0\n",
+                2,
+                "data_range must be a finite number > 0, got -1",
+            ),
+            (
+                "data_range = nan\n",
+                2,
+                "data_range must be a finite number > 0, got NaN",
+            ),
+            (
+                "[reference]\nspp = 0\n",
+                2,
+                "reference.spp must be between 1 and 64, got 0",
+            ),
+            (
+                "[reference]\ntol = -1e-5\n",
+                2,
+                "reference.tol must be a finite number > 0",
+            ),
         ];
         for (globals, line, message) in cases {
             let text = format!("scene = \"s.toml\"\n{globals}{runs}");
@@ -589,10 +607,14 @@ mod tests {
             assert!(err.starts_with(&format!("dir/exp.toml:{line}: ")), "{err}");
             assert!(err.contains(message), "{err}");
         }
-        let err = parse("scene = \"s.toml\"\n[[approximations]]\nmethod = \"riemann\"\nspp = [65]\n")
-            .unwrap_err()
-            .to_string();
-        assert!(err.contains("dir/exp.toml:4: spp: expected whole numbers from 1 to 64, got 65"), "{err}");
+        let err =
+            parse("scene = \"s.toml\"\n[[approximations]]\nmethod = \"riemann\"\nspp = [65]\n")
+                .unwrap_err()
+                .to_string();
+        assert!(
+            err.contains("dir/exp.toml:4: spp: expected whole numbers from 1 to 64, got 65"),
+            "{err}"
+        );
     }
 
     #[test]
