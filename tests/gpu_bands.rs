@@ -44,12 +44,20 @@ fn odd_scene(model: OpticalModel, mode: RenderMode, width: u32, height: u32) -> 
     s
 }
 
+/// A method, its parameter values, and the scene's model and mode.
+type Case = (
+    &'static str,
+    &'static [(&'static str, u32)],
+    OpticalModel,
+    RenderMode,
+);
+
 #[test]
 fn banded_images_are_bit_identical_to_one_band() {
     let Some(ctx) = gpu() else { return };
     let (w, h) = (37, 29);
     let row = w as u64 * 16;
-    let cases: &[(&str, &[(&str, u32)], OpticalModel, RenderMode)] = &[
+    let cases: &[Case] = &[
         // The thesis method takes several passes on lavapipe: every band must see the same
         // pass ranges as the whole image does, or the sums would be grouped differently.
         (
