@@ -1,12 +1,13 @@
-// pgt entry point, appended after the method file: one invocation per pixel, one ray through
-// the pixel centre (DESIGN.md §1), the method's `shade`, the result into `output` (pass 0
-// writes, later passes of a multi-pass method add), and the counters of `stats`.
+// pgt entry point, appended after the method file: one invocation per pixel of the band
+// [row_begin, row_begin + row_count) of the image, one ray through the pixel centre
+// (DESIGN.md §1), the method's `shade`, the result into `output` (which holds the band only;
+// pass 0 writes, later passes of a multi-pass method add), and the counters of `stats`.
 @compute @workgroup_size(WORKGROUP_SIDE, WORKGROUP_SIDE, 1)
 fn pgt_main(@builtin(global_invocation_id) gid: vec3<u32>) {
-    if (gid.x >= frame.width || gid.y >= frame.height) {
+    if (gid.x >= frame.width || gid.y >= frame.row_count) {
         return;
     }
-    let pixel = gid.xy;
+    let pixel = vec2<u32>(gid.x, frame.row_begin + gid.y);
     let radiance = shade(camera_ray(pixel), pixel);
     let i = gid.y * frame.width + gid.x;
     if (frame.pair_begin == 0u) {

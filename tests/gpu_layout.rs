@@ -113,6 +113,8 @@ fn rust_and_wgsl_struct_layouts_agree() {
             ("camera_position", offset_of!(GpuFrame, camera_position)),
             ("pair_begin", offset_of!(GpuFrame, pair_begin)),
             ("pair_end", offset_of!(GpuFrame, pair_end)),
+            ("row_begin", offset_of!(GpuFrame, row_begin)),
+            ("row_count", offset_of!(GpuFrame, row_count)),
             ("params", offset_of!(GpuFrame, params)),
         ],
     );

@@ -170,25 +170,66 @@ impl Pipeline {
     }
 }
 
-/// Sizes of the storage buffers, checked against the device's limits before any allocation so
-/// that a scene that is too large is refused with a message, not a wgpu validation error.
-fn check_limits(ctx: &GpuContext, buffers: &[(&str, u64)]) -> Result<()> {
+/// The largest storage buffer the adapter binds and allocates (bytes).
+pub fn storage_limit(ctx: &GpuContext) -> u64 {
     let limits = ctx.device.limits();
-    let allowed = limits
+    limits
         .max_storage_buffer_binding_size
-        .min(limits.max_buffer_size);
+        .min(limits.max_buffer_size)
+}
+
+/// Sizes of the scene's storage buffers, checked against `limit` before any allocation so that
+/// a scene that is too large is refused with a message (the limit and the size), not a wgpu
+/// validation error. The image never is: it is split into bands ([`bands`]).
+fn check_limits(ctx: &GpuContext, limit: u64, buffers: &[(&str, u64)]) -> Result<()> {
     for &(name, size) in buffers {
-        if size > allowed {
+        if size > limit {
             return Err(PgtError::Gpu(format!(
-                "too large for {}: the {name} buffer needs {:.1} MiB, the adapter allows {:.1} MiB per storage buffer \
-                 (max_storage_buffer_binding_size); render a smaller part of the scene or a smaller image, or use an adapter with larger limits",
+                "too large for {}: the {name} buffer needs {}, the adapter allows {} per storage buffer \
+                 (max_storage_buffer_binding_size); render fewer particles, or use an adapter with larger limits",
                 ctx.adapter.name,
-                size as f64 / 1048576.0,
-                allowed as f64 / 1048576.0
+                human_bytes(size),
+                human_bytes(limit)
             )));
         }
     }
     Ok(())
+}
+
+/// `320 bytes`, `1.5 KiB`, `128.0 MiB`.
+fn human_bytes(bytes: u64) -> String {
+    match bytes {
+        0..1024 => format!("{bytes} bytes"),
+        1024..1048576 => format!("{:.1} KiB", bytes as f64 / 1024.0),
+        _ => format!("{:.1} MiB", bytes as f64 / 1048576.0),
+    }
+}
+
+/// Bytes of one output pixel (a `vec4<f32>`).
+const PIXEL_BYTES: u64 = 16;
+
+/// Splits a `width`×`height` image into bands of whole rows, (row_begin, row_count), whose
+/// output fits in `limit` bytes: one band where the image fits, else as many rows as fit,
+/// rounded down to whole workgroups. Each pixel's result does not depend on the band it is in,
+/// so a banded image is bit-identical to an unbanded one. An error only where one row alone
+/// exceeds the limit.
+pub fn bands(width: u32, height: u32, limit: u64) -> Result<Vec<(u32, u32)>> {
+    let row_bytes = width as u64 * PIXEL_BYTES;
+    let fit = limit / row_bytes.max(1);
+    if fit == 0 {
+        return Err(PgtError::Gpu(format!(
+            "one image row of {width} pixels needs {}, the adapter allows {} per storage buffer",
+            human_bytes(row_bytes),
+            human_bytes(limit)
+        )));
+    }
+    let side = WORKGROUP_SIDE as u64;
+    let rows = if fit >= side { fit - fit % side } else { fit };
+    let rows = rows.min(height.max(1) as u64) as u32;
+    Ok((0..height.max(1))
+        .step_by(rows as usize)
+        .map(|begin| (begin, rows.min(height.max(1) - begin)))
+        .collect())
 }
 
 /// A storage buffer from a slice; an empty slice still gets one zeroed element (wgpu forbids
@@ -215,108 +256,184 @@ fn bytes<T>(n: usize) -> u64 {
 const STATS_BYTES: u64 = std::mem::size_of::<GpuStats>() as u64;
 const TIMESTAMP_BYTES: u64 = 16;
 
-/// A scene on the GPU: its buffers bound to a pipeline's layout, and the buffers a run writes
-/// and reads back.
-pub struct Upload {
-    bind_group: wgpu::BindGroup,
+fn buffer(ctx: &GpuContext, label: &str, size: u64, usage: wgpu::BufferUsages) -> wgpu::Buffer {
+    ctx.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some(label),
+        size,
+        usage,
+        mapped_at_creation: false,
+    })
+}
+
+/// The scene's buffers, shared by every band.
+struct SceneOnGpu {
+    particles: wgpu::Buffer,
+    nodes: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    lights: wgpu::Buffer,
+    stats: wgpu::Buffer,
+}
+
+/// One band of rows of the image: its frame uniform, its part of the output, the bind group
+/// that joins them to the scene.
+struct Band {
+    row_begin: u32,
+    row_count: u32,
     frame: wgpu::Buffer,
     output: wgpu::Buffer,
-    stats: wgpu::Buffer,
-    /// Query set and resolve buffer, where the adapter has timestamp queries.
-    timestamps: Option<(wgpu::QuerySet, wgpu::Buffer)>,
-    out_read: wgpu::Buffer,
-    stats_read: wgpu::Buffer,
-    ts_read: wgpu::Buffer,
-    /// A copy of the image before each pass, for [`PassVerdict::Redo`] (Cpu adapters).
+    /// A copy of the band before each pass, for [`PassVerdict::Redo`] (Cpu adapters).
     backup: Option<wgpu::Buffer>,
-    out_bytes: u64,
+    bind_group: wgpu::BindGroup,
+    bytes: u64,
     groups: (u32, u32),
 }
 
+impl Band {
+    fn new(
+        ctx: &GpuContext,
+        pipeline: &Pipeline,
+        scene: &SceneOnGpu,
+        frame: &GpuFrame,
+        (row_begin, row_count): (u32, u32),
+    ) -> Band {
+        use wgpu::BufferUsages as U;
+        let device = &ctx.device;
+        let bytes = frame.width as u64 * row_count as u64 * PIXEL_BYTES;
+        let frame_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("pgt frame"),
+            contents: bytemuck::bytes_of(frame),
+            usage: U::UNIFORM | U::COPY_DST,
+        });
+        let output = buffer(
+            ctx,
+            "pgt output",
+            bytes,
+            U::STORAGE | U::COPY_SRC | U::COPY_DST,
+        );
+        // In BINDINGS order: frame, particles, nodes, leaf_indices, lights, output, stats.
+        let resources = [
+            &frame_buf,
+            &scene.particles,
+            &scene.nodes,
+            &scene.indices,
+            &scene.lights,
+            &output,
+            &scene.stats,
+        ];
+        let entries: Vec<wgpu::BindGroupEntry> = BINDINGS
+            .iter()
+            .zip(&resources)
+            .map(|(b, r)| wgpu::BindGroupEntry {
+                binding: b.index,
+                resource: r.as_entire_binding(),
+            })
+            .collect();
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("pgt scene"),
+            layout: &pipeline.layout,
+            entries: &entries,
+        });
+        Band {
+            row_begin,
+            row_count,
+            frame: frame_buf,
+            backup: ctx
+                .adapter
+                .is_cpu
+                .then(|| buffer(ctx, "pgt output backup", bytes, U::COPY_SRC | U::COPY_DST)),
+            output,
+            bind_group,
+            bytes,
+            groups: (
+                frame.width.div_ceil(WORKGROUP_SIDE),
+                row_count.div_ceil(WORKGROUP_SIDE),
+            ),
+        }
+    }
+}
+
+/// A scene on the GPU: its buffers bound to a pipeline's layout, once per band of the image,
+/// and the buffers a run writes and reads back.
+pub struct Upload {
+    bands: Vec<Band>,
+    stats: wgpu::Buffer,
+    /// Query set and resolve buffer, where the adapter has timestamp queries.
+    timestamps: Option<(wgpu::QuerySet, wgpu::Buffer)>,
+    /// Read-back of one band at a time (the largest band's size).
+    out_read: wgpu::Buffer,
+    stats_read: wgpu::Buffer,
+    ts_read: wgpu::Buffer,
+}
+
 impl Upload {
-    /// Checks the sizes against the adapter's limits and uploads the scene.
+    /// Checks the sizes against the adapter's limits, splits the image into bands that fit
+    /// and uploads the scene.
     pub fn new(
         ctx: &GpuContext,
         pipeline: &Pipeline,
         scene: &SceneBuffers,
         frame: &GpuFrame,
     ) -> Result<Upload> {
-        let out_bytes = bytes::<[f32; 4]>(frame.width as usize * frame.height as usize);
+        Upload::with_limit(ctx, pipeline, scene, frame, storage_limit(ctx))
+    }
+
+    /// [`Upload::new`] with a per-buffer limit of `limit` bytes (at most the adapter's).
+    fn with_limit(
+        ctx: &GpuContext,
+        pipeline: &Pipeline,
+        scene: &SceneBuffers,
+        frame: &GpuFrame,
+        limit: u64,
+    ) -> Result<Upload> {
+        let limit = limit.min(storage_limit(ctx));
         check_limits(
             ctx,
+            limit,
             &[
                 ("particle", bytes::<GpuParticle>(scene.particles.len())),
                 ("BVH node", bytes::<GpuBvhNode>(scene.nodes.len())),
                 ("BVH index", bytes::<u32>(scene.leaf_indices.len())),
                 ("light", bytes::<GpuLight>(scene.lights.len())),
-                ("output image", out_bytes),
             ],
         )?;
+        let rows = bands(frame.width, frame.height, limit)?;
+        let max_groups = ctx.device.limits().max_compute_workgroups_per_dimension;
         let groups = (
             frame.width.div_ceil(WORKGROUP_SIDE),
-            frame.height.div_ceil(WORKGROUP_SIDE),
+            rows[0].1.div_ceil(WORKGROUP_SIDE),
         );
-        let max_groups = ctx.device.limits().max_compute_workgroups_per_dimension;
         if groups.0 > max_groups || groups.1 > max_groups {
             return Err(PgtError::Gpu(format!(
                 "image {}x{} needs {}x{} workgroups, the adapter allows {max_groups} per dimension",
                 frame.width, frame.height, groups.0, groups.1
             )));
         }
-        let device = &ctx.device;
-        let buffer = |label: &str, size: u64, usage: wgpu::BufferUsages| {
-            device.create_buffer(&wgpu::BufferDescriptor {
-                label: Some(label),
-                size,
-                usage,
-                mapped_at_creation: false,
-            })
-        };
         use wgpu::BufferUsages as U;
         ctx.checked("uploading the scene", || {
-            let frame_buf = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-                label: Some("pgt frame"),
-                contents: bytemuck::bytes_of(frame),
-                usage: U::UNIFORM | U::COPY_DST,
-            });
-            let output = buffer(
-                "pgt output",
-                out_bytes,
-                U::STORAGE | U::COPY_SRC | U::COPY_DST,
-            );
-            let stats = buffer(
-                "pgt stats",
-                STATS_BYTES,
-                U::STORAGE | U::COPY_SRC | U::COPY_DST,
-            );
-            let particles = storage(ctx, "pgt particles", &scene.particles);
-            let nodes = storage(ctx, "pgt bvh nodes", &scene.nodes);
-            let indices = storage(ctx, "pgt bvh indices", &scene.leaf_indices);
-            let lights = storage(ctx, "pgt lights", &scene.lights);
-            // In BINDINGS order: frame, particles, nodes, leaf_indices, lights, output, stats.
-            let resources = [
-                &frame_buf, &particles, &nodes, &indices, &lights, &output, &stats,
-            ];
-            let entries: Vec<wgpu::BindGroupEntry> = BINDINGS
+            let shared = SceneOnGpu {
+                particles: storage(ctx, "pgt particles", &scene.particles),
+                nodes: storage(ctx, "pgt bvh nodes", &scene.nodes),
+                indices: storage(ctx, "pgt bvh indices", &scene.leaf_indices),
+                lights: storage(ctx, "pgt lights", &scene.lights),
+                stats: buffer(
+                    ctx,
+                    "pgt stats",
+                    STATS_BYTES,
+                    U::STORAGE | U::COPY_SRC | U::COPY_DST,
+                ),
+            };
+            let bands: Vec<Band> = rows
                 .iter()
-                .zip(&resources)
-                .map(|(b, r)| wgpu::BindGroupEntry {
-                    binding: b.index,
-                    resource: r.as_entire_binding(),
-                })
+                .map(|&r| Band::new(ctx, pipeline, &shared, frame, r))
                 .collect();
-            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("pgt scene"),
-                layout: &pipeline.layout,
-                entries: &entries,
-            });
             let timestamps = ctx.timestamps.then(|| {
-                let set = device.create_query_set(&wgpu::QuerySetDescriptor {
+                let set = ctx.device.create_query_set(&wgpu::QuerySetDescriptor {
                     label: Some("pgt timestamps"),
                     ty: wgpu::QueryType::Timestamp,
                     count: 2,
                 });
                 let resolve = buffer(
+                    ctx,
                     "pgt timestamp resolve",
                     TIMESTAMP_BYTES,
                     U::QUERY_RESOLVE | U::COPY_SRC,
@@ -324,30 +441,23 @@ impl Upload {
                 (set, resolve)
             });
             let read = U::MAP_READ | U::COPY_DST;
+            let largest = bands.iter().map(|b| b.bytes).max().unwrap_or(PIXEL_BYTES);
             Upload {
-                bind_group,
-                frame: frame_buf,
-                output,
-                stats,
+                bands,
+                stats: shared.stats,
                 timestamps,
-                out_read: buffer("pgt output read-back", out_bytes, read),
-                stats_read: buffer("pgt stats read-back", STATS_BYTES, read),
-                ts_read: buffer("pgt timestamps read-back", TIMESTAMP_BYTES, read),
-                backup: ctx
-                    .adapter
-                    .is_cpu
-                    .then(|| buffer("pgt output backup", out_bytes, U::COPY_SRC | U::COPY_DST)),
-                out_bytes,
-                groups,
+                out_read: buffer(ctx, "pgt output read-back", largest, read),
+                stats_read: buffer(ctx, "pgt stats read-back", STATS_BYTES, read),
+                ts_read: buffer(ctx, "pgt timestamps read-back", TIMESTAMP_BYTES, read),
             }
         })
     }
 }
 
-/// Maps a MAP_READ buffer and copies its bytes out.
-fn read_back(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
+/// Maps a MAP_READ buffer and copies its first `size` bytes out.
+fn read_back(ctx: &GpuContext, buffer: &wgpu::Buffer, size: u64) -> Result<Vec<u8>> {
     let (tx, rx) = std::sync::mpsc::channel();
-    buffer.map_async(wgpu::MapMode::Read, .., move |r| {
+    buffer.map_async(wgpu::MapMode::Read, ..size, move |r| {
         let _ = tx.send(r);
     });
     ctx.device
@@ -357,62 +467,78 @@ fn read_back(ctx: &GpuContext, buffer: &wgpu::Buffer) -> Result<Vec<u8>> {
         .map_err(|_| PgtError::Gpu("the GPU never answered the read-back".into()))?
         .map_err(|e| PgtError::Gpu(format!("reading the result back: {e}")))?;
     let data = buffer
-        .get_mapped_range(..)
+        .get_mapped_range(..size)
         .map_err(|e| PgtError::Gpu(format!("reading the result back: {e:?}")))?
         .to_vec();
     buffer.unmap();
     Ok(data)
 }
 
-/// Copies `from` to `to` on the GPU (`what` names the step in errors).
-fn copy(
+/// Copies each band's `from` buffer to its `to` buffer on the GPU, in one submission (`what`
+/// names the step in errors).
+fn copy_bands<'a>(
     ctx: &GpuContext,
     what: &str,
-    from: &wgpu::Buffer,
-    to: &wgpu::Buffer,
-    size: u64,
+    bands: &'a [Band],
+    from_to: impl Fn(&'a Band) -> Option<(&'a wgpu::Buffer, &'a wgpu::Buffer)>,
 ) -> Result<()> {
     ctx.checked(what, || {
         let mut encoder = ctx
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pgt") });
-        encoder.copy_buffer_to_buffer(from, 0, to, 0, size);
+        for band in bands {
+            if let Some((from, to)) = from_to(band) {
+                encoder.copy_buffer_to_buffer(from, 0, to, 0, band.bytes);
+            }
+        }
         ctx.queue.submit([encoder.finish()]);
     })
 }
 
-/// One dispatch over the image with `frame`; returns its counters and timestamp ticks.
+/// One dispatch per band with `frame` (its row range set per band), all in one submission, so
+/// that the counters in `stats` are those of the whole image; returns them and the timestamp
+/// ticks from the first band's start to the last band's end.
 fn run_pass(
     ctx: &GpuContext,
     pipeline: &Pipeline,
     up: &Upload,
     frame: &GpuFrame,
 ) -> Result<(GpuStats, Option<u64>)> {
-    ctx.queue
-        .write_buffer(&up.frame, 0, bytemuck::bytes_of(frame));
+    for band in &up.bands {
+        let band_frame = GpuFrame {
+            row_begin: band.row_begin,
+            row_count: band.row_count,
+            ..*frame
+        };
+        ctx.queue
+            .write_buffer(&band.frame, 0, bytemuck::bytes_of(&band_frame));
+    }
     ctx.queue
         .write_buffer(&up.stats, 0, bytemuck::bytes_of(&GpuStats::default()));
+    let last = up.bands.len() - 1;
     ctx.checked("running the compute pass", || {
         let mut encoder = ctx
             .device
             .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pgt") });
-        if let Some(backup) = &up.backup {
-            encoder.copy_buffer_to_buffer(&up.output, 0, backup, 0, up.out_bytes);
-        }
-        {
+        for (k, band) in up.bands.iter().enumerate() {
+            if let Some(backup) = &band.backup {
+                encoder.copy_buffer_to_buffer(&band.output, 0, backup, 0, band.bytes);
+            }
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("pgt method"),
-                timestamp_writes: up.timestamps.as_ref().map(|(set, _)| {
-                    wgpu::ComputePassTimestampWrites {
+                // The first band's start and the last band's end (wgpu refuses a pass with
+                // neither index, so the bands between carry none).
+                timestamp_writes: up.timestamps.as_ref().filter(|_| k == 0 || k == last).map(
+                    |(set, _)| wgpu::ComputePassTimestampWrites {
                         query_set: set,
-                        beginning_of_pass_write_index: Some(0),
-                        end_of_pass_write_index: Some(1),
-                    }
-                }),
+                        beginning_of_pass_write_index: (k == 0).then_some(0),
+                        end_of_pass_write_index: (k == last).then_some(1),
+                    },
+                ),
             });
             pass.set_pipeline(&pipeline.pipeline);
-            pass.set_bind_group(0, &up.bind_group, &[]);
-            pass.dispatch_workgroups(up.groups.0, up.groups.1, 1);
+            pass.set_bind_group(0, &band.bind_group, &[]);
+            pass.dispatch_workgroups(band.groups.0, band.groups.1, 1);
         }
         if let Some((set, resolve)) = &up.timestamps {
             encoder.resolve_query_set(set, 0..2, resolve, 0);
@@ -421,12 +547,12 @@ fn run_pass(
         encoder.copy_buffer_to_buffer(&up.stats, 0, &up.stats_read, 0, STATS_BYTES);
         ctx.queue.submit([encoder.finish()]);
     })?;
-    let stats_data = read_back(ctx, &up.stats_read)?;
+    let stats_data = read_back(ctx, &up.stats_read, STATS_BYTES)?;
     ctx.check_uncaptured("running the compute pass")?;
     let stats: GpuStats = bytemuck::pod_read_unaligned(&stats_data[..STATS_BYTES as usize]);
     let ticks = match up.timestamps {
         Some(_) => {
-            let ts = read_back(ctx, &up.ts_read)?;
+            let ts = read_back(ctx, &up.ts_read, TIMESTAMP_BYTES)?;
             let t: [u64; 2] = bytemuck::pod_read_unaligned(&ts[..TIMESTAMP_BYTES as usize]);
             Some(t[1].saturating_sub(t[0]))
         }
@@ -435,36 +561,51 @@ fn run_pass(
     Ok((stats, ticks))
 }
 
-/// Reads the finished image back (RGB of the vec4 per pixel).
+/// Reads the finished image back band by band (RGB of the vec4 per pixel).
 fn read_image(ctx: &GpuContext, up: &Upload, width: u32, height: u32) -> Result<RgbImage> {
-    copy(
-        ctx,
-        "reading the image back",
-        &up.output,
-        &up.out_read,
-        up.out_bytes,
-    )?;
-    let data = read_back(ctx, &up.out_read)?;
-    ctx.check_uncaptured("reading the image back")?;
-    let pixels = width as usize * height as usize;
-    let floats: &[[f32; 4]] = bytemuck::try_cast_slice(&data[..pixels * 16])
-        .map_err(|e| PgtError::Gpu(format!("reading the result back: {e}")))?;
     let mut image = RgbImage::new(width, height);
-    for (dst, src) in image.pixels.iter_mut().zip(floats) {
-        *dst = [src[0], src[1], src[2]];
+    for band in &up.bands {
+        copy_bands(
+            ctx,
+            "reading the image back",
+            std::slice::from_ref(band),
+            |b| Some((&b.output, &up.out_read)),
+        )?;
+        let data = read_back(ctx, &up.out_read, band.bytes)?;
+        ctx.check_uncaptured("reading the image back")?;
+        let floats: &[[f32; 4]] = bytemuck::try_cast_slice(&data)
+            .map_err(|e| PgtError::Gpu(format!("reading the result back: {e}")))?;
+        let first = band.row_begin as usize * width as usize;
+        let pixels = &mut image.pixels[first..first + floats.len()];
+        for (dst, src) in pixels.iter_mut().zip(floats) {
+            *dst = [src[0], src[1], src[2]];
+        }
     }
     Ok(image)
 }
 
 /// Uploads the scene and runs `pipeline` over every pixel, in as many passes as
-/// [`PassSchedule`] decides.
+/// [`PassSchedule`] decides, each pass over every band of the image ([`bands`]).
 pub fn run(
     ctx: &GpuContext,
     pipeline: &Pipeline,
     scene: &SceneBuffers,
     frame: &GpuFrame,
 ) -> Result<DispatchOutput> {
-    let up = Upload::new(ctx, pipeline, scene, frame)?;
+    run_with_limit(ctx, pipeline, scene, frame, storage_limit(ctx))
+}
+
+/// [`run`] as if the adapter allowed only `limit` bytes per storage buffer (never more than it
+/// does): tests force small bands with it and compare with an unbanded run.
+#[doc(hidden)]
+pub fn run_with_limit(
+    ctx: &GpuContext,
+    pipeline: &Pipeline,
+    scene: &SceneBuffers,
+    frame: &GpuFrame,
+    limit: u64,
+) -> Result<DispatchOutput> {
+    let up = Upload::with_limit(ctx, pipeline, scene, frame, limit)?;
     let mut schedule = PassSchedule::new(ctx.adapter.is_cpu);
     let start = Instant::now();
     let mut gpu_ticks: Option<f64> = up.timestamps.as_ref().map(|_| 0.0);
@@ -479,9 +620,9 @@ pub fn run(
         passes += 1;
         let verdict = schedule.after_pass(stats.more_work > 0, stats.max_loop_iterations);
         if verdict == PassVerdict::Redo {
-            if let Some(backup) = &up.backup {
-                copy(ctx, "restoring the image", backup, &up.output, up.out_bytes)?;
-            }
+            copy_bands(ctx, "restoring the image", &up.bands, |b| {
+                b.backup.as_ref().map(|backup| (backup, &b.output))
+            })?;
             continue;
         }
         hit_overflows = hit_overflows.max(stats.hit_overflows);
@@ -563,5 +704,38 @@ mod tests {
             }
         }
         panic!("no end after 64 doublings: {s:?}");
+    }
+
+    #[test]
+    fn an_image_that_fits_is_one_band() {
+        assert_eq!(bands(64, 48, 64 * 48 * 16).unwrap(), vec![(0, 48)]);
+        assert_eq!(bands(64, 48, u64::MAX).unwrap(), vec![(0, 48)]);
+    }
+
+    #[test]
+    fn bands_are_whole_workgroups_of_rows_and_cover_the_image_once() {
+        // 20 rows fit; 16 (two workgroups of 8) are taken.
+        let b = bands(10, 45, 10 * 16 * 20).unwrap();
+        assert_eq!(b, vec![(0, 16), (16, 16), (32, 13)]);
+        // Fewer rows than a workgroup fit: as many as fit.
+        assert_eq!(
+            bands(10, 7, 10 * 16 * 3).unwrap(),
+            vec![(0, 3), (3, 3), (6, 1)]
+        );
+        // 8192² in lavapipe's 128 MiB: 8 bands of 1024 rows.
+        let b = bands(8192, 8192, 128 << 20).unwrap();
+        assert_eq!(b.len(), 8);
+        assert!(b.iter().all(|&(_, n)| n == 1024));
+    }
+
+    #[test]
+    fn a_row_beyond_the_limit_is_an_error_with_both_sizes() {
+        let e = bands(1000, 10, 1000).unwrap_err().to_string();
+        assert!(e.contains("one image row of 1000 pixels"), "{e}");
+        assert!(
+            e.contains("needs 15.6 KiB, the adapter allows 1000 bytes"),
+            "{e}"
+        );
+        assert_eq!(human_bytes(128 << 20), "128.0 MiB");
     }
 }

@@ -155,9 +155,13 @@ gpu_struct! {
         /// (see `dispatch::PassSchedule`). Pass 0 writes the image, later passes add to it.
         pub pair_begin: u32,
         pub pair_end: u32,
+        /// The image band this dispatch computes: rows [row_begin, row_begin + row_count) of
+        /// the `width`×`height` image, written to `output` from its index 0 (row `row_begin`).
+        /// Images whose output exceeds one storage buffer are rendered band by band (see
+        /// `dispatch::bands`); the camera ray still uses the whole image's size.
+        pub row_begin: u32,
+        pub row_count: u32,
         pub _pad0: u32,
-        pub _pad1: u32,
-        pub _pad2: u32,
         /// The method's parameters, slot k at `params[k / 4][k % 4]` (the prelude's
         /// `method_param(slot)`; slots are named by generated `PARAM_<NAME>` constants).
         pub params: [[u32; 4]; 2],
@@ -337,6 +341,8 @@ impl GpuFrame {
             camera_position: cam.position.as_vec3().to_array(),
             pair_begin: 0,
             pair_end: u32::MAX,
+            row_begin: 0,
+            row_count: cam.height,
             params: slots,
             ..GpuFrame::default()
         }

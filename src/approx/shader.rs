@@ -11,6 +11,8 @@ use std::borrow::Cow;
 pub const COMMON_WGSL: &str = include_str!("../../shaders/common.wgsl");
 /// The compute entry point `pgt_main`, appended after the method.
 pub const ENTRY_WGSL: &str = include_str!("../../shaders/entry.wgsl");
+/// The name the entry point file has in messages.
+const ENTRY_FILE: &str = "shaders/entry.wgsl";
 /// Name of the compute entry point.
 pub const ENTRY_POINT: &str = "pgt_main";
 
@@ -79,7 +81,7 @@ impl ShaderProgram {
         });
         parts.push(method);
         parts.push(ShaderPart {
-            name: "shaders/entry.wgsl".into(),
+            name: ENTRY_FILE.into(),
             text: Cow::Borrowed(ENTRY_WGSL),
         });
         ShaderProgram::from_parts(parts)
@@ -138,14 +140,36 @@ impl ShaderProgram {
         })
     }
 
+    /// `file:line:column: ` of the source offset an error points at. pgt's entry point only
+    /// calls the method's `shade`, so an error there is the method's: it is blamed on the line
+    /// of the method's `fn shade`, saying what the entry point expects.
+    fn blame(&self, offset: usize) -> String {
+        let p = self.position(offset);
+        let entry = self.parts.len().checked_sub(1);
+        let in_entry =
+            entry.is_some_and(|k| self.parts[k].name == ENTRY_FILE && p.file == ENTRY_FILE);
+        let method = self.parts.len().checked_sub(2).map(|k| (k, &self.parts[k]));
+        match method {
+            Some((k, part)) if in_entry => {
+                let at = part.text.find("fn shade").unwrap_or(0);
+                let m = self.position(self.starts[k] + at);
+                format!(
+                    "{}:{}:{}: `shade` must be `fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32>` \
+                     (pgt's entry point {}:{} calls it so): ",
+                    m.file, m.line, m.column, p.file, p.line
+                )
+            }
+            _ => format!("{}:{}:{}: ", p.file, p.line, p.column),
+        }
+    }
+
     /// Parses and validates the program with naga; errors name the file and line.
     pub fn validate(&self) -> Result<naga::Module> {
         let module = naga::front::wgsl::parse_str(&self.source).map_err(|e| {
             let mut msg = String::new();
-            let first = e.labels().next().and_then(|(span, _)| span.to_range());
+            let first = e.labels().find_map(|(span, _)| span.to_range());
             if let Some(range) = first {
-                let p = self.position(range.start);
-                msg += &format!("{}:{}:{}: ", p.file, p.line, p.column);
+                msg += &self.blame(range.start);
             }
             msg += &format!("WGSL error: {}", e.message());
             for (span, label) in e.labels() {
@@ -167,10 +191,9 @@ impl ShaderProgram {
         validator.validate(&module).map_err(|e| {
             let mut msg = String::new();
             // The last span is the most specific (the expression, after the function that holds it).
-            let first = e.spans().last().and_then(|(span, _)| span.to_range());
+            let first = e.spans().filter_map(|(span, _)| span.to_range()).last();
             if let Some(range) = first {
-                let p = self.position(range.start);
-                msg += &format!("{}:{}:{}: ", p.file, p.line, p.column);
+                msg += &self.blame(range.start);
             }
             // The error chain names the function, expression and reason.
             msg += &format!("WGSL validation error: {}", e.as_inner());

@@ -34,9 +34,12 @@
 
 use super::maps;
 use super::{Comparison, CHANNELS};
-use crate::error::{toml_error, PgtError, Result};
+use crate::error::{line_of, toml_error, with_quoted_line, PgtError, Result};
 use crate::image_io::RgbImage;
+use serde::de::IgnoredAny;
+use std::collections::BTreeMap;
 use std::path::Path;
+use toml::Spanned;
 
 /// The gate file (see the module documentation).
 #[derive(Debug, Clone, Default, PartialEq, serde::Deserialize)]
@@ -85,6 +88,45 @@ pub struct PercentileGate {
     pub min: Option<f64>,
 }
 
+/// Where a value of a gate file is: a top-level key, a key of `[channels]`, the i-th
+/// `[[percentiles]]` table.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Field {
+    Top(&'static str),
+    Channel(&'static str),
+    Percentile(usize),
+}
+
+/// The positions of a gate file's values: the types above keep none, so the text is read a
+/// second time for them (only when a message needs one).
+#[derive(serde::Deserialize)]
+struct Spans {
+    channels: Option<BTreeMap<String, Spanned<IgnoredAny>>>,
+    #[serde(default)]
+    percentiles: Vec<Spanned<IgnoredAny>>,
+}
+
+impl Field {
+    /// The 1-based line of the value in `text` (a file that [`Gate`] parsed).
+    fn line(self, text: &str) -> Option<usize> {
+        let span = match self {
+            Field::Top(name) => {
+                let top: BTreeMap<String, Spanned<IgnoredAny>> = toml::from_str(text).ok()?;
+                top.get(name)?.span()
+            }
+            Field::Channel(name) => {
+                let spans: Spans = toml::from_str(text).ok()?;
+                spans.channels?.get(name)?.span()
+            }
+            Field::Percentile(i) => {
+                let spans: Spans = toml::from_str(text).ok()?;
+                spans.percentiles.get(i)?.span()
+            }
+        };
+        Some(line_of(text, span.start))
+    }
+}
+
 /// The outcome of one threshold.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct GateCheck {
@@ -99,9 +141,20 @@ impl Gate {
     /// Reads and validates a gate file.
     pub fn load(path: &Path) -> Result<Gate> {
         let text = std::fs::read_to_string(path).map_err(|e| PgtError::io(path, e))?;
-        let gate: Gate = toml::from_str(&text).map_err(|e| toml_error(path, &text, &e))?;
-        gate.validate().map_err(|m| PgtError::in_file(path, m))?;
-        Ok(gate)
+        Gate::parse(&text, path)
+    }
+
+    /// Parses and validates the text of the gate file `path`; errors name the file and the
+    /// line of the offending value (DESIGN.md §6 "Bad input").
+    pub fn parse(text: &str, path: &Path) -> Result<Gate> {
+        let gate: Gate = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
+        match gate.problem() {
+            None => Ok(gate),
+            Some((field, message)) => Err(match field.line(text) {
+                Some(line) => PgtError::at_line(path, line, with_quoted_line(message, text, line)),
+                None => PgtError::in_file(path, message),
+            }),
+        }
     }
 
     /// Whether no threshold is set.
@@ -130,6 +183,14 @@ impl Gate {
 
     /// Checks the values make sense (finite; percentiles in (0, 100] with exactly one bound).
     pub fn validate(&self) -> std::result::Result<(), String> {
+        match self.problem() {
+            Some((_, message)) => Err(message),
+            None => Ok(()),
+        }
+    }
+
+    /// The first value that makes no sense, where it is, and why.
+    fn problem(&self) -> Option<(Field, String)> {
         let scalars = [
             ("min_ssim", self.min_ssim),
             ("max_rmse", self.max_rmse),
@@ -142,7 +203,8 @@ impl Gate {
         for (name, v) in scalars {
             if let Some(v) = v {
                 if !v.is_finite() {
-                    return Err(format!("{name} must be a finite number, got {v}"));
+                    let message = format!("{name} must be a finite number, got {v}");
+                    return Some((Field::Top(name), message));
                 }
             }
         }
@@ -154,29 +216,29 @@ impl Gate {
                 ("max_abs", c.max_abs),
             ] {
                 if v.is_some_and(|v| v.iter().any(|x| !x.is_finite())) {
-                    return Err(format!("channels.{name} must hold finite numbers"));
+                    let message = format!("channels.{name} must hold finite numbers");
+                    return Some((Field::Channel(name), message));
                 }
             }
         }
-        for p in &self.percentiles {
+        for (i, p) in self.percentiles.iter().enumerate() {
             if !(p.percentile > 0.0 && p.percentile <= 100.0) {
-                return Err(format!(
-                    "percentile must be in (0, 100], got {}",
-                    p.percentile
-                ));
+                let message = format!("percentile must be in (0, 100], got {}", p.percentile);
+                return Some((Field::Percentile(i), message));
             }
             match (p.min, p.max) {
                 (Some(v), None) | (None, Some(v)) if v.is_finite() => {}
                 _ => {
-                    return Err(format!(
+                    let message = format!(
                         "percentile gate on '{:?}' needs exactly one finite 'min' or 'max'",
                         p.map
                     )
-                    .to_lowercase())
+                    .to_lowercase();
+                    return Some((Field::Percentile(i), message));
                 }
             }
         }
-        Ok(())
+        None
     }
 
     /// Evaluates every threshold: the lower bounds (SSIM, PSNR), the upper bounds (errors,
@@ -405,5 +467,34 @@ mod tests {
         assert!(bad.validate().is_err());
         assert!(Gate::default().is_empty());
         assert!(!g.is_empty());
+    }
+
+    #[test]
+    fn invalid_values_name_their_line() {
+        let cases = [
+            ("max_rmse = 0.1\nmin_ssim = nan\n", 2, "min_ssim must be a finite number"),
+            (
+                "min_ssim = 0.9\n\n[channels]\nmax_rmse = [0.1, 0.1, 0.1]\nmax_abs = [1.0, inf, 1.0]\n",
+                5,
+                "channels.max_abs must hold finite numbers",
+            ),
+            (
+                "[[percentiles]]\nmap = \"abs\"\npercentile = 99\nmax = 0.1\n\n[[percentiles]]\nmap = \"rel\"\npercentile = 0\nmax = 0.1\n",
+                6,
+                "percentile must be in (0, 100], got 0",
+            ),
+            (
+                "[[percentiles]]\nmap = \"ssim\"\npercentile = 5\nmin = 0.1\nmax = 0.2\n",
+                1,
+                "needs exactly one finite 'min' or 'max'",
+            ),
+        ];
+        for (text, line, message) in cases {
+            let err = Gate::parse(text, Path::new("g.toml"))
+                .unwrap_err()
+                .to_string();
+            assert!(err.starts_with(&format!("g.toml:{line}: ")), "{err}");
+            assert!(err.contains(message), "{err}");
+        }
     }
 }

@@ -130,7 +130,14 @@ pub(super) fn scene_from_toml(
             "> 0",
         )?;
         spec.path = base.join(&spec.path);
-        let loaded = crate::formats::load_particles(&spec)?;
+        // A file that cannot be read is named with the scene's include line (a typo in the
+        // path is the usual cause); errors inside a file that was read name that file's line.
+        let loaded = crate::formats::load_particles(&spec).map_err(|e| match e {
+            PgtError::Io { path, source } => {
+                spec_at.err(format!("include: cannot read {}: {source}", path.display()))
+            }
+            e => e,
+        })?;
         warnings.extend(loaded.warnings);
         for rec in &loaded.records {
             particles.push(record_particle(

@@ -5,6 +5,7 @@
 
 use super::method::{find_method, method_names, ParamDefault, ParamValue, SweepMethod, SweepParam};
 use crate::error::{line_of, toml_error, with_quoted_line, PgtError, Result};
+use crate::reference::MAX_SPP;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -15,10 +16,9 @@ use toml::Spanned;
 #[serde(deny_unknown_fields)]
 struct ExperimentFile {
     scene: PathBuf,
-    size: Option<[u32; 2]>,
-    data_range: Option<f64>,
-    #[serde(default)]
-    reference: ReferenceSpec,
+    size: Option<Spanned<[u32; 2]>>,
+    data_range: Option<Spanned<f64>>,
+    reference: Option<Spanned<ReferenceSpec>>,
     approximations: Vec<BTreeMap<Spanned<String>, Spanned<toml::Value>>>,
     plot_x: Option<Spanned<String>>,
     #[serde(default)]
@@ -157,13 +157,34 @@ impl Experiment {
     pub fn parse(text: &str, path: &Path) -> Result<Experiment> {
         let file: ExperimentFile = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
         let at = Place { path, text };
-        let ref_spp = file.reference.spp.unwrap_or(1);
+        at.check_globals(&file)?;
+        let reference = file
+            .reference
+            .as_ref()
+            .map(|r| r.get_ref().clone())
+            .unwrap_or_default();
+        let ref_spp = reference.spp.unwrap_or(1);
         let mut entries = Vec::new();
         for table in &file.approximations {
             entries.push(at.entry(table, ref_spp)?);
         }
         let mut runs = Vec::new();
-        for entry in &entries {
+        for (entry, table) in entries.iter().zip(&file.approximations) {
+            // Counted before they are made: a few long lists multiply to millions of runs.
+            let count = entry
+                .lists
+                .iter()
+                .try_fold(1usize, |n, l| n.checked_mul(l.len()))
+                .filter(|&n| runs.len() + n <= MAX_RUNS);
+            if count.is_none() {
+                let line = table.keys().map(|k| at.line(k)).min().unwrap_or(1);
+                return Err(at.error(
+                    line,
+                    format!(
+                        "this entry's lists make more than {MAX_RUNS} runs in all (their product); sweep fewer values"
+                    ),
+                ));
+            }
             runs.extend(entry.runs());
         }
         if runs.is_empty() {
@@ -187,9 +208,9 @@ impl Experiment {
         Ok(Experiment {
             path: path.to_path_buf(),
             scene: base.join(&file.scene),
-            size: file.size,
-            data_range: file.data_range,
-            reference: file.reference,
+            size: file.size.map(Spanned::into_inner),
+            data_range: file.data_range.map(Spanned::into_inner),
+            reference,
             runs,
             plot_x,
             attributions,
@@ -287,6 +308,10 @@ fn default_value(p: &SweepParam, ref_spp: u32) -> ParamValue {
     }
 }
 
+/// Most runs one experiment may have: each is a render, and a sweep of more is a typo or a
+/// mistake in a list, not a plan.
+pub const MAX_RUNS: usize = 10_000;
+
 /// The experiment file, for errors that name file:line.
 struct Place<'a> {
     path: &'a Path,
@@ -300,6 +325,36 @@ impl Place<'_> {
 
     fn error(&self, line: usize, message: String) -> PgtError {
         PgtError::at_line(self.path, line, with_quoted_line(message, self.text, line))
+    }
+
+    /// Checks `size`, `data_range` and `[reference]` as `pgt render` and `pgt compare` would,
+    /// but before anything is rendered and naming their line.
+    fn check_globals(&self, file: &ExperimentFile) -> Result<()> {
+        if let Some(size) = &file.size {
+            let [w, h] = *size.get_ref();
+            crate::scene::check_image_size(w as i64, h as i64)
+                .map_err(|m| self.error(self.line(size), format!("size: {m}")))?;
+        }
+        if let Some(range) = &file.data_range {
+            let r = *range.get_ref();
+            if !(r.is_finite() && r > 0.0) {
+                let message = format!("data_range must be a finite number > 0, got {r}");
+                return Err(self.error(self.line(range), message));
+            }
+        }
+        if let Some(reference) = &file.reference {
+            let line = self.line(reference);
+            let spec = reference.get_ref();
+            if let Some(spp) = spec.spp.filter(|s| !(1..=MAX_SPP).contains(s)) {
+                let message = format!("reference.spp must be between 1 and {MAX_SPP}, got {spp}");
+                return Err(self.error(line, message));
+            }
+            if let Some(tol) = spec.tol.filter(|t| !(t.is_finite() && *t > 0.0)) {
+                let message = format!("reference.tol must be a finite number > 0, got {tol}");
+                return Err(self.error(line, message));
+            }
+        }
+        Ok(())
     }
 
     /// Validates one `[[approximations]]` table against its method's parameters.
@@ -525,15 +580,16 @@ impl Place<'_> {
 /// One value of parameter `p`: a count ≥ `p.min`, or `"all"` where `p` accepts it.
 fn one_value(p: &SweepParam, v: &toml::Value) -> std::result::Result<ParamValue, String> {
     let expected = || {
+        let range = format!("expected whole numbers from {} to {}", p.min, p.max);
         if p.accepts_all {
-            format!("expected whole numbers ≥ {} or \"all\"", p.min)
+            format!("{range} or \"all\"")
         } else {
-            format!("expected whole numbers ≥ {}", p.min)
+            range
         }
     };
     match v {
         toml::Value::String(s) if p.accepts_all && s == "all" => Ok(ParamValue::All),
-        toml::Value::Integer(n) if *n >= p.min as i64 && *n < u32::MAX as i64 => {
+        toml::Value::Integer(n) if *n >= p.min as i64 && *n <= p.max as i64 => {
             Ok(ParamValue::Count(*n as u32))
         }
         other => Err(format!("{}, got {other}", expected())),
@@ -581,7 +637,9 @@ mod tests {
         .unwrap_err()
         .to_string();
         assert!(
-            err.starts_with("dir/exp.toml:4: samples: expected whole numbers ≥ 1, got \"all\""),
+            err.starts_with(
+                "dir/exp.toml:4: samples: expected whole numbers from 1 to 16777216, got \"all\""
+            ),
             "{err}"
         );
         let err = parse(
@@ -707,5 +765,59 @@ mod tests {
                 .unwrap_err()
                 .to_string();
         assert!(err.contains("no approximation runs"), "{err}");
+    }
+
+    #[test]
+    fn global_values_are_checked_at_their_line_before_anything_runs() {
+        let runs = "[[approximations]]\nmethod = \"riemann\"\nsamples = 1\n";
+        let cases = [
+            ("size = [0, 16]\n", 2, "size: image size must be between 1"),
+            (
+                "data_range = -1.0\n",
+                2,
+                "data_range must be a finite number > 0, got -1",
+            ),
+            (
+                "data_range = nan\n",
+                2,
+                "data_range must be a finite number > 0, got NaN",
+            ),
+            (
+                "[reference]\nspp = 0\n",
+                2,
+                "reference.spp must be between 1 and 64, got 0",
+            ),
+            (
+                "[reference]\ntol = -1e-5\n",
+                2,
+                "reference.tol must be a finite number > 0",
+            ),
+        ];
+        for (globals, line, message) in cases {
+            let text = format!("scene = \"s.toml\"\n{globals}{runs}");
+            let err = parse(&text).unwrap_err().to_string();
+            assert!(err.starts_with(&format!("dir/exp.toml:{line}: ")), "{err}");
+            assert!(err.contains(message), "{err}");
+        }
+        let err =
+            parse("scene = \"s.toml\"\n[[approximations]]\nmethod = \"riemann\"\nspp = [65]\n")
+                .unwrap_err()
+                .to_string();
+        assert!(
+            err.contains("dir/exp.toml:4: spp: expected whole numbers from 1 to 64, got 65"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn a_product_of_lists_beyond_max_runs_is_refused_at_its_entry() {
+        let list: Vec<String> = (1..=101).map(|n| n.to_string()).collect();
+        let list = list.join(", ");
+        let text = format!(
+            "scene = \"s.toml\"\n[[approximations]]\nmethod = \"riemann\"\nsamples = [{list}]\n\n[[approximations]]\nmethod = \"thesis\"\nsamples = [{list}]\nn_exact = [{list}]\n"
+        );
+        let err = parse(&text).unwrap_err().to_string();
+        assert!(err.starts_with("dir/exp.toml:7: "), "{err}");
+        assert!(err.contains("more than 10000 runs"), "{err}");
     }
 }

@@ -29,6 +29,8 @@ fn sweep_param(spec: &ParamSpec) -> SweepParam {
         name: spec.name,
         default: ParamDefault::Value(default),
         min: spec.min,
+        // "all" is the sentinel N_EXACT_ALL = u32::MAX; counts stay below it.
+        max: if accepts_all { u32::MAX - 1 } else { spec.max },
         accepts_all,
         doc: spec.doc,
     }

@@ -66,6 +66,8 @@ pub struct SweepParam {
     pub default: ParamDefault,
     /// The smallest count accepted.
     pub min: u32,
+    /// The largest count accepted.
+    pub max: u32,
     /// Whether `"all"` is a value.
     pub accepts_all: bool,
     pub doc: &'static str,
