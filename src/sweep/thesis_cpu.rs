@@ -38,6 +38,8 @@ const PARAMS: [SweepParam; 2] = [
         name: "samples",
         default: ParamDefault::Value(ParamValue::Count(100)),
         min: 1,
+        // As the GPU `thesis` allows, so that the two can be swept over the same values.
+        max: 1 << 24,
         accepts_all: false,
         doc: "midpoint samples per particle chord",
     },
@@ -45,6 +47,7 @@ const PARAMS: [SweepParam; 2] = [
         name: "n_exact",
         default: ParamDefault::Value(ParamValue::All),
         min: 0,
+        max: u32::MAX - 1,
         accepts_all: true,
         doc: "particles from the eye that get the lit model; the rest get the emission model",
     },
