@@ -214,6 +214,7 @@ fn comparison_page(s: &Summary, figures: &[Figure], viewer: &str) -> String {
         s.data_range_source,
         s.seconds
     );
+    body += viewer;
     body += "<div class=\"grid\">\n";
     for f in figures {
         let _ = writeln!(
@@ -227,7 +228,6 @@ fn comparison_page(s: &Summary, figures: &[Figure], viewer: &str) -> String {
         );
     }
     body += "</div>\n";
-    body += viewer;
     body += &metrics_table(s);
     if !s.gates.is_empty() {
         body += "<h2>Gates</h2>\n<table><tr><th>threshold</th><th>value</th><th>limit</th><th>result</th></tr>\n";
