@@ -412,3 +412,67 @@ fn viewer_zooms_flips_and_probes_the_exr_values() {
     s.eval("var e = document.getElementById('pgt-exposure'); e.value = '1'; e.dispatchEvent(new Event('input')); return 0;");
     assert_eq!(shown(&s), rv.map(|v| srgb(2.0 * v)).to_vec());
 }
+
+/// The sweep page's viewer: a run is chosen from a list, and the probe shows the reference's
+/// values (as the reference's cached EXR holds them) against the chosen run's.
+#[test]
+fn sweep_viewer_switches_runs_and_probes_the_reference() {
+    let Some((browser, driver)) = webdriver::browser_and_driver() else {
+        return;
+    };
+    let dir = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("examples/shadows.toml");
+    let exp = dir.path().join("exp.toml");
+    std::fs::write(
+        &exp,
+        format!(
+            "scene = {:?}\nsize = [40, 30]\n[reference]\nspp = 2\n[[approximations]]\nmethod = \"riemann\"\nsamples = [1]\nspp = [1, 2]\n",
+            scene.to_string_lossy()
+        ),
+    )
+    .unwrap();
+    let rep = dir.path().join("sweep");
+    let o = Command::new(env!("CARGO_BIN_EXE_pgt"))
+        .args(["sweep", &exp.to_string_lossy(), "--report"])
+        .arg(&rep)
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let cache = std::fs::read_dir(rep.join("cache"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|e| e == "exr"))
+        .expect("the cached reference");
+    let reference = pgt::image_io::read_exr_layer(&cache, "").unwrap();
+
+    let s = webdriver::Session::start(&browser, &driver, 1400, 1000);
+    s.open(
+        &rep.join("index.html"),
+        "document.getElementById('pgt-viewer') && document.getElementById('pgt-viewer').getAttribute('data-ready') === '1'",
+    );
+    s.eval("document.getElementById('pgt-viewer').scrollIntoView(); return 0;");
+    let options = s.eval(
+        "return Array.from(document.querySelectorAll('#pgt-run option')).map(o => o.textContent);",
+    );
+    assert_eq!(
+        options,
+        serde_json::json!(["riemann samples=1 spp=1", "riemann samples=1 spp=2"])
+    );
+    // Choose the run at the reference's own spp: in opaque mode it is the reference, bit for bit.
+    s.eval("var r = document.getElementById('pgt-run'); r.value = '1'; r.dispatchEvent(new Event('change')); return 0;");
+    assert!(s.text("#pgt-title-b").contains("spp=2"));
+    let target = (20, 14);
+    let (px, py) = pixel_centre(&s, "a", (40, 30), target);
+    s.hover(px, py);
+    let rv = reference.get(target.0, target.1).map(|v| v as f64);
+    assert_shown(&probe_row(&s, "reference"), rv, "reference");
+    assert_shown(&probe_row(&s, "approximation"), rv, "run spp=2");
+    assert_eq!(probe_row(&s, "difference"), vec![0.0; 3]);
+    // No error estimate in a sweep's cached reference: the row says so.
+    assert_eq!(s.text("td[data-probe=\"estimate-0\"]"), "—");
+}

@@ -334,7 +334,7 @@ body {{ font-family: sans-serif; margin: 1.5em; color: #222; }}
 figure {{ margin: 0; max-width: 32em; }}
 figure img, .plot img {{ max-width: 100%; image-rendering: pixelated; border: 1px solid #ccc; }}
 .heat {{ display: flex; align-items: flex-start; gap: 0.3em; }}
-.heat img {{ min-width: 0; flex: 1 1 auto; }}
+.heat img {{ min-width: 0; flex: 0 1 auto; }}
 .colorbar {{ flex: none; }}
 #pgt-viewer .controls {{ display: flex; flex-wrap: wrap; gap: 0.6em; align-items: center; margin: 0.5em 0; }}
 #pgt-viewer .panes {{ display: flex; flex-wrap: wrap; gap: 1em; }}

@@ -205,11 +205,11 @@
   var exposure = document.getElementById("pgt-exposure");
   var exposureOut = document.getElementById("pgt-exposure-value");
   exposure.value = String(state.exposure);
-  exposureOut.textContent = fmt(state.exposure);
+  exposureOut.textContent = String(Math.round(state.exposure * 100) / 100);
   exposure.disabled = !hasData;
   exposure.addEventListener("input", function () {
     state.exposure = Number(exposure.value);
-    exposureOut.textContent = fmt(state.exposure);
+    exposureOut.textContent = String(Math.round(state.exposure * 100) / 100);
     drawAll();
   });
   var select = document.getElementById("pgt-run");

@@ -55,6 +55,8 @@ pub struct RunResult {
     pub image_file: String,
     /// |a − r| against the reference, mean over channels, per pixel (for the heatmaps).
     pub abs_error: Vec<f32>,
+    /// The run's image (linear float), for the report's pixel probe.
+    pub image: RgbImage,
     pub warnings: Vec<String>,
 }
 
@@ -64,6 +66,8 @@ pub struct SweepResults {
     pub experiment: PathBuf,
     pub scene: PathBuf,
     pub reference: ReferenceInfo,
+    /// The reference image (linear float), for the report's pixel probe.
+    pub reference_image: RgbImage,
     pub width: u32,
     pub height: u32,
     pub runs: Vec<RunResult>,
@@ -191,7 +195,7 @@ pub fn run_sweep(
     let mut runs = Vec::with_capacity(exp.runs.len());
     let mut ctx = SweepContext::new(options.threads);
     for (i, run) in exp.runs.iter().enumerate() {
-        let (result, image) = one_run(
+        let result = one_run(
             run,
             scene,
             &mut ctx,
@@ -202,7 +206,7 @@ pub fn run_sweep(
         .map_err(|e| e.context(run.label()))?;
         progress(Progress::Run(&result));
         if run.baseline.is_some() || exp.runs.iter().any(|r| r.baseline == Some(i)) {
-            kept[i] = Some(image);
+            kept[i] = Some(result.image.clone());
         }
         runs.push(result);
     }
@@ -226,6 +230,7 @@ pub fn run_sweep(
         reference,
         width: reference_image.width,
         height: reference_image.height,
+        reference_image,
         runs,
     })
 }
@@ -238,7 +243,7 @@ fn one_run(
     reference_image: &RgbImage,
     compare_options: &CompareOptions,
     dir: &Path,
-) -> Result<(RunResult, RgbImage)> {
+) -> Result<RunResult> {
     let t = Instant::now();
     let out = method_of(run)?.render(ctx, scene, &run.values())?;
     let seconds = out.gpu_seconds.unwrap_or_else(|| t.elapsed().as_secs_f64());
@@ -253,7 +258,8 @@ fn one_run(
         baseline: None,
         image_file,
         abs_error,
+        image: out.image,
         warnings: out.warnings,
     };
-    Ok((result, out.image))
+    Ok(result)
 }
