@@ -73,10 +73,17 @@ pub struct SweepResults {
     pub runs: Vec<RunResult>,
 }
 
-/// What [`run_sweep`] reports while it works (the CLI prints one line each).
+/// What [`run_sweep`] reports while it works (the CLI shows the run in progress and prints a
+/// line for the reference and each finished run).
 #[derive(Debug)]
 pub enum Progress<'a> {
     Reference(&'a ReferenceInfo),
+    /// Run `index` (0-based) of `total` is about to start.
+    Start {
+        index: usize,
+        total: usize,
+        run: &'a Run,
+    },
     Run(&'a RunResult),
 }
 
@@ -195,6 +202,11 @@ pub fn run_sweep(
     let mut runs = Vec::with_capacity(exp.runs.len());
     let mut ctx = SweepContext::new(options.threads);
     for (i, run) in exp.runs.iter().enumerate() {
+        progress(Progress::Start {
+            index: i,
+            total: exp.runs.len(),
+            run,
+        });
         let result = one_run(
             run,
             scene,
