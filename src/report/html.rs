@@ -1,6 +1,7 @@
 //! The self-contained HTML report of one comparison (DESIGN.md §5): reference | approximation |
 //! error heatmap with its colour bar | SSIM map, relative error and FLIP maps, a metrics table and
-//! the gates. The page references only the PNGs written beside it and has no external resources;
+//! the gates, and the interactive viewer (`viewer.rs`). The page references only the files
+//! written beside it (PNGs, `pgt-data.js`, `pgt-viewer.js`) and has no external resources;
 //! an inline script marks `<body data-pgt-images="ok">` once every image has decoded (the
 //! browser test reads that mark from the DOM).
 
@@ -162,6 +163,21 @@ pub fn write_report(dir: &Path, inputs: &ReportInputs) -> Result<std::path::Path
         serde_json::to_string_pretty(inputs.summary).map_err(|e| PgtError::Usage(e.to_string()))?;
     write_text(&dir.join("summary.json"), &(json + "\n"))?;
 
+    let viewer_html = compare_viewer(dir, inputs, exposure, abs_scale)?;
+    let page = comparison_page(inputs.summary, &figures, &viewer_html);
+    let path = dir.join("index.html");
+    write_text(&path, &page)?;
+    Ok(path)
+}
+
+/// The viewer of one comparison: reference against approximation, the abs-error heatmap in the
+/// error pane, the reference's error estimate in the probe.
+fn compare_viewer(
+    dir: &Path,
+    inputs: &ReportInputs,
+    exposure: f32,
+    abs_scale: Scale,
+) -> Result<String> {
     let viewer = Viewer {
         reference: inputs.reference,
         reference_png: "reference.png".into(),
@@ -178,11 +194,7 @@ pub fn write_report(dir: &Path, inputs: &ReportInputs) -> Result<std::path::Path
             short(abs_scale.hi)
         ),
     };
-    let viewer_html = write_viewer(dir, &viewer)?;
-    let page = comparison_page(inputs.summary, &figures, &viewer_html);
-    let path = dir.join("index.html");
-    write_text(&path, &page)?;
-    Ok(path)
+    write_viewer(dir, &viewer)
 }
 
 fn fixed_or_auto(fixed: Option<f64>, values: &[f32]) -> Scale {
