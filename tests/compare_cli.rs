@@ -349,9 +349,11 @@ fn report_folder_has_page_maps_and_summary() {
     assert_eq!((abs.width, abs.height), (48, 32));
     let ssim = pgt::image_io::read_exr_layer(&rep.join("maps.exr"), "ssim").unwrap();
     assert!(ssim.pixels.iter().all(|p| p.iter().all(|v| *v <= 1.0)));
-    // The heatmap is wider than the map: the colour bar sits to its right.
+    // The heatmap is the map pixel for pixel; its colour bar is SVG with text in the page,
+    // labelled up to the fixed scale's top.
     let heat = image::open(rep.join("abs_error.png")).unwrap();
-    assert!(heat.width() > 48 && heat.height() >= 32);
+    assert_eq!((heat.width(), heat.height()), (48, 32));
+    assert!(html.contains("<svg class=\"colorbar\"") && html.contains(">0.01</text>"));
 }
 
 #[test]

@@ -35,6 +35,12 @@ fn riemann_sweep_reports_and_caches_the_reference() {
     let err = String::from_utf8_lossy(&o.stderr).into_owned();
     assert_eq!(o.status.code(), Some(0), "{err}");
     assert!(err.contains("rendered in"), "{err}");
+    // Each finished run is counted: done/total and its label.
+    assert!(
+        err.contains("[1/2] riemann samples=4 spp=1:")
+            && err.contains("[2/2] riemann samples=4 spp=2:"),
+        "{err}"
+    );
     for f in [
         "index.html",
         "dssim.svg",

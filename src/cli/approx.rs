@@ -112,6 +112,24 @@ fn describe_params(method: &Method, values: &[(String, u32)]) -> String {
     format!(" ({})", shown.join(", "))
 }
 
+/// A spinner with the elapsed time while the GPU works (a long approximation, e.g. `thesis`
+/// with many samples on lavapipe, runs for minutes in passes the CLI cannot see into); shown only
+/// when stderr is a terminal (DESIGN.md §7), cleared before the summary line.
+fn approx_spinner(params: &ApproxParams) -> indicatif::ProgressBar {
+    let method = match &params.method {
+        Some(m) => m.name(),
+        None => "the default method".to_string(),
+    };
+    let bar = indicatif::ProgressBar::new_spinner();
+    bar.set_style(
+        indicatif::ProgressStyle::with_template("{spinner} {elapsed_precise} {msg}")
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_spinner()),
+    );
+    bar.set_message(format!("approximating with {method}"));
+    bar.enable_steady_tick(std::time::Duration::from_millis(120));
+    bar
+}
+
 /// Loads the scene, runs the approximation (DESIGN.md §4), writes the image and prints the
 /// one-line summary with the adapter and the GPU time (DESIGN.md §7).
 pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
@@ -130,7 +148,12 @@ pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
     };
     let scene = super::load_scene_for(scene_path, &options, output, args.exposure)?;
     let params = args.params()?;
-    let out = approx::render_approx(&scene, &params)?;
+    let spinner = super::stderr_is_terminal().then(|| approx_spinner(&params));
+    let out = approx::render_approx(&scene, &params);
+    if let Some(s) = &spinner {
+        s.finish_and_clear();
+    }
+    let out = out?;
     write_image(output, &out.image, &[], args.exposure)?;
     if out.hit_overflow_pixels > 0 {
         eprintln!(

@@ -112,9 +112,11 @@ pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
         checks,
         start.elapsed().as_secs_f64(),
     );
-    summary.reference_uncertainty = reference_estimate(&args.reference, args.layer.as_deref())
-        .filter(|e| (e.width, e.height) == (reference.width, reference.height))
-        .map(|e| crate::metrics::errors::reference_uncertainty(&reference, &approximation, &e));
+    let estimate = reference_estimate(&args.reference, args.layer.as_deref())
+        .filter(|e| (e.width, e.height) == (reference.width, reference.height));
+    summary.reference_uncertainty = estimate
+        .as_ref()
+        .map(|e| crate::metrics::errors::reference_uncertainty(&reference, &approximation, e));
     if let Some(u) = &summary.reference_uncertainty {
         eprintln!(
             "reference error estimate: max {:.3e}, mean {:.3e}; the difference exceeds it at {:.3}% of pixel-channels",
@@ -127,6 +129,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
         let inputs = ReportInputs {
             reference: &reference,
             approximation: &approximation,
+            estimate: estimate.as_ref(),
             comparison: &cmp,
             summary: &summary,
             options: ReportOptions {

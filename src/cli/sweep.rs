@@ -24,8 +24,10 @@ pub struct SweepArgs {
     pub threads: Option<usize>,
 }
 
-/// Runs the experiment, printing a line for the reference and one per run on stderr, and
-/// writes the report.
+/// Runs the experiment and writes the report. On stderr: a line for the reference and one per
+/// finished run, counted (`[2/6] thesis samples=4: …`); where stderr is a terminal, also a bar
+/// of runs done out of the total with the run in progress (DESIGN.md §7 "Long work shows a
+/// progress bar on stderr when it is a terminal").
 pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
     let mut experiment = Experiment::load(&args.experiment)?;
     if let Some((w, h)) = args.size {
@@ -38,47 +40,104 @@ pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
     // The report is written into a temporary folder that takes the report's place at the end
     // (an interrupted sweep leaves no half-written report); the reference cache lives in the
     // report folder itself, so that it survives from one sweep to the next.
-    let (runs, page) = write_folder_atomically(&args.report, |tmp| {
+    let terminal = super::stderr_is_terminal();
+    let mut lines = RunLines {
+        bar: None,
+        terminal,
+        done: 0,
+        total: experiment.runs.len(),
+    };
+    let outcome = write_folder_atomically(&args.report, |tmp| {
         let options = SweepOptions {
             dir: tmp.to_path_buf(),
             cache: args.report.join("cache"),
             threads: args.threads,
-            progress: super::stderr_is_terminal(),
+            progress: terminal,
         };
-        let results = run_sweep(&experiment, &scene, &options, print_progress)?;
+        let results = run_sweep(&experiment, &scene, &options, |p| lines.show(p));
+        if let Some(bar) = &lines.bar {
+            bar.finish_and_clear();
+        }
+        let results = results?;
         write_sweep_report(tmp, &results)?;
         Ok((results.runs.len(), args.report.join("index.html")))
-    })?;
+    });
+    let (runs, page) = outcome?;
     println!("sweep: {runs} runs, report {}", page.display());
     Ok(Outcome::Success)
 }
 
-/// One line per finished render on stderr.
-fn print_progress(p: Progress) {
-    match p {
-        Progress::Reference(r) => eprintln!(
-            "reference: {} ({})",
-            r.cache_file.display(),
-            match r.seconds {
-                Some(s) => format!("rendered in {s:.2} s"),
-                None => "from the cache".into(),
+/// The sweep's progress on stderr: the bar (a terminal only; made at the first run, after the
+/// reference's own bar has finished) and the lines, printed above the bar.
+struct RunLines {
+    bar: Option<indicatif::ProgressBar>,
+    terminal: bool,
+    done: usize,
+    total: usize,
+}
+
+impl RunLines {
+    fn show(&mut self, p: Progress) {
+        match p {
+            Progress::Reference(r) => self.line(format!(
+                "reference: {} ({})",
+                r.cache_file.display(),
+                match r.seconds {
+                    Some(s) => format!("rendered in {s:.2} s"),
+                    None => "from the cache".into(),
+                }
+            )),
+            Progress::Start { index, total, run } => {
+                self.total = total;
+                if self.terminal {
+                    let bar = self.bar.get_or_insert_with(|| run_bar(total));
+                    bar.set_position(index as u64);
+                    bar.set_message(run.label());
+                }
             }
-        ),
-        Progress::Run(r) => {
-            let ssim = r
-                .comparison
-                .ssim_values()
-                .map(|s| format!("{:.6}", s.mean))
-                .unwrap_or("n/a".into());
-            eprintln!(
-                "{}: {:.2} s, SSIM {ssim}, RMSE {:.3e}",
-                r.run.label(),
-                r.seconds,
-                r.comparison.error_values(|e| e.rmse).mean
-            );
-            for w in &r.warnings {
-                eprintln!("warning: {}: {w}", r.run.label());
+            Progress::Run(r) => {
+                self.done += 1;
+                let ssim = r
+                    .comparison
+                    .ssim_values()
+                    .map(|s| format!("{:.6}", s.mean))
+                    .unwrap_or("n/a".into());
+                self.line(format!(
+                    "[{}/{}] {}: {:.2} s, SSIM {ssim}, RMSE {:.3e}",
+                    self.done,
+                    self.total,
+                    r.run.label(),
+                    r.seconds,
+                    r.comparison.error_values(|e| e.rmse).mean
+                ));
+                for w in &r.warnings {
+                    self.line(format!("warning: {}: {w}", r.run.label()));
+                }
+                if let Some(bar) = &self.bar {
+                    bar.set_position(self.done as u64);
+                }
             }
         }
     }
+
+    /// A line on stderr, above the bar where there is one.
+    fn line(&self, text: String) {
+        match &self.bar {
+            Some(bar) => bar.println(text),
+            None => eprintln!("{text}"),
+        }
+    }
+}
+
+/// The bar of runs: done/total, elapsed, and the run in progress.
+fn run_bar(total: usize) -> indicatif::ProgressBar {
+    let bar = indicatif::ProgressBar::new(total as u64);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(
+            "{elapsed_precise} [{bar:30}] {pos}/{len} runs; now: {msg}",
+        )
+        .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    bar
 }

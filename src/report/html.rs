@@ -1,12 +1,15 @@
 //! The self-contained HTML report of one comparison (DESIGN.md §5): reference | approximation |
 //! error heatmap with its colour bar | SSIM map, relative error and FLIP maps, a metrics table and
-//! the gates. The page references only the PNGs written beside it and has no external resources;
+//! the gates, and the interactive viewer (`viewer.rs`). The page references only the files
+//! written beside it (PNGs, `pgt-data.js`, `pgt-viewer.js`) and has no external resources;
 //! an inline script marks `<body data-pgt-images="ok">` once every image has decoded (the
 //! browser test reads that mark from the DOM).
 
+use super::colorbar::colorbar_svg;
 use super::colormap::{ColorMap, Scale};
 use super::heatmap::heatmap;
 use super::summary::{format_db, short, Summary};
+use super::viewer::{write_viewer, Viewer, ViewerImage};
 use crate::error::{PgtError, Result};
 use crate::image_io::{write_image, RgbImage};
 use crate::metrics::{maps, Comparison, PerChannel};
@@ -26,16 +29,19 @@ pub struct ReportOptions {
 pub struct ReportInputs<'a> {
     pub reference: &'a RgbImage,
     pub approximation: &'a RgbImage,
+    /// The reference's per-pixel error estimate (its EXR `err` layer), for the pixel probe.
+    pub estimate: Option<&'a RgbImage>,
     pub comparison: &'a Comparison,
     pub summary: &'a Summary,
     pub options: ReportOptions,
 }
 
-/// One picture of the report with its caption.
+/// One picture of the report with its caption and, for heatmaps, its colour bar (inline SVG).
 struct Figure {
     file: &'static str,
     title: String,
     caption: String,
+    bar: Option<String>,
 }
 
 /// Writes the maps and the page into `dir` (created if missing): `index.html`,
@@ -75,11 +81,13 @@ pub fn write_report(dir: &Path, inputs: &ReportInputs) -> Result<std::path::Path
             file: "reference.png",
             title: "Reference".into(),
             caption: exposure_note.clone(),
+            bar: None,
         },
         Figure {
             file: "approximation.png",
             title: "Approximation".into(),
             caption: exposure_note,
+            bar: None,
         },
         Figure {
             file: "abs_error.png",
@@ -94,18 +102,24 @@ pub fn write_report(dir: &Path, inputs: &ReportInputs) -> Result<std::path::Path
                     " (max of the map)"
                 }
             ),
+            bar: Some(colorbar_svg(
+                abs_scale,
+                ColorMap::Magma,
+                "absolute error",
+                "bar-abs",
+            )),
         },
     ];
     let mut layers_owned: Vec<(&str, RgbImage)> = vec![("rel", rel)];
     if let Ok(ssim) = &cmp.ssim {
         let img = maps::ssim_image(w, h, ssim);
         let mean = maps::channel_mean(&img);
-        heatmap(&mean, w, h, Scale { lo: 0.0, hi: 1.0 }, ColorMap::Viridis)
-            .write_png(&dir.join("ssim.png"))?;
+        heatmap(&mean, w, h, UNIT, ColorMap::Viridis).write_png(&dir.join("ssim.png"))?;
         figures.push(Figure {
             file: "ssim.png",
             title: "SSIM map".into(),
             caption: "mean over R, G, B; viridis, scale 0 … 1 (values below 0 shown as 0)".into(),
+            bar: Some(colorbar_svg(UNIT, ColorMap::Viridis, "SSIM", "bar-ssim")),
         });
         layers_owned.push(("ssim", img));
     }
@@ -117,10 +131,15 @@ pub fn write_report(dir: &Path, inputs: &ReportInputs) -> Result<std::path::Path
             short(rel_scale.lo),
             short(rel_scale.hi)
         ),
+        bar: Some(colorbar_svg(
+            rel_scale,
+            ColorMap::Magma,
+            "relative error",
+            "bar-rel",
+        )),
     });
     if let Ok(flip) = &cmp.flip {
-        heatmap(&flip.map, w, h, Scale { lo: 0.0, hi: 1.0 }, ColorMap::Magma)
-            .write_png(&dir.join("flip.png"))?;
+        heatmap(&flip.map, w, h, UNIT, ColorMap::Magma).write_png(&dir.join("flip.png"))?;
         figures.push(Figure {
             file: "flip.png",
             title: if flip.exposures.is_some() { "HDR-FLIP" } else { "FLIP (LDR)" }.into(),
@@ -134,6 +153,7 @@ pub fn write_report(dir: &Path, inputs: &ReportInputs) -> Result<std::path::Path
                     flip.pixels_per_degree
                 ),
             },
+            bar: Some(colorbar_svg(UNIT, ColorMap::Magma, "FLIP", "bar-flip")),
         });
         layers_owned.push(("flip", maps::gray_image(w, h, &flip.map)));
     }
@@ -143,10 +163,38 @@ pub fn write_report(dir: &Path, inputs: &ReportInputs) -> Result<std::path::Path
         serde_json::to_string_pretty(inputs.summary).map_err(|e| PgtError::Usage(e.to_string()))?;
     write_text(&dir.join("summary.json"), &(json + "\n"))?;
 
-    let page = comparison_page(inputs.summary, &figures);
+    let viewer_html = compare_viewer(dir, inputs, exposure, abs_scale)?;
+    let page = comparison_page(inputs.summary, &figures, &viewer_html);
     let path = dir.join("index.html");
     write_text(&path, &page)?;
     Ok(path)
+}
+
+/// The viewer of one comparison: reference against approximation, the abs-error heatmap in the
+/// error pane, the reference's error estimate in the probe.
+fn compare_viewer(
+    dir: &Path,
+    inputs: &ReportInputs,
+    exposure: f32,
+    abs_scale: Scale,
+) -> Result<String> {
+    let viewer = Viewer {
+        reference: inputs.reference,
+        reference_png: "reference.png".into(),
+        estimate: inputs.estimate,
+        approximations: vec![ViewerImage {
+            label: "approximation".into(),
+            png: "approximation.png".into(),
+            heatmap: "abs_error.png".into(),
+            image: inputs.approximation,
+        }],
+        exposure,
+        error_caption: format!(
+            "|a − r|, mean over R, G, B, magma 0 … {}",
+            short(abs_scale.hi)
+        ),
+    };
+    write_viewer(dir, &viewer)
 }
 
 fn fixed_or_auto(fixed: Option<f64>, values: &[f32]) -> Scale {
@@ -156,7 +204,10 @@ fn fixed_or_auto(fixed: Option<f64>, values: &[f32]) -> Scale {
     }
 }
 
-fn comparison_page(s: &Summary, figures: &[Figure]) -> String {
+/// The scale of SSIM and FLIP maps.
+const UNIT: Scale = Scale { lo: 0.0, hi: 1.0 };
+
+fn comparison_page(s: &Summary, figures: &[Figure], viewer: &str) -> String {
     let mut body = String::new();
     let _ = write!(
         body,
@@ -175,13 +226,15 @@ fn comparison_page(s: &Summary, figures: &[Figure]) -> String {
         s.data_range_source,
         s.seconds
     );
+    body += viewer;
     body += "<div class=\"grid\">\n";
     for f in figures {
         let _ = writeln!(
             body,
-            "<figure><img src=\"{}\" alt=\"{}\"><figcaption><b>{}</b><br>{}</figcaption></figure>",
+            "<figure><div class=\"heat\"><img src=\"{}\" alt=\"{}\">{}</div><figcaption><b>{}</b><br>{}</figcaption></figure>",
             f.file,
             escape(&f.title),
+            f.bar.as_deref().unwrap_or(""),
             escape(&f.title),
             escape(&f.caption)
         );
@@ -292,6 +345,15 @@ body {{ font-family: sans-serif; margin: 1.5em; color: #222; }}
 .grid {{ display: flex; flex-wrap: wrap; gap: 1em; }}
 figure {{ margin: 0; max-width: 32em; }}
 figure img, .plot img {{ max-width: 100%; image-rendering: pixelated; border: 1px solid #ccc; }}
+.heat {{ display: flex; align-items: flex-start; gap: 0.3em; }}
+.heat img {{ min-width: 0; flex: 0 1 auto; }}
+.colorbar {{ flex: none; }}
+#pgt-viewer .controls {{ display: flex; flex-wrap: wrap; gap: 0.6em; align-items: center; margin: 0.5em 0; }}
+#pgt-viewer .panes {{ display: flex; flex-wrap: wrap; gap: 1em; }}
+#pgt-viewer .viewport {{ position: relative; overflow: hidden; border: 1px solid #888; background: #777; cursor: crosshair; touch-action: none; }}
+#pgt-viewer canvas {{ position: absolute; left: 0; top: 0; transform-origin: 0 0; image-rendering: pixelated; }}
+#pgt-viewer .pane-title {{ font-size: 0.85em; font-weight: bold; }}
+#pgt-probe td {{ font-family: monospace; }}
 figcaption {{ font-size: 0.85em; }}
 table {{ border-collapse: collapse; margin: 1em 0; }}
 td, th {{ border: 1px solid #bbb; padding: 0.2em 0.6em; text-align: right; }}

@@ -1,7 +1,9 @@
 //! Reports of a comparison (DESIGN.md §5): colour maps and heatmaps with colour bars, the
-//! self-contained HTML page, SVG plots of swept parameters, and the page of a sweep.
+//! self-contained HTML page with its interactive viewer (`viewer.rs`, `viewer.js`), SVG colour
+//! bars and plots of swept parameters, and the page of a sweep.
 
 pub mod attribution;
+pub mod colorbar;
 pub mod colormap;
 mod colormap_data;
 pub mod heatmap;
@@ -15,3 +17,4 @@ pub use html::{write_report, ReportInputs, ReportOptions};
 pub use summary::Summary;
 pub mod plot;
 pub mod sweep_page;
+pub mod viewer;

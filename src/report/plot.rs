@@ -5,7 +5,8 @@
 //! Ticks are placed here, not by plotters, so that labels stay readable: on a log axis at
 //! 1, 2, 5 × 10^k (or every decade, or every few decades, whichever keeps them apart), written
 //! `1`, `10`, `0.001` (and `1e-7` outside 0.001..100000); on a category axis (e.g. `n_exact` =
-//! 1, 2, 5, all) at each category; linear axes keep plotters' round ticks.
+//! 1, 2, 5, all) at each category, or every n-th where their labels would overlap; linear axes
+//! keep plotters' round ticks. A test checks that no two tick labels overlap.
 
 use crate::error::{PgtError, Result};
 use plotters::prelude::*;
@@ -177,14 +178,37 @@ impl Axis {
     }
 }
 
+/// Width of the plot area in SVG pixels (640 minus the y label area and the margins), and the
+/// width of a label character at plotters' label font (about 9.7 px sans-serif: at most
+/// 0.6 em per digit), with a gap between neighbouring labels.
+const PLOT_AREA_W: f64 = 640.0 - 70.0 - 2.0 * 12.0;
+const LABEL_CHAR_W: f64 = 6.0;
+const LABEL_GAP: f64 = 8.0;
+
+/// Label every n-th category so that neighbouring labels do not overlap: categories sit
+/// `PLOT_AREA_W / count` apart, a label needs its characters plus a gap.
+fn category_step(categories: &[String]) -> usize {
+    let chars = categories
+        .iter()
+        .map(|c| c.chars().count())
+        .max()
+        .unwrap_or(1);
+    let need = chars as f64 * LABEL_CHAR_W + LABEL_GAP;
+    let room = PLOT_AREA_W / categories.len().max(1) as f64;
+    ((need / room).ceil() as usize).max(1)
+}
+
 /// Draws `series` into an SVG file at `path` (640×400).
 pub fn line_plot_svg(path: &Path, spec: &PlotSpec, series: &[Series]) -> Result<()> {
     let log_x = spec.log_x && spec.x_categories.is_none();
     let (series, x, y) = layout(spec, series);
     let (x0, x1, xt) = (x.lo, x.hi, x.ticks);
     let (y0, y1, yt) = (y.lo, y.hi, y.ticks);
+    let every = spec.x_categories.map_or(1, category_step);
     let x_label = |v: &f64| match spec.x_categories {
-        Some(c) if (v - v.round()).abs() < 1e-6 && *v >= 0.0 => {
+        Some(c)
+            if (v - v.round()).abs() < 1e-6 && *v >= 0.0 && (v.round() as usize) % every == 0 =>
+        {
             c.get(v.round() as usize).cloned().unwrap_or_default()
         }
         Some(_) => String::new(),
@@ -257,6 +281,106 @@ pub fn line_plot_svg(path: &Path, spec: &PlotSpec, series: &[Series]) -> Result<
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Tick labels of an SVG written by [`line_plot_svg`]: (x, y, anchor, text).
+    fn tick_labels(svg: &str) -> Vec<(f64, f64, String, String)> {
+        svg.split("<text ")
+            .skip(1)
+            .filter_map(|t| {
+                let attr = |name: &str| -> Option<String> {
+                    let v = t.split(&format!("{name}=\"")).nth(1)?;
+                    Some(v[..v.find('"')?].to_string())
+                };
+                let text = t.split('>').nth(1)?.split('<').next()?.trim().to_string();
+                Some((
+                    attr("x")?.parse().ok()?,
+                    attr("y")?.parse().ok()?,
+                    attr("text-anchor")?,
+                    text,
+                ))
+            })
+            .filter(|l: &(f64, f64, String, String)| !l.3.is_empty())
+            .collect()
+    }
+
+    #[test]
+    fn tick_labels_never_overlap() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("p.svg");
+        let many: Vec<String> = (0..40).map(|i| (1000 + 37 * i).to_string()).collect();
+        let few: Vec<String> = ["1", "2", "5", "all"].map(String::from).to_vec();
+        // (log x, log y, categories, points)
+        type Case<'a> = (bool, bool, Option<&'a [String]>, Vec<(f64, f64)>);
+        let cases: Vec<Case> = vec![
+            (true, true, None, vec![(1.0, 1e-9), (1e6, 0.5)]),
+            (true, false, None, vec![(1.0, 1.234e-4), (3000.0, 9.87e-4)]),
+            (true, true, None, vec![(2.0, 3e-3), (3.0, 4e-3)]),
+            (
+                false,
+                false,
+                None,
+                vec![(0.000_123, 1.0), (0.000_987, 123_456.0)],
+            ),
+            (
+                true,
+                true,
+                Some(&many),
+                (0..40).map(|i| (i as f64, 1e-3 / (i + 1) as f64)).collect(),
+            ),
+            (
+                true,
+                true,
+                Some(&few),
+                (0..4).map(|i| (i as f64, 1e-3 / (i + 1) as f64)).collect(),
+            ),
+        ];
+        for (log_x, log_y, categories, points) in cases {
+            let spec = PlotSpec {
+                title: "t",
+                x_label: "x",
+                y_label: "y",
+                log_x,
+                log_y,
+                x_categories: categories,
+            };
+            let series = [Series {
+                label: String::new(),
+                points,
+            }];
+            line_plot_svg(&path, &spec, &series).unwrap();
+            let svg = std::fs::read_to_string(&path).unwrap();
+            let labels = tick_labels(&svg);
+            // x tick labels: centred, on the row below the plot; y tick labels: right-aligned.
+            let mut xs: Vec<_> = labels
+                .iter()
+                .filter(|l| l.2 == "middle" && l.1 > 340.0 && l.1 < 380.0)
+                .collect();
+            let mut ys: Vec<_> = labels.iter().filter(|l| l.2 == "end").collect();
+            assert!(xs.len() >= 2 && ys.len() >= 2, "{labels:?}");
+            xs.sort_by(|a, b| a.0.total_cmp(&b.0));
+            ys.sort_by(|a, b| a.1.total_cmp(&b.1));
+            for p in xs.windows(2) {
+                let half = |t: &str| t.chars().count() as f64 * LABEL_CHAR_W / 2.0;
+                assert!(
+                    p[1].0 - p[0].0 >= half(&p[0].3) + half(&p[1].3) + 2.0,
+                    "x labels overlap: {:?} {:?} (categories {categories:?})",
+                    p[0],
+                    p[1]
+                );
+            }
+            for p in ys.windows(2) {
+                assert!(
+                    p[1].1 - p[0].1 >= 12.0,
+                    "y labels overlap: {:?} {:?}",
+                    p[0],
+                    p[1]
+                );
+            }
+        }
+        // The many categories are thinned, the few all labelled.
+        assert!(category_step(&many) > 1);
+        assert_eq!(category_step(&few), 1);
+    }
 
     #[test]
     fn log_ticks_are_round_and_few() {

@@ -5,9 +5,11 @@
 //! [`SweepResults`](crate::sweep::SweepResults).
 
 use super::attribution::{attribution_json, attribution_section, write_attribution_files};
+use super::colorbar::colorbar_svg;
 use super::html::{escape, page, write_text};
 use super::plot::{line_plot_svg, PlotSpec, Series};
 use super::summary::{format_db, short};
+use super::viewer::{write_viewer, Viewer, ViewerImage};
 use super::{heatmap, ColorMap, Scale};
 use crate::error::{PgtError, Result};
 use crate::metrics::Comparison;
@@ -38,8 +40,33 @@ pub fn write_sweep_report(dir: &Path, results: &SweepResults) -> Result<PathBuf>
     }
     write_plots(dir, &results.runs, results.plot_x)?;
     write_attribution_files(dir, &results.attributions, results.width, results.height)?;
+    let viewer = Viewer {
+        reference: &results.reference_image,
+        reference_png: "reference.png".into(),
+        estimate: None,
+        approximations: results
+            .runs
+            .iter()
+            .map(|r| ViewerImage {
+                label: r.run.label(),
+                png: r.image_file.clone(),
+                heatmap: heatmap_file(r),
+                image: &r.image,
+            })
+            .collect(),
+        exposure: 0.0,
+        error_caption: format!(
+            "|a − r|, mean over R, G, B, magma 0 … {}, one scale for all runs",
+            short(scale.hi)
+        ),
+    };
+    let viewer_html = if results.runs.is_empty() {
+        String::new()
+    } else {
+        write_viewer(dir, &viewer)?
+    };
     let page_path = dir.join("index.html");
-    write_text(&page_path, &sweep_page(results))?;
+    write_text(&page_path, &sweep_page(results, &viewer_html, scale))?;
     write_json(dir, "sweep.json", &sweep_json(&results.runs))?;
     write_json(dir, "summary.json", &summary_json(results))?;
     Ok(page_path)
@@ -266,8 +293,8 @@ fn ssim_cells(cmp: &Comparison) -> String {
 }
 
 /// The page: the header, the table against the reference, the table against the baselines (if
-/// any), the plots, the images.
-fn sweep_page(results: &SweepResults) -> String {
+/// any), the viewer, the plots, the images with their heatmaps on `scale`.
+fn sweep_page(results: &SweepResults, viewer: &str, scale: Scale) -> String {
     let mut b = String::new();
     let reference = &results.reference;
     let _ = writeln!(
@@ -329,6 +356,7 @@ fn sweep_page(results: &SweepResults) -> String {
         }
         b += "</table>\n";
     }
+    b += viewer;
     b += "<h2>Plots</h2>\n<div class=\"grid\">\n";
     let mut plots = vec![
         ("dssim.svg", "1 − SSIM"),
@@ -345,8 +373,14 @@ fn sweep_page(results: &SweepResults) -> String {
     b += "</div>\n";
     b += &attribution_section(&results.attributions);
     b += "<h2>Images</h2>\n<div class=\"grid\">\n<figure><img src=\"reference.png\" alt=\"reference\"><figcaption><b>reference</b></figcaption></figure>\n";
-    for r in &results.runs {
+    for (i, r) in results.runs.iter().enumerate() {
         let label = escape(&r.run.label());
+        let bar = colorbar_svg(
+            scale,
+            ColorMap::Magma,
+            "absolute error",
+            &format!("bar-{i}"),
+        );
         let _ = writeln!(
             b,
             "<figure><img src=\"{}\" alt=\"{label}\"><figcaption><b>{label}</b></figcaption></figure>",
@@ -354,7 +388,7 @@ fn sweep_page(results: &SweepResults) -> String {
         );
         let _ = writeln!(
             b,
-            "<figure><img src=\"{}\" alt=\"error of {label}\"><figcaption>|a − r|, mean over R, G, B; magma, one scale for all runs</figcaption></figure>",
+            "<figure><div class=\"heat\"><img src=\"{}\" alt=\"error of {label}\">{bar}</div><figcaption>|a − r|, mean over R, G, B; magma, one scale for all runs</figcaption></figure>",
             escape(&heatmap_file(r)),
         );
     }

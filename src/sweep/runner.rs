@@ -58,6 +58,8 @@ pub struct RunResult {
     pub image_file: String,
     /// |a − r| against the reference, mean over channels, per pixel (for the heatmaps).
     pub abs_error: Vec<f32>,
+    /// The run's image (linear float), for the report's pixel probe.
+    pub image: RgbImage,
     pub warnings: Vec<String>,
 }
 
@@ -67,6 +69,8 @@ pub struct SweepResults {
     pub experiment: PathBuf,
     pub scene: PathBuf,
     pub reference: ReferenceInfo,
+    /// The reference image (linear float), for the report's pixel probe.
+    pub reference_image: RgbImage,
     pub width: u32,
     pub height: u32,
     pub runs: Vec<RunResult>,
@@ -80,10 +84,17 @@ pub struct SweepResults {
     pub threads: usize,
 }
 
-/// What [`run_sweep`] reports while it works (the CLI prints one line each).
+/// What [`run_sweep`] reports while it works (the CLI shows the run in progress and prints a
+/// line for the reference and each finished run).
 #[derive(Debug)]
 pub enum Progress<'a> {
     Reference(&'a ReferenceInfo),
+    /// Run `index` (0-based) of `total` is about to start.
+    Start {
+        index: usize,
+        total: usize,
+        run: &'a Run,
+    },
     Run(&'a RunResult),
 }
 
@@ -182,7 +193,12 @@ pub fn run_sweep(
     let mut runs = Vec::with_capacity(exp.runs.len());
     let mut ctx = SweepContext::new(options.threads);
     for (i, run) in exp.runs.iter().enumerate() {
-        let (result, image) = one_run(
+        progress(Progress::Start {
+            index: i,
+            total: exp.runs.len(),
+            run,
+        });
+        let result = one_run(
             run,
             scene,
             &mut ctx,
@@ -197,7 +213,7 @@ pub fn run_sweep(
             .iter()
             .any(|a| a.run == i || a.steps.iter().any(|s| s.run == Some(i)));
         if in_chain || run.baseline.is_some() || exp.runs.iter().any(|r| r.baseline == Some(i)) {
-            kept[i] = Some(image);
+            kept[i] = Some(result.image.clone());
         }
         runs.push(result);
     }
@@ -226,6 +242,7 @@ pub fn run_sweep(
         reference,
         width: reference_image.width,
         height: reference_image.height,
+        reference_image,
         runs,
         plot_x: exp.plot_x,
         attributions,
@@ -242,7 +259,7 @@ fn one_run(
     reference_image: &RgbImage,
     compare_options: &CompareOptions,
     dir: &Path,
-) -> Result<(RunResult, RgbImage)> {
+) -> Result<RunResult> {
     let t = Instant::now();
     let out = method_of(run)?.render(ctx, scene, &run.values())?;
     let seconds = out.gpu_seconds.unwrap_or_else(|| t.elapsed().as_secs_f64());
@@ -257,7 +274,8 @@ fn one_run(
         baseline: None,
         image_file,
         abs_error,
+        image: out.image,
         warnings: out.warnings,
     };
-    Ok((result, out.image))
+    Ok(result)
 }
