@@ -17,6 +17,18 @@ fn sweep(experiment: &Path, report: &Path) -> std::process::Output {
         .unwrap()
 }
 
+/// [`sweep`], which must succeed (exit 0; its stderr is the failure message otherwise).
+fn sweep_ok(experiment: &Path, report: &Path) -> std::process::Output {
+    let o = sweep(experiment, report);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
 #[test]
 fn riemann_sweep_reports_and_caches_the_reference() {
     let dir = tempfile::tempdir().unwrap();
@@ -91,13 +103,7 @@ fn a_baseline_run_is_compared_in_the_references_place() {
     )
     .unwrap();
     let rep = dir.path().join("rep");
-    let o = sweep(&exp, &rep);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    sweep_ok(&exp, &rep);
     let runs: serde_json::Value =
         serde_json::from_slice(&std::fs::read(rep.join("sweep.json")).unwrap()).unwrap();
     let at = |spp: u64| {
@@ -308,13 +314,7 @@ fn attribution_splits_the_error_into_causes_whose_shares_add_up() {
     )
     .unwrap();
     let rep = dir.path().join("rep");
-    let o = sweep(&exp, &rep);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    sweep_ok(&exp, &rep);
     let a = first_attribution(&rep);
     assert_eq!(a["run"], "thesis-cpu samples=4 n_exact=0");
     let causes = a["causes"].as_array().unwrap();
@@ -377,13 +377,7 @@ fn thesis_on_the_gpu_differs_from_thesis_cpu_by_float32_rounding_only() {
     )
     .unwrap();
     let rep = dir.path().join("rep");
-    let o = sweep(&exp, &rep);
-    assert_eq!(
-        o.status.code(),
-        Some(0),
-        "{}",
-        String::from_utf8_lossy(&o.stderr)
-    );
+    sweep_ok(&exp, &rep);
     let a = first_attribution(&rep);
     let causes = a["causes"].as_array().unwrap();
     // The chain stops before the reference: the rest is the residual.
