@@ -6,7 +6,7 @@
 # tests/data and ../shared/data (when present), the examples and fuzz/seeds/TARGET. A crash is
 # minimised into fuzz/artifacts/TARGET/minimized-*; commit it under tests/data/fuzz/TARGET with
 # a regression test. One fuzzing process (libFuzzer's default; `-jobs=N` would fork N and log to
-# files), niced: the machine is shared.
+# files), niced (PGT_FUZZ_NICE, default 10: the machine is shared; 0 to fuzz at full speed).
 #
 # Needs a nightly toolchain (`rustup toolchain install nightly`); installs cargo-fuzz when it is
 # missing. CARGO_TARGET_DIR is honoured (the fuzz build is separate from the normal one).
@@ -55,5 +55,5 @@ for dir in "${seed_dirs[@]}"; do
 done
 
 cd "$fuzz"
-exec nice -n 10 cargo +nightly fuzz run "$target" "$corpus" -- \
+exec nice -n "${PGT_FUZZ_NICE:-10}" cargo +nightly fuzz run "$target" "$corpus" -- \
     -max_total_time="$seconds" -rss_limit_mb=2048 -timeout=10 "$@"

@@ -35,6 +35,10 @@ fn assert_refused(o: &Output, file: &str, line: usize, reason: &str, case: &str)
         err.contains(reason),
         "{case}: expected `{reason}` in: {err}"
     );
+    if case == "not text" {
+        // The I/O error is the message's cause and its text: said once, not twice.
+        assert_eq!(err.matches(reason).count(), 1, "{case}: said twice in: {err}");
+    }
 }
 
 const NOT_UTF8: &[u8] = b"min_ssim = 0.9\n\xff\xfe\x00\x01garbage";
