@@ -209,22 +209,29 @@ fn merge_intervals(
     let mut t = first.t0;
     let mut next = 0;
     loop {
-        let mut k = 0;
-        while k < active.len() {
-            if exits[k] == t {
-                active.remove(k);
-                exits.remove(k);
-            } else {
-                k += 1;
+        // The active set is a handful of particles: shifting by hand beats `Vec::insert` and
+        // `Vec::remove`, whose memmove calls cost more than the few elements they move.
+        let mut kept = 0;
+        for k in 0..active.len() {
+            if exits[k] != t {
+                active[kept] = active[k];
+                exits[kept] = exits[k];
+                kept += 1;
             }
         }
+        active.truncate(kept);
+        exits.truncate(kept);
         while next < spans.len() && spans[next].t0 == t {
             let s = spans[next];
             let key = (ranks[s.index as usize], s.index);
             // A particle entered twice cannot happen on a ray; ignoring it keeps the sweep total.
             if let Err(pos) = active.binary_search(&key) {
-                active.insert(pos, key);
-                exits.insert(pos, s.t1);
+                active.push(key);
+                exits.push(s.t1);
+                for k in (pos + 1..active.len()).rev() {
+                    active.swap(k, k - 1);
+                    exits.swap(k, k - 1);
+                }
             }
             next += 1;
         }
