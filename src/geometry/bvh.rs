@@ -84,7 +84,7 @@ fn sphere_box(c: DVec3, r: f64) -> Aabb {
 impl Bvh {
     /// Builds the hierarchy. Centres and radii must be finite (the scene validates them).
     ///
-    /// Subtrees over more than [`PARALLEL_MIN`] spheres are built on rayon's pool, their two
+    /// Subtrees over more than `PARALLEL_MIN` (16k) spheres are built on rayon's pool, their two
     /// halves at once. The node layout is that of a sequential depth-first build (a node's
     /// children are allocated as a pair when it is split, the left subtree is finished before
     /// the right one starts), so the tree is the same for any number of threads.
@@ -278,7 +278,7 @@ impl NodeStack {
 
 /// Subtrees over more spheres than this are built in parallel (smaller ones are not worth a
 /// task, and each parallel level copies its subtrees once to relocate them).
-pub const PARALLEL_MIN: usize = 16 * 1024;
+const PARALLEL_MIN: usize = 16 * 1024;
 
 /// A node's box and where its range of `indices` was split (`None`: a leaf).
 fn split_node(indices: &mut [u32], boxes: &[Aabb], centers: &[DVec3]) -> (Aabb, Option<usize>) {

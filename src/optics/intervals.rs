@@ -21,7 +21,6 @@
 use super::particle::Particle;
 use crate::geometry::Hit;
 use glam::DVec3;
-use rayon::prelude::*;
 use std::cmp::Ordering;
 
 /// A piece [t0, t1] of a ray with a fixed set of particles: what the models of DESIGN.md §2 need.
@@ -58,8 +57,9 @@ pub fn canonical_ranks(particles: &[Particle]) -> Vec<u32> {
         ]
     };
     let mut order: Vec<u32> = (0..particles.len() as u32).collect();
-    // A stable sort: ties keep index order, the same on any number of threads.
-    order.par_sort_by(|&a, &b| {
+    // Sequential: rayon's parallel merge sort was slower than this on two busy cores (it makes
+    // more calls of the heavy comparison).
+    order.sort_by(|&a, &b| {
         let (ka, kb) = (key(&particles[a as usize]), key(&particles[b as usize]));
         ka.iter()
             .zip(&kb)
