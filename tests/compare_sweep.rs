@@ -386,3 +386,48 @@ fn thesis_on_the_gpu_differs_from_thesis_cpu_by_float32_rounding_only() {
     assert!(float32 < 1e-5, "{a}");
     assert!(causes[1]["rmse"].as_f64().unwrap() > 100.0 * float32, "{a}");
 }
+
+/// DESIGN.md §3: a reference pixel that does not converge is reported, not hidden, in a sweep
+/// too: the centre pixel's ray runs exactly through a point light inside gas. The count and the
+/// worst pixel are in `summary.json` and on stderr, also when the reference comes from the cache.
+#[test]
+fn a_sweep_reports_the_references_unconverged_pixels() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::write(
+        dir.path().join("light_inside.toml"),
+        "[camera]\nposition = [0.0, 0.0, -5.0]\nlook_at = [0.0, 0.0, 0.0]\nfov_y = 40.0\n\
+         [render]\nmodel = \"lit\"\ntol = 1e-4\n\
+         [[lights]]\ntype = \"point\"\nposition = [0.0, 0.0, 0.0]\nintensity = [0.1, 0.1, 0.1]\n\
+         [[particles]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\ncolor = [1.0, 1.0, 1.0]\nopacity = 0.5\n",
+    )
+    .unwrap();
+    let exp = dir.path().join("exp.toml");
+    std::fs::write(
+        &exp,
+        "scene = \"light_inside.toml\"\nsize = [3, 3]\n[[approximations]]\nmethod = \"riemann\"\nsamples = 4\n",
+    )
+    .unwrap();
+    let rep = dir.path().join("rep");
+    for pass in ["rendered", "from the cache"] {
+        let o = sweep_ok(&exp, &rep);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            err.contains(pass)
+                && err.contains("reference pixel(s) did not reach tol; the worst is (1, 1)"),
+            "{err}"
+        );
+        let summary: serde_json::Value =
+            serde_json::from_slice(&std::fs::read(rep.join("summary.json")).unwrap()).unwrap();
+        assert!(
+            summary["reference_unconverged"].as_u64().unwrap() >= 1,
+            "{summary}"
+        );
+        let worst = &summary["reference_worst_unconverged"];
+        assert_eq!(
+            (worst[0].as_u64(), worst[1].as_u64()),
+            (Some(1), Some(1)),
+            "{summary}"
+        );
+        assert!(worst[2].as_f64().unwrap() > 1e-4, "{summary}");
+    }
+}

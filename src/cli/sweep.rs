@@ -79,14 +79,25 @@ struct RunLines {
 impl RunLines {
     fn show(&mut self, p: Progress) {
         match p {
-            Progress::Reference(r) => self.line(format!(
-                "reference: {} ({})",
-                r.cache_file.display(),
-                match r.seconds {
-                    Some(s) => format!("rendered in {s:.2} s"),
-                    None => "from the cache".into(),
+            Progress::Reference(r) => {
+                self.line(format!(
+                    "reference: {} ({})",
+                    r.cache_file.display(),
+                    match r.seconds {
+                        Some(s) => format!("rendered in {s:.2} s"),
+                        None => "from the cache".into(),
+                    }
+                ));
+                // DESIGN.md §3: a pixel that does not converge is reported, not hidden.
+                if let Some(u) = r.unconverged {
+                    if let Some((x, y, e)) = u.worst {
+                        self.line(format!(
+                            "warning: {} reference pixel(s) did not reach tol; the worst is ({x}, {y}) with error estimate {e:.3e}",
+                            u.count
+                        ));
+                    }
                 }
-            )),
+            }
             Progress::Start { index, total, run } => {
                 self.total = total;
                 if self.terminal {

@@ -7,6 +7,7 @@
 
 use super::{intersect_sphere, Chord, Ray};
 use glam::DVec3;
+use rayon::prelude::*;
 
 /// Spheres per leaf at most (fewer when the SAH says a split does not pay).
 const MAX_LEAF: usize = 4;
@@ -82,98 +83,31 @@ fn sphere_box(c: DVec3, r: f64) -> Aabb {
 
 impl Bvh {
     /// Builds the hierarchy. Centres and radii must be finite (the scene validates them).
+    ///
+    /// Subtrees over more than `PARALLEL_MIN` (16k) spheres are built on rayon's pool, their two
+    /// halves at once. The node layout is that of a sequential depth-first build (a node's
+    /// children are allocated as a pair when it is split, the left subtree is finished before
+    /// the right one starts), so the tree is the same for any number of threads.
     pub fn build(centers: Vec<DVec3>, radii: Vec<f64>) -> Bvh {
         assert_eq!(centers.len(), radii.len());
         let n = centers.len();
         let boxes: Vec<Aabb> = centers
-            .iter()
+            .par_iter()
             .zip(&radii)
             .map(|(&c, &r)| sphere_box(c, r))
             .collect();
         let mut indices: Vec<u32> = (0..n as u32).collect();
-        let mut nodes = Vec::with_capacity(2 * n.max(1));
-        nodes.push(BvhNode {
-            min: DVec3::ZERO,
-            max: DVec3::ZERO,
-            first: 0,
-            count: 0,
-        });
-        if n == 0 {
+        let nodes = if n == 0 {
             // An empty box that no ray enters.
-            nodes[0].min = DVec3::splat(f64::INFINITY);
-            nodes[0].max = DVec3::splat(f64::NEG_INFINITY);
-            return Bvh {
-                nodes,
-                indices,
-                centers,
-                radii,
-            };
-        }
-        // Explicit work stack: (node, range start, range end); depth is bounded by the
-        // fall-back median split, so no recursion limit is hit for millions of spheres.
-        let mut stack = vec![(0usize, 0usize, n)];
-        while let Some((node, start, end)) = stack.pop() {
-            let mut bounds = Aabb::EMPTY;
-            let mut cbounds = Aabb::EMPTY;
-            for &i in &indices[start..end] {
-                bounds.grow(&boxes[i as usize]);
-                cbounds.grow_point(centers[i as usize]);
-            }
-            nodes[node].min = bounds.min;
-            nodes[node].max = bounds.max;
-            let count = end - start;
-            let split = if count <= MAX_LEAF {
-                None
-            } else {
-                choose_split(&indices[start..end], &boxes, &centers, &bounds, &cbounds)
-            };
-            let mid = match split {
-                Some((axis, pos)) => {
-                    let slice = &mut indices[start..end];
-                    let mut left = 0;
-                    for k in 0..slice.len() {
-                        if centers[slice[k] as usize][axis] < pos {
-                            slice.swap(k, left);
-                            left += 1;
-                        }
-                    }
-                    if left == 0 || left == slice.len() {
-                        // Round-off put every centroid on one side: split by count instead.
-                        median_split(slice, &centers, &cbounds);
-                        start + slice.len() / 2
-                    } else {
-                        start + left
-                    }
-                }
-                None if count > 4 * MAX_LEAF * BINS => {
-                    // SAH sees no gain (e.g. all centroids equal) but the node is huge: split
-                    // by count so depth stays logarithmic.
-                    let slice = &mut indices[start..end];
-                    median_split(slice, &centers, &cbounds);
-                    start + slice.len() / 2
-                }
-                None => start,
-            };
-            if mid == start || mid == end {
-                nodes[node].first = start as u32;
-                nodes[node].count = count as u32;
-                continue;
-            }
-            let left = nodes.len();
-            for _ in 0..2 {
-                nodes.push(BvhNode {
-                    min: DVec3::ZERO,
-                    max: DVec3::ZERO,
-                    first: 0,
-                    count: 0,
-                });
-            }
-            nodes[node].first = left as u32;
-            nodes[node].count = 0;
-            stack.push((left + 1, mid, end));
-            stack.push((left, start, mid));
-        }
-        nodes.shrink_to_fit();
+            vec![BvhNode {
+                min: DVec3::splat(f64::INFINITY),
+                max: DVec3::splat(f64::NEG_INFINITY),
+                first: 0,
+                count: 0,
+            }]
+        } else {
+            build_subtree(&mut indices, 0, &boxes, &centers)
+        };
         Bvh {
             nodes,
             indices,
@@ -340,6 +274,143 @@ impl NodeStack {
         self.len -= 1;
         Some(self.fixed[self.len])
     }
+}
+
+/// Subtrees over more spheres than this are built in parallel (smaller ones are not worth a
+/// task, and each parallel level copies its subtrees once to relocate them).
+const PARALLEL_MIN: usize = 16 * 1024;
+
+/// A node's box and where its range of `indices` was split (`None`: a leaf).
+fn split_node(indices: &mut [u32], boxes: &[Aabb], centers: &[DVec3]) -> (Aabb, Option<usize>) {
+    let mut bounds = Aabb::EMPTY;
+    let mut cbounds = Aabb::EMPTY;
+    for &i in indices.iter() {
+        bounds.grow(&boxes[i as usize]);
+        cbounds.grow_point(centers[i as usize]);
+    }
+    let count = indices.len();
+    let split = if count <= MAX_LEAF {
+        None
+    } else {
+        choose_split(indices, boxes, centers, &bounds, &cbounds)
+    };
+    let mid = match split {
+        Some((axis, pos)) => {
+            let mut left = 0;
+            for k in 0..indices.len() {
+                if centers[indices[k] as usize][axis] < pos {
+                    indices.swap(k, left);
+                    left += 1;
+                }
+            }
+            if left == 0 || left == count {
+                // Round-off put every centroid on one side: split by count instead.
+                median_split(indices, centers, &cbounds);
+                count / 2
+            } else {
+                left
+            }
+        }
+        None if count > 4 * MAX_LEAF * BINS => {
+            // SAH sees no gain (e.g. all centroids equal) but the node is huge: split by count
+            // so depth stays logarithmic.
+            median_split(indices, centers, &cbounds);
+            count / 2
+        }
+        None => 0,
+    };
+    (bounds, (mid != 0 && mid != count).then_some(mid))
+}
+
+/// The subtree over `indices` (which start at position `base` of the tree's index array): its
+/// root first, then the rest in the order of a sequential depth-first build. Child links are
+/// positions in the returned vector; leaf ranges are positions in the whole index array.
+fn build_subtree(
+    indices: &mut [u32],
+    base: usize,
+    boxes: &[Aabb],
+    centers: &[DVec3],
+) -> Vec<BvhNode> {
+    if indices.len() > PARALLEL_MIN {
+        let (bounds, mid) = split_node(indices, boxes, centers);
+        if let Some(mid) = mid {
+            let (left, right) = indices.split_at_mut(mid);
+            let (l, r) = if mid.min(right.len()) > PARALLEL_MIN {
+                rayon::join(
+                    || build_subtree(left, base, boxes, centers),
+                    || build_subtree(right, base + mid, boxes, centers),
+                )
+            } else {
+                // A lopsided split: recursing on would nest as deep as the tree (a few spheres
+                // peeled off per level); the big side is built sequentially instead.
+                (
+                    build_sequential(left, base, boxes, centers),
+                    build_sequential(right, base + mid, boxes, centers),
+                )
+            };
+            // [root, l[0], r[0], l[1..], r[1..]]: position q ≥ 1 of l moves to q + 2, of r to
+            // q + |l| + 1; roots (q = 0) move to 1 and 2 and are never linked to from inside.
+            let mut nodes = Vec::with_capacity(1 + l.len() + r.len());
+            nodes.push(BvhNode {
+                min: bounds.min,
+                max: bounds.max,
+                first: 1,
+                count: 0,
+            });
+            let moved = |node: &BvhNode, by: usize| BvhNode {
+                first: if node.count == 0 {
+                    node.first + by as u32
+                } else {
+                    node.first
+                },
+                ..*node
+            };
+            let (by_l, by_r) = (2, l.len() + 1);
+            nodes.push(moved(&l[0], by_l));
+            nodes.push(moved(&r[0], by_r));
+            nodes.extend(l[1..].iter().map(|node| moved(node, by_l)));
+            nodes.extend(r[1..].iter().map(|node| moved(node, by_r)));
+            return nodes;
+        }
+    }
+    build_sequential(indices, base, boxes, centers)
+}
+
+/// [`build_subtree`] on one thread, with an explicit work stack of (node, range start, range
+/// end): depth is bounded by the fall-back median split, so no recursion limit is hit.
+fn build_sequential(
+    indices: &mut [u32],
+    base: usize,
+    boxes: &[Aabb],
+    centers: &[DVec3],
+) -> Vec<BvhNode> {
+    let empty = BvhNode {
+        min: DVec3::ZERO,
+        max: DVec3::ZERO,
+        first: 0,
+        count: 0,
+    };
+    let mut nodes = Vec::with_capacity(2 * indices.len().max(1));
+    nodes.push(empty);
+    let mut stack = vec![(0usize, 0usize, indices.len())];
+    while let Some((node, start, end)) = stack.pop() {
+        let (bounds, mid) = split_node(&mut indices[start..end], boxes, centers);
+        nodes[node].min = bounds.min;
+        nodes[node].max = bounds.max;
+        let Some(mid) = mid else {
+            nodes[node].first = (base + start) as u32;
+            nodes[node].count = (end - start) as u32;
+            continue;
+        };
+        let left = nodes.len();
+        nodes.extend([empty, empty]);
+        nodes[node].first = left as u32;
+        nodes[node].count = 0;
+        stack.push((left + 1, start + mid, end));
+        stack.push((left, start, start + mid));
+    }
+    nodes.shrink_to_fit();
+    nodes
 }
 
 /// Reorders `slice` so that its first half holds the centroids below the median along the widest
@@ -578,6 +649,42 @@ mod tests {
             }
         }
         assert!(seen.iter().all(|&s| s == 1));
+    }
+
+    /// The parallel build gives the sequential build's tree, node for node, on any number of
+    /// threads: for uniform spheres (balanced splits, several parallel levels) and for a dense
+    /// cluster with a sparse halo (lopsided splits).
+    #[test]
+    fn parallel_build_equals_the_sequential_tree_on_any_thread_count() {
+        let mut rng = crate::formats::random::SplitMix64::new(5);
+        let mut v = || DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64());
+        let n = 6 * PARALLEL_MIN;
+        let uniform: Vec<DVec3> = (0..n).map(|_| v() * 100.0).collect();
+        let clustered: Vec<DVec3> = (0..n)
+            .map(|i| if i % 50 == 0 { v() * 1e4 } else { v() })
+            .collect();
+        for centers in [uniform, clustered] {
+            let radii: Vec<f64> = (0..n).map(|i| 0.2 + (i % 7) as f64 * 0.1).collect();
+            let boxes: Vec<Aabb> = centers
+                .iter()
+                .zip(&radii)
+                .map(|(&c, &r)| sphere_box(c, r))
+                .collect();
+            let mut indices: Vec<u32> = (0..n as u32).collect();
+            let nodes = build_sequential(&mut indices, 0, &boxes, &centers);
+            for threads in [1, 2, 5] {
+                let pool = rayon::ThreadPoolBuilder::new()
+                    .num_threads(threads)
+                    .build()
+                    .unwrap();
+                let bvh = pool.install(|| Bvh::build(centers.clone(), radii.clone()));
+                assert!(bvh.nodes == nodes, "{threads} threads: the nodes differ");
+                assert!(
+                    bvh.indices == indices,
+                    "{threads} threads: the indices differ"
+                );
+            }
+        }
     }
 
     #[test]

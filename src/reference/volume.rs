@@ -224,7 +224,7 @@ impl<'a> VolumeRenderer<'a> {
             direction: inc.toward,
         };
         sh.rays += 1;
-        sh.occluders[k].hits(&shadow_ray, inc.distance, &mut sh.hits);
+        sh.occluders[k].hits(t, &shadow_ray, inc.distance, &mut sh.hits);
         let s = self.shadow_composite(inc.distance, inc.irradiance, |_| false, sh);
         self.model.light_source(&self.params, iv, &s)
     }

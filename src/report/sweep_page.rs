@@ -79,14 +79,18 @@ fn write_json(dir: &Path, name: &str, value: &serde_json::Value) -> Result<()> {
     write_text(&dir.join(name), &(json + "\n"))
 }
 
-/// `summary.json`: what the sweep ran on (size, reference time and threads, adapter) and the
-/// error attributions; the runs are in `sweep.json`.
+/// `summary.json`: what the sweep ran on (size, reference time and threads, adapter), the
+/// reference's pixels that did not reach `tol` (count, and the worst as [x, y, error estimate];
+/// null where a cached reference predates them) and the error attributions; the runs are in
+/// `sweep.json`.
 fn summary_json(results: &SweepResults) -> serde_json::Value {
     serde_json::json!({
         "experiment": results.experiment.display().to_string(),
         "scene": results.scene.display().to_string(),
         "size": [results.width, results.height],
         "reference_seconds": results.reference.seconds,
+        "reference_unconverged": results.reference.unconverged.map(|u| u.count),
+        "reference_worst_unconverged": results.reference.unconverged.and_then(|u| u.worst),
         "threads": results.threads,
         "adapter": results.adapter,
         "attribution": attribution_json(&results.attributions),

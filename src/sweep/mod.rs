@@ -88,5 +88,5 @@ pub use method::{
 };
 pub use runner::{
     load_scene, reference_key, run_sweep, BaselineResult, Progress, ReferenceInfo, RunResult,
-    SweepOptions, SweepResults,
+    SweepOptions, SweepResults, Unconverged,
 };

@@ -7,10 +7,11 @@ use super::attribution::{attribute, AttributionResult};
 use super::experiment::{Experiment, Run};
 use super::method::{find_method, SweepContext, SweepMethod};
 use crate::error::{PgtError, Result};
-use crate::image_io::{read_exr_layer, write_image, RgbImage};
+use crate::image_io::{read_exr_layer, write_atomically, write_image, RgbImage};
 use crate::metrics::{compare, maps, CompareOptions, Comparison};
 use crate::reference::{self, Integrator, RenderOptions};
 use crate::scene::{Scene, SceneLoadOptions};
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -34,6 +35,18 @@ pub struct ReferenceInfo {
     pub cache_file: PathBuf,
     /// Render time in seconds; `None` when it came from the cache.
     pub seconds: Option<f64>,
+    /// Pixels that did not reach `tol` (DESIGN.md §3: reported, not hidden) and the worst one
+    /// (x, y, its largest error estimate); `None` for a cached render from before pgt kept
+    /// this beside the cached image.
+    pub unconverged: Option<Unconverged>,
+}
+
+/// The pixels of a reference render that did not reach `tol`.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Unconverged {
+    pub count: u64,
+    /// (x, y, largest channel of its error estimate).
+    pub worst: Option<(u32, u32, f64)>,
 }
 
 /// A run compared with its baseline run.
@@ -134,25 +147,39 @@ fn cached_reference(
         "reference-{}.exr",
         reference_key(scene, &ref_options)
     ));
+    // The unconverged pixels travel beside the cached image; the image is written last, so a
+    // cached image always has them (unless a pgt from before wrote it).
+    let status_file = cache_file.with_extension("unconverged.json");
     if cache_file.is_file() {
         let image = read_exr_layer(&cache_file, "")?;
+        let unconverged = std::fs::read_to_string(&status_file)
+            .ok()
+            .and_then(|t| serde_json::from_str(&t).ok());
         return Ok((
             image,
             ReferenceInfo {
                 cache_file,
                 seconds: None,
+                unconverged,
             },
         ));
     }
     let t = Instant::now();
     let out = reference::render(scene, &ref_options)?;
     let seconds = Some(t.elapsed().as_secs_f64());
+    let unconverged = Unconverged {
+        count: out.stats.unconverged,
+        worst: out.stats.worst_unconverged,
+    };
+    let json = serde_json::to_string(&unconverged).map_err(|e| PgtError::Usage(e.to_string()))?;
+    write_atomically(&status_file, |w| w.write_all(json.as_bytes()))?;
     write_image(&cache_file, &out.image, &[], 0.0)?;
     Ok((
         out.image,
         ReferenceInfo {
             cache_file,
             seconds,
+            unconverged: Some(unconverged),
         },
     ))
 }
