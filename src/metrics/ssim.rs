@@ -34,8 +34,13 @@ pub const K1: f64 = 0.01;
 /// Contrast/structure stabiliser constant.
 pub const K2: f64 = 0.03;
 
-/// Output rows per parallel work item.
+/// Output rows per parallel work item (and per partial sum of the index).
 const BAND: usize = 32;
+/// Output columns per work item at most: the five statistics planes of a block (f64, BAND + 10
+/// rows) stay in a core's L2 cache, so the column pass reads from cache, not memory.
+const STRIP: usize = 512;
+/// Columns the filters accumulate in registers at a time.
+const LANES: usize = 8;
 
 /// The SSIM of one channel.
 #[derive(Debug, Clone)]
@@ -111,21 +116,40 @@ pub fn ssim_channel(
     let weights = gaussian_window();
     let c1 = (K1 * data_range).powi(2);
     let c2 = (K2 * data_range).powi(2);
-    let bands: Vec<(usize, usize)> = (0..h)
+    let items: Vec<((usize, usize), (usize, usize))> = (0..h)
         .step_by(BAND)
-        .map(|y0| (y0, (y0 + BAND).min(h)))
-        .collect();
-    let results: Vec<(Vec<f64>, f64)> = bands
-        .par_iter()
-        .map(|&(y0, y1)| {
-            let stats = Statistics::of_rows(reference, approximation, channel, y0, y1);
-            ssim_band(&stats, &weights, (w, h), (y0, y1), (c1, c2))
+        .flat_map(|y0| {
+            let strips = w.div_ceil(STRIP);
+            (0..strips).map(move |s| {
+                let xs = (s * w / strips, (s + 1) * w / strips);
+                (xs, (y0, (y0 + BAND).min(h)))
+            })
         })
         .collect();
-    let mut map = Vec::with_capacity(w * h);
+    let parts: Vec<Vec<f64>> = items
+        .par_iter()
+        .map(|&(xs, ys)| {
+            let stats = Statistics::of_block(reference, approximation, channel, xs, ys);
+            ssim_block(&stats, &weights, ys, (c1, c2))
+        })
+        .collect();
+    let mut map = vec![0.0f64; w * h];
+    for (&((x0, x1), (y0, _)), part) in items.iter().zip(&parts) {
+        for (y, src) in (y0..).zip(part.chunks_exact(x1 - x0)) {
+            map[y * w + x0..y * w + x1].copy_from_slice(src);
+        }
+    }
+    // The cropped mean summed as before the blocks (per row from left to right, rows into bands
+    // of BAND, bands in order), so that the index does not depend on the block layout.
     let mut sum = 0.0f64;
-    for (band_map, band_sum) in results {
-        map.extend_from_slice(&band_map);
+    for band in map.chunks(BAND * w).enumerate() {
+        let (b, rows) = band;
+        let mut band_sum = 0.0f64;
+        for (r, row) in rows.chunks_exact(w).enumerate() {
+            if (RADIUS..h - RADIUS).contains(&(b * BAND + r)) {
+                band_sum += row[RADIUS..w - RADIUS].iter().fold(0.0, |a, &v| a + v);
+            }
+        }
         sum += band_sum;
     }
     let count = ((w - 2 * RADIUS) * (h - 2 * RADIUS)) as f64;
@@ -137,40 +161,49 @@ pub fn ssim_channel(
 
 /// The five per-pixel quantities the local statistics filter, x, y, x², y², xy, as planes
 /// (structure of arrays, so that the filters run over contiguous rows and vectorise), for the
-/// image rows a band of output rows reads: `lo..hi`, its rows ± [`RADIUS`] within the image
-/// (the reflected rows beyond the border are among them, as the image has ≥ [`WINDOW`] rows).
+/// image rows and columns a block of output pixels reads: rows `lo..hi`, its rows ± [`RADIUS`]
+/// within the image (the reflected rows beyond the border are among them, as the image has
+/// ≥ [`WINDOW`] rows), and its columns ± [`RADIUS`], reflected at the image's sides (the row
+/// pass reads them directly).
 struct Statistics {
     lo: usize,
+    /// Columns of a plane row: the block's plus 2·[`RADIUS`].
     width: usize,
     height: usize,
     planes: [Vec<f64>; 5],
 }
 
 impl Statistics {
-    fn of_rows(
+    fn of_block(
         reference: &RgbImage,
         approximation: &RgbImage,
         channel: usize,
-        y0: usize,
-        y1: usize,
+        (x0, x1): (usize, usize),
+        (y0, y1): (usize, usize),
     ) -> Statistics {
         let (w, h) = (reference.width as usize, reference.height as usize);
         let (lo, hi) = (y0.saturating_sub(RADIUS), (y1 + RADIUS).min(h));
-        let n = (hi - lo) * w;
+        let width = x1 - x0 + 2 * RADIUS;
+        let n = (hi - lo) * width;
         let mut planes: [Vec<f64>; 5] = std::array::from_fn(|_| Vec::with_capacity(n));
-        let rows = lo * w..hi * w;
-        for (p, q) in reference.pixels[rows.clone()]
-            .iter()
-            .zip(&approximation.pixels[rows])
-        {
-            let (a, b) = (p[channel] as f64, q[channel] as f64);
-            for (plane, v) in planes.iter_mut().zip([a, b, a * a, b * b, a * b]) {
-                plane.push(v);
+        let columns: Vec<usize> = (0..width)
+            .map(|c| reflect(x0 as isize + c as isize - RADIUS as isize, w))
+            .collect();
+        for y in lo..hi {
+            let (r, a) = (
+                &reference.pixels[y * w..(y + 1) * w],
+                &approximation.pixels[y * w..(y + 1) * w],
+            );
+            for &x in &columns {
+                let (a, b) = (r[x][channel] as f64, a[x][channel] as f64);
+                for (plane, v) in planes.iter_mut().zip([a, b, a * a, b * b, a * b]) {
+                    plane.push(v);
+                }
             }
         }
         Statistics {
             lo,
-            width: w,
+            width,
             height: h,
             planes,
         }
@@ -184,62 +217,56 @@ impl Statistics {
     }
 }
 
-/// One band of the SSIM map and the sum of its cropped values. The column pass (scipy filters
-/// axis 0 first) then the row pass, each as the centre tap times its weight plus the pairs from
-/// the outside in (scipy's `NI_Correlate1D` for symmetric kernels), so that every value equals
-/// the per-pixel formulation bit for bit; loops run along rows so that the compiler vectorises.
-fn ssim_band(
+/// out[x] = rows[R][x]·w[R] + Σ_{j=R..1} (rows[R−j][x] + rows[R+j][x])·w[R−j]: the centre tap
+/// first, then the pairs from the outside in (scipy's `NI_Correlate1D` for symmetric kernels), so
+/// that every value equals the per-pixel formulation bit for bit; [`LANES`] columns accumulate in
+/// registers at a time.
+#[inline(always)]
+fn symmetric_filter(rows: &[&[f64]; WINDOW], weights: &[f64; WINDOW], out: &mut [f64]) {
+    let n = out.len();
+    let full = n - n % LANES;
+    let tap = |x: usize, acc: &mut [f64]| {
+        let len = acc.len();
+        for (d, &c) in acc.iter_mut().zip(&rows[RADIUS][x..x + len]) {
+            *d = c * weights[RADIUS];
+        }
+        for j in (1..=RADIUS).rev() {
+            let (lo, hi) = (&rows[RADIUS - j][x..x + len], &rows[RADIUS + j][x..x + len]);
+            for ((d, &a), &b) in acc.iter_mut().zip(lo).zip(hi) {
+                *d += (a + b) * weights[RADIUS - j];
+            }
+        }
+    };
+    for x in (0..full).step_by(LANES) {
+        let mut acc = [0.0f64; LANES];
+        tap(x, &mut acc);
+        out[x..x + LANES].copy_from_slice(&acc);
+    }
+    tap(full, &mut out[full..]);
+}
+
+/// One block of the SSIM map (rows y0..y1 of the block's columns): the column pass (scipy
+/// filters axis 0 first) into a line with the block's reflected or neighbouring columns on
+/// each side, then the row pass, then the SSIM formula in scikit-image's order of operations.
+fn ssim_block(
     stats: &Statistics,
     weights: &[f64; WINDOW],
-    (w, h): (usize, usize),
     (y0, y1): (usize, usize),
     (c1, c2): (f64, f64),
-) -> (Vec<f64>, f64) {
-    let padded = w + 2 * RADIUS;
+) -> Vec<f64> {
+    let padded = stats.width;
+    let w = padded - 2 * RADIUS;
     let mut map = vec![0.0f64; (y1 - y0) * w];
-    let mut cropped_sum = 0.0f64;
     let mut line: [Vec<f64>; 5] = std::array::from_fn(|_| vec![0.0f64; padded]);
     let mut m: [Vec<f64>; 5] = std::array::from_fn(|_| vec![0.0f64; w]);
-    for y in y0..y1 {
-        // Column pass into `line`, with RADIUS reflected columns on each side.
-        for (q, l) in line.iter_mut().enumerate() {
-            let acc = &mut l[RADIUS..RADIUS + w];
-            for (d, &c) in acc.iter_mut().zip(stats.row(q, y as isize)) {
-                *d = c * weights[RADIUS];
-            }
-            for j in (1..=RADIUS).rev() {
-                let lo = stats.row(q, y as isize - j as isize);
-                let hi = stats.row(q, (y + j) as isize);
-                let wj = weights[RADIUS - j];
-                for ((d, &a), &b) in acc.iter_mut().zip(lo).zip(hi) {
-                    *d += (a + b) * wj;
-                }
-            }
-            for k in 0..RADIUS {
-                l[k] = l[RADIUS + reflect(k as isize - RADIUS as isize, w)];
-                l[RADIUS + w + k] = l[RADIUS + reflect((w + k) as isize, w)];
-            }
+    for (y, out) in (y0..y1).zip(map.chunks_exact_mut(w)) {
+        for (q, (l, mq)) in line.iter_mut().zip(&mut m).enumerate() {
+            let rows = std::array::from_fn(|k| stats.row(q, (y + k) as isize - RADIUS as isize));
+            symmetric_filter(&rows, weights, l);
+            let shifted = std::array::from_fn(|k| &l[k..k + w]);
+            symmetric_filter(&shifted, weights, mq);
         }
-        // Row pass into `m`.
-        for (mq, l) in m.iter_mut().zip(&line) {
-            for (d, &c) in mq.iter_mut().zip(&l[RADIUS..RADIUS + w]) {
-                *d = c * weights[RADIUS];
-            }
-            for j in (1..=RADIUS).rev() {
-                let wj = weights[RADIUS - j];
-                let (lo, hi) = (
-                    &l[RADIUS - j..RADIUS - j + w],
-                    &l[RADIUS + j..RADIUS + j + w],
-                );
-                for ((d, &a), &b) in mq.iter_mut().zip(lo).zip(hi) {
-                    *d += (a + b) * wj;
-                }
-            }
-        }
-        // The SSIM formula, in scikit-image's order of operations.
-        let out = &mut map[(y - y0) * w..(y - y0 + 1) * w];
-        let mut row_sum = 0.0f64;
-        for x in 0..w {
+        for (x, s) in out.iter_mut().enumerate() {
             let (ux, uy, uxx, uyy, uxy) = (m[0][x], m[1][x], m[2][x], m[3][x], m[4][x]);
             let vx = uxx - ux * ux;
             let vy = uyy - uy * uy;
@@ -248,17 +275,10 @@ fn ssim_band(
             let a2 = 2.0 * vxy + c2;
             let b1 = ux * ux + uy * uy + c1;
             let b2 = vx + vy + c2;
-            let s = (a1 * a2) / (b1 * b2);
-            out[x] = s;
-            if (RADIUS..w - RADIUS).contains(&x) {
-                row_sum += s;
-            }
-        }
-        if (RADIUS..h - RADIUS).contains(&y) {
-            cropped_sum += row_sum;
+            *s = (a1 * a2) / (b1 * b2);
         }
     }
-    (map, cropped_sum)
+    map
 }
 
 #[cfg(test)]
