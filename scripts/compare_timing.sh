@@ -23,9 +23,15 @@ for rep in $(seq "$reps"); do
         for which in old new; do
             bin=$old
             [ "$which" = new ] && bin=$new
+            rc=0
             /usr/bin/time -o "$dir/time" -f "%e %U %S" "$bin" compare "$dir/${name}_ref.$ext" \
-                "$dir/${name}_approx.$ext" --json "$dir/${name}_$which.json" >/dev/null 2>&1 || true
-            read -r e u s <"$dir/time"
+                "$dir/${name}_approx.$ext" --json "$dir/${name}_$which.json" >/dev/null 2>&1 || rc=$?
+            # Exit 1 is a failed gate (none is set here); 2 is an error, which makes no timing.
+            if [ "$rc" -gt 1 ]; then
+                echo "$bin compare failed on the $name pair (exit $rc)" >&2
+                exit 2
+            fi
+            read -r e u s < <(tail -1 "$dir/time")
             c=$(echo "$u + $s" | bc)
             echo "run $rep $name $which: wall $e s, cpu $c s"
             wall[$name.$which]+="$e "
