@@ -479,22 +479,39 @@ fn finish_row(
     let t: [&[f32]; Y_VALUES] = std::array::from_fn(|k| &test[k][..n]);
     let inv_sqrt2 = 1.0 / 2.0f32.sqrt();
     for (x, d) in out.iter_mut().enumerate() {
-        let ycxcz = |v: &[&[f32]; Y_VALUES]| [v[0][x], v[1][x], v[2][x] + v[3][x]];
-        let color = finisher.color(ycxcz(&r), ycxcz(&t));
-        let edge = |v: &[&[f32]; Y_VALUES]| (v[4][x] * v[4][x] + v[6][x] * v[6][x]).sqrt();
-        let point = |v: &[&[f32]; Y_VALUES]| (v[5][x] * v[5][x] + v[7][x] * v[7][x]).sqrt();
-        let de = (edge(&r) - edge(&t)).abs();
-        let dp = (point(&r) - point(&t)).abs();
+        let color = finisher.color(filtered_ycxcz(&r, x), filtered_ycxcz(&t, x));
+        let de = (edge(&r, x) - edge(&t, x)).abs();
+        let dp = (point(&r, x) - point(&t, x)).abs();
         let feature = (inv_sqrt2 * de.max(dp)).sqrt();
         let flip = flip_math::pow(color, 1.0 - feature);
         *d = d.max(flip);
     }
 }
 
+/// The filtered YCxCz of pixel x (Cz is the sum of its two Gaussians). Functions rather than
+/// closures here so that they inline into the AVX2 build.
+#[inline(always)]
+fn filtered_ycxcz(v: &[&[f32]; Y_VALUES], x: usize) -> [f32; 3] {
+    [v[0][x], v[1][x], v[2][x] + v[3][x]]
+}
+
+/// Edge strength at pixel x: ‖(dx·g, g·dy)‖ (paper eq. 8).
+#[inline(always)]
+fn edge(v: &[&[f32]; Y_VALUES], x: usize) -> f32 {
+    (v[4][x] * v[4][x] + v[6][x] * v[6][x]).sqrt()
+}
+
+/// Point strength at pixel x: ‖(ddx·g, g·ddy)‖ (paper eq. 8).
+#[inline(always)]
+fn point(v: &[&[f32]; Y_VALUES], x: usize) -> f32 {
+    (v[5][x] * v[5][x] + v[7][x] * v[7][x]).sqrt()
+}
+
 /// The FLIP map of one work item (columns x0..x1, rows y0..y1), maxed over `transforms`. Input
 /// rows are x-filtered once each into a ring as the output rows need them, so the rows the y
 /// filters read stay in cache.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 fn work_item<F: Fn([f32; 3]) -> [f32; 3]>(
     reference: &[[f32; 3]],
     test: &[[f32; 3]],
@@ -530,6 +547,49 @@ fn work_item<F: Fn([f32; 3]) -> [f32; 3]>(
         }
     }
     out
+}
+
+/// [`work_item`] compiled for AVX2 when the CPU has it (checked at run time; pgt's build targets
+/// baseline x86-64): the same operations in the same order on 8 lanes instead of SSE2's 4, so
+/// the map is the same bit for bit (Rust never fuses a multiply and an add by itself; tested
+/// below). About twice the throughput of the filters and the finish.
+#[allow(clippy::too_many_arguments)]
+fn work_item_fastest<F: Fn([f32; 3]) -> [f32; 3]>(
+    reference: &[[f32; 3]],
+    test: &[[f32; 3]],
+    size: (usize, usize),
+    xs: (usize, usize),
+    ys: (usize, usize),
+    transforms: &[F],
+    taps: &Taps,
+    finisher: Finisher,
+) -> Vec<f32> {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("avx2") {
+        // SAFETY: the CPU has AVX2 (checked just above), the one condition for calling a
+        // function compiled with `target_feature(enable = "avx2")`.
+        return unsafe {
+            work_item_avx2(reference, test, size, xs, ys, transforms, taps, finisher)
+        };
+    }
+    work_item(reference, test, size, xs, ys, transforms, taps, finisher)
+}
+
+/// [`work_item`], inlined into a function compiled for AVX2.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[allow(clippy::too_many_arguments)]
+unsafe fn work_item_avx2<F: Fn([f32; 3]) -> [f32; 3]>(
+    reference: &[[f32; 3]],
+    test: &[[f32; 3]],
+    size: (usize, usize),
+    xs: (usize, usize),
+    ys: (usize, usize),
+    transforms: &[F],
+    taps: &Taps,
+    finisher: Finisher,
+) -> Vec<f32> {
+    work_item(reference, test, size, xs, ys, transforms, taps, finisher)
 }
 
 /// The per-pixel maximum over `transforms` of the FLIP map of `reference` against `test`
@@ -569,7 +629,9 @@ where
         .collect();
     let parts: Vec<Vec<f32>> = items
         .par_iter()
-        .map(|&(xs, ys)| work_item(reference, test, (w, h), xs, ys, transforms, &taps, finisher))
+        .map(|&(xs, ys)| {
+            work_item_fastest(reference, test, (w, h), xs, ys, transforms, &taps, finisher)
+        })
         .collect();
     let mut map = vec![0.0f32; w * h];
     for (&((x0, x1), (y0, _)), part) in items.iter().zip(&parts) {
@@ -896,6 +958,42 @@ mod tests {
             eprintln!("{w}x{h}, ppd {ppd}: worst {worst:e}");
             assert!(worst < 1e-5, "{w}x{h}, ppd {ppd}: worst difference {worst}");
         }
+    }
+
+    /// The AVX2 build of a work item gives the baseline's map bit for bit (same operations,
+    /// wider registers, no fused multiply-adds).
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn avx2_equals_baseline_bit_for_bit() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            eprintln!("no AVX2 on this CPU: nothing to compare");
+            return;
+        }
+        let (w, h) = (301usize, 90usize);
+        let (r, a) = noise_pair(w as u32, h as u32);
+        let decode = |b: &[u8]| -> Vec<[f32; 3]> {
+            b.chunks(3)
+                .map(|c| [c[0], c[1], c[2]].map(|v| v as f32 / 200.0))
+                .collect()
+        };
+        let (rf, af) = (decode(&r), decode(&a));
+        let taps = Taps::new(&Filters::new(67.02));
+        let cmax = max_distance();
+        let finisher = Finisher {
+            cmax,
+            pccmax: GPC * cmax,
+        };
+        let transforms = [|p: [f32; 3]| p.map(|v| v.clamp(0.0, 1.0))];
+        let (xs, ys) = ((13, 290), (7, 80));
+        let base = work_item(&rf, &af, (w, h), xs, ys, &transforms, &taps, finisher);
+        // SAFETY: AVX2 is present (checked above).
+        let wide =
+            unsafe { work_item_avx2(&rf, &af, (w, h), xs, ys, &transforms, &taps, finisher) };
+        assert!(base.iter().any(|&v| v > 0.0));
+        assert!(base
+            .iter()
+            .zip(&wide)
+            .all(|(x, y)| x.to_bits() == y.to_bits()));
     }
 
     #[test]
