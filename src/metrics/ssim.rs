@@ -91,8 +91,8 @@ fn reflect(i: isize, n: usize) -> usize {
 }
 
 /// SSIM of channel `channel` (0 = R, 1 = G, 2 = B) of two images of equal size, with data range
-/// `data_range` (DESIGN.md §5). Parallel over bands of rows; the result does not depend on the
-/// thread count.
+/// `data_range` (DESIGN.md §5). Parallel over blocks of rows and columns; the result does not
+/// depend on the block layout or the thread count.
 pub fn ssim_channel(
     reference: &RgbImage,
     approximation: &RgbImage,
