@@ -4,6 +4,9 @@
 //! nv-flip, single-threaded C++ on 8-bit sRGB, one call per HDR exposure) and after (pgt's float
 //! FLIP in parallel bands), measured in the same run. Asserts only generous bounds (SSIM of three
 //! 4K channels well under a minute) so that a quadratic or unseparated filter is caught.
+//!
+//! `write_4k_pairs` (ignored too) writes the same pairs as files for `scripts/compare_timing.sh`,
+//! which times whole `pgt compare` commands (reading, metrics, output) of two binaries.
 
 use pgt::image_io::RgbImage;
 use pgt::metrics::{compare, errors, flip, ssim, CompareOptions};
@@ -189,6 +192,24 @@ fn ssim_channel_before(
     }
     let count = ((w - 2 * ssim::RADIUS) * (h - 2 * ssim::RADIUS)) as f64;
     sum / count
+}
+
+/// Writes the timing pairs into `$PGT_TIMING_DIR`: `ldr_ref.png`/`ldr_approx.png` (8-bit sRGB)
+/// and `hdr_ref.exr`/`hdr_approx.exr` (float, values up to 8), 3840×2160 each.
+#[test]
+#[ignore]
+fn write_4k_pairs() {
+    let dir = std::path::PathBuf::from(
+        std::env::var_os("PGT_TIMING_DIR").expect("set PGT_TIMING_DIR to the output folder"),
+    );
+    std::fs::create_dir_all(&dir).unwrap();
+    for (name, scale, ext) in [("ldr", 1.0f32, "png"), ("hdr", 8.0, "exr")] {
+        let (r, a) = pair(3840, 2160, scale);
+        for (image, which) in [(&r, "ref"), (&a, "approx")] {
+            let path = dir.join(format!("{name}_{which}.{ext}"));
+            pgt::image_io::write_image(&path, image, &[], 0.0).unwrap();
+        }
+    }
 }
 
 #[test]

@@ -418,3 +418,36 @@ fn the_example_user_methods_are_measurably_worse_than_the_thesis_method() {
         assert!(e > 10.0 * e_thesis, "{example}: {e} vs thesis {e_thesis}");
     }
 }
+
+/// The dispatch reports every pass to its progress callback (issue 14 item 6, the spinner of
+/// `pgt approx`): as many calls as passes, numbered 1..=N, the work items done never going back
+/// and, on lavapipe, a thesis run with many samples taking several passes.
+#[test]
+fn progress_is_reported_once_per_pass() {
+    let Some(ctx) = gpu() else { return };
+    let s = scene(
+        disjoint_particles(),
+        lights(),
+        RenderMode::Volume,
+        models::LIT,
+    );
+    let params = thesis(256, N_EXACT_ALL);
+    let method = Method::named("thesis").unwrap();
+    let pipeline = pgt::approx::ApproxPipeline::new(ctx, &method, &params).unwrap();
+    let mut calls = Vec::new();
+    let out = pipeline
+        .render_with_progress(ctx, &s, &params, &mut |p| calls.push(p))
+        .unwrap();
+    eprintln!("{} passes: {calls:?}", out.passes);
+    assert_eq!(calls.len() as u32, out.passes);
+    for (i, p) in calls.iter().enumerate() {
+        assert_eq!(p.passes, i as u32 + 1);
+    }
+    assert!(calls.windows(2).all(|w| w[1].items_done >= w[0].items_done));
+    if ctx.adapter.is_cpu {
+        assert!(
+            out.passes > 1,
+            "lavapipe should split 256 samples into passes"
+        );
+    }
+}

@@ -605,6 +605,32 @@ pub fn run_with_limit(
     frame: &GpuFrame,
     limit: u64,
 ) -> Result<DispatchOutput> {
+    run_with_progress(ctx, pipeline, scene, frame, limit, &mut |_| {})
+}
+
+/// Where a run stands after a pass (issue 14 item 6: a long approximation on lavapipe runs for
+/// minutes in passes; the CLI shows them). The number of passes is not known in advance: the
+/// schedule adapts to each pass's cost.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct PassProgress {
+    /// Passes run so far, this one included (redone ones too).
+    pub passes: u32,
+    /// Work items (for `thesis`: (particle, sample) pairs) of every pixel done so far.
+    pub items_done: u32,
+    /// Whether this pass was too heavy and is redone with fewer items.
+    pub redone: bool,
+}
+
+/// [`run_with_limit`], calling `progress` after every pass (on the calling thread, between
+/// passes; it costs the GPU nothing).
+pub fn run_with_progress(
+    ctx: &GpuContext,
+    pipeline: &Pipeline,
+    scene: &SceneBuffers,
+    frame: &GpuFrame,
+    limit: u64,
+    progress: &mut dyn FnMut(PassProgress),
+) -> Result<DispatchOutput> {
     let up = Upload::with_limit(ctx, pipeline, scene, frame, limit)?;
     let mut schedule = PassSchedule::new(ctx.adapter.is_cpu);
     let start = Instant::now();
@@ -619,6 +645,14 @@ pub fn run_with_limit(
         }
         passes += 1;
         let verdict = schedule.after_pass(stats.more_work > 0, stats.max_loop_iterations);
+        progress(PassProgress {
+            passes,
+            items_done: match verdict {
+                PassVerdict::Redo => pass_frame.pair_begin,
+                _ => pass_frame.pair_end,
+            },
+            redone: verdict == PassVerdict::Redo,
+        });
         if verdict == PassVerdict::Redo {
             copy_bands(ctx, "restoring the image", &up.bands, |b| {
                 b.backup.as_ref().map(|backup| (backup, &b.output))

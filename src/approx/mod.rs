@@ -62,9 +62,19 @@ pub struct ApproxOutput {
 /// Opens a GPU context ([`GpuContext::new`] with `params.adapter`) and renders the scene.
 /// The method's WGSL is checked first, so a broken shader is reported even without a GPU.
 pub fn render_approx(scene: &Scene, params: &ApproxParams) -> Result<ApproxOutput> {
+    render_approx_with_progress(scene, params, &mut |_| {})
+}
+
+/// [`render_approx`], calling `progress` after every pass of the dispatch (the CLI's spinner).
+pub fn render_approx_with_progress(
+    scene: &Scene,
+    params: &ApproxParams,
+    progress: &mut dyn FnMut(dispatch::PassProgress),
+) -> Result<ApproxOutput> {
     let (method, values, program) = prepare(scene, params)?;
     let ctx = GpuContext::new(params.adapter.as_deref())?;
-    ApproxPipeline::from_program(&ctx, method, &values, &program)?.render(&ctx, scene, params)
+    ApproxPipeline::from_program(&ctx, method, &values, &program)?
+        .render_with_progress(&ctx, scene, params, progress)
 }
 
 /// Renders with an open context (a sweep opens one and renders many parameter sets).
@@ -139,6 +149,17 @@ impl ApproxPipeline {
         scene: &Scene,
         params: &ApproxParams,
     ) -> Result<ApproxOutput> {
+        self.render_with_progress(ctx, scene, params, &mut |_| {})
+    }
+
+    /// [`Self::render`], calling `progress` after every pass of the dispatch.
+    pub fn render_with_progress(
+        &self,
+        ctx: &GpuContext,
+        scene: &Scene,
+        params: &ApproxParams,
+        progress: &mut dyn FnMut(dispatch::PassProgress),
+    ) -> Result<ApproxOutput> {
         self.method.check_scene(scene)?;
         let values = params.resolve(&self.method)?;
         if values.iter().map(|(n, _)| n).ne(self.names.iter()) {
@@ -158,7 +179,9 @@ impl ApproxPipeline {
         }
         let slots: Vec<u32> = values.iter().map(|(_, v)| *v).collect();
         let frame = layout::GpuFrame::new(scene, &slots);
-        let out = dispatch::run(ctx, &self.pipeline, &buffers, &frame)?;
+        let limit = dispatch::storage_limit(ctx);
+        let out =
+            dispatch::run_with_progress(ctx, &self.pipeline, &buffers, &frame, limit, progress)?;
         Ok(ApproxOutput {
             image: out.image,
             gpu_seconds: out.gpu_seconds,

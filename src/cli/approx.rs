@@ -130,6 +130,25 @@ fn approx_spinner(params: &ApproxParams) -> indicatif::ProgressBar {
     bar
 }
 
+/// The spinner's message after a pass: the method's words (`approximating with …`) and where
+/// the passes stand (their number is not known in advance: the schedule adapts to each pass).
+fn pass_message(current: &str, p: approx::dispatch::PassProgress) -> String {
+    let base = current.split(": pass ").next().unwrap_or(current);
+    let items = match p.items_done {
+        // A real GPU takes every item in one pass.
+        u32::MAX => "all work items done".to_string(),
+        n => format!("{n} work items done"),
+    };
+    if p.redone {
+        format!(
+            "{base}: pass {} too heavy for lavapipe, redone with fewer work items ({items})",
+            p.passes
+        )
+    } else {
+        format!("{base}: pass {}, {items}", p.passes)
+    }
+}
+
 /// Loads the scene, runs the approximation (DESIGN.md §4), writes the image and prints the
 /// one-line summary with the adapter and the GPU time (DESIGN.md §7).
 pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
@@ -149,7 +168,11 @@ pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
     let scene = super::load_scene_for(scene_path, &options, output, args.exposure)?;
     let params = args.params()?;
     let spinner = super::stderr_is_terminal().then(|| approx_spinner(&params));
-    let out = approx::render_approx(&scene, &params);
+    let out = approx::render_approx_with_progress(&scene, &params, &mut |p| {
+        if let Some(s) = &spinner {
+            s.set_message(pass_message(&s.message(), p));
+        }
+    });
     if let Some(s) = &spinner {
         s.finish_and_clear();
     }

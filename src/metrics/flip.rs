@@ -228,10 +228,12 @@ pub fn exposure_range(reference: &RgbImage) -> Result<(f32, f32), FlipError> {
         return Err(FlipError::NoExposureRange("median"));
     }
     let y_max = lum.iter().fold(-1e30f32, |m, &v| m.max(v));
-    lum.sort_unstable_by(|p, q| p.total_cmp(q));
     // FLIP 1.7 (flip-evaluator) takes the element at n/2 of the sorted luminances; the older C++
-    // bundled with nv-flip averaged elements n/2 − 1 and n/2. pgt follows 1.7.
-    let y_median = lum[lum.len() / 2];
+    // bundled with nv-flip averaged elements n/2 − 1 and n/2. pgt follows 1.7. Selected, not
+    // sorted: the same element in linear time (a full sort of a 4K image's luminances took
+    // 0.4 s on one core).
+    let middle = lum.len() / 2;
+    let (_, &mut y_median, _) = lum.select_nth_unstable_by(middle, |p, q| p.total_cmp(q));
     if y_max <= 0.0 {
         return Err(FlipError::NoExposureRange("maximum"));
     }

@@ -7,6 +7,7 @@
 pub mod errors;
 pub mod flip;
 pub mod flip_float;
+mod flip_math;
 pub mod gate;
 pub mod maps;
 pub mod ssim;
