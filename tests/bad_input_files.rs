@@ -37,7 +37,11 @@ fn assert_refused(o: &Output, file: &str, line: usize, reason: &str, case: &str)
     );
     if case == "not text" {
         // The I/O error is the message's cause and its text: said once, not twice.
-        assert_eq!(err.matches(reason).count(), 1, "{case}: said twice in: {err}");
+        assert_eq!(
+            err.matches(reason).count(),
+            1,
+            "{case}: said twice in: {err}"
+        );
     }
 }
 
