@@ -77,23 +77,20 @@ fn read_png(path: &Path) -> Result<ReadImage> {
 /// has 25 million).
 fn decode_through_table(samples: impl Iterator<Item = [usize; 3]>, bits: u32) -> Vec<[f32; 3]> {
     let codes = 1u32 << bits;
-    let table: Vec<f32> = if bits == 8 {
-        let all = image::RgbImage::from_fn(codes, 1, |x, _| image::Rgb([x as u8; 3]));
-        image::DynamicImage::ImageRgb8(all)
-            .to_rgb32f()
-            .pixels()
-            .map(|p| srgb_to_linear_f32(p.0[0]))
-            .collect()
+    let all = if bits == 8 {
+        image::DynamicImage::ImageRgb8(image::RgbImage::from_fn(codes, 1, |x, _| {
+            image::Rgb([x as u8; 3])
+        }))
     } else {
-        let all = image::ImageBuffer::<image::Rgb<u16>, Vec<u16>>::from_fn(codes, 1, |x, _| {
+        image::DynamicImage::ImageRgb16(image::ImageBuffer::from_fn(codes, 1, |x, _| {
             image::Rgb([x as u16; 3])
-        });
-        image::DynamicImage::ImageRgb16(all)
-            .to_rgb32f()
-            .pixels()
-            .map(|p| srgb_to_linear_f32(p.0[0]))
-            .collect()
+        }))
     };
+    let table: Vec<f32> = all
+        .to_rgb32f()
+        .pixels()
+        .map(|p| srgb_to_linear_f32(p.0[0]))
+        .collect();
     samples.map(|p| p.map(|c| table[c])).collect()
 }
 

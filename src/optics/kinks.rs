@@ -111,23 +111,42 @@ pub(crate) fn for_each_swept_leaf(bvh: &Bvh, poly: &SweptPolygon, mut visit: imp
 /// Roots of the ray against the cylinder of radius r about c + s·ω (ω unit, towards the light),
 /// kept where the tangent point lies ahead of x(t) towards the light.
 fn cylinder_roots(ray: &Ray, omega: DVec3, c: DVec3, r: f64) -> [Option<f64>; 2] {
-    let q0 = ray.origin - c;
-    let d_perp = ray.direction - ray.direction.dot(omega) * omega;
-    let q_perp = q0 - q0.dot(omega) * omega;
-    let a = d_perp.length_squared();
-    if !(a > 1e-24) {
+    let Some(AxisApproach { t_c, dist, a }) = axis_approach(ray, omega, c, 1e-24) else {
         // The camera ray runs along the light: its distance to the axis never changes.
         return [None, None];
-    }
-    // Same stable form as the sphere intersection: closest approach, then the half-chord.
-    let t_c = -q_perp.dot(d_perp) / a;
-    let dist = (q_perp + t_c * d_perp).length();
+    };
     if dist >= r {
         return [None, None];
     }
     let half = ((r - dist) * (r + dist) / a).sqrt();
     let ahead = |t: f64| (c - ray.at(t)).dot(omega) > 0.0;
     [t_c - half, t_c + half].map(|t| ahead(t).then_some(t))
+}
+
+/// Where a ray comes closest to the line c + s·ω (ω unit): at t_c, at distance `dist`, with
+/// a = |d⊥|² the squared part of the ray's direction normal to ω. The inside of the cylinder of
+/// radius r about that line is t_c ± √((r² − dist²)/a).
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct AxisApproach {
+    pub t_c: f64,
+    pub dist: f64,
+    pub a: f64,
+}
+
+/// The ray's closest approach to the line c + s·ω, in the same stable form as the sphere
+/// intersection (closest approach first, then the half-chord); `None` where a ≤ `min_a`, i.e.
+/// the ray runs (nearly) along the line and the approach is undefined or far off.
+pub(crate) fn axis_approach(ray: &Ray, omega: DVec3, c: DVec3, min_a: f64) -> Option<AxisApproach> {
+    let q0 = ray.origin - c;
+    let d_perp = ray.direction - ray.direction.dot(omega) * omega;
+    let q_perp = q0 - q0.dot(omega) * omega;
+    let a = d_perp.length_squared();
+    if !(a > min_a) {
+        return None;
+    }
+    let t_c = -q_perp.dot(d_perp) / a;
+    let dist = (q_perp + t_c * d_perp).length();
+    Some(AxisApproach { t_c, dist, a })
 }
 
 /// Roots of the ray against the cone with apex p (the point light) tangent to sphere (c, r),

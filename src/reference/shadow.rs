@@ -26,7 +26,7 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
 use crate::geometry::{intersect_sphere, Bvh, Hit, Ray};
-use crate::optics::kinks::{for_each_swept_leaf, swept_polygon};
+use crate::optics::kinks::{axis_approach, for_each_swept_leaf, swept_polygon, AxisApproach};
 use crate::optics::light::Light;
 use crate::optics::particle::Particle;
 use glam::DVec3;
@@ -166,23 +166,19 @@ fn reach_range(camera_ray: &Ray, light: &Light, c: DVec3, r: f64, t_end: f64) ->
     let Light::Directional { direction, .. } = *light else {
         return ALL;
     };
-    let omega = -direction;
-    let q0 = camera_ray.origin - c;
-    let d = camera_ray.direction;
-    let d_perp = d - d.dot(omega) * omega;
-    let q_perp = q0 - q0.dot(omega) * omega;
-    let a = d_perp.length_squared();
     let size = camera_ray.origin.abs().max_element()
         + c.abs().max_element()
         + r
         + if t_end.is_finite() { t_end.abs() } else { 0.0 };
     let pad = RANGE_PADDING * size;
-    if !(a > 1e-12) || !pad.is_finite() {
-        // The camera ray runs (nearly) along the light: the range would be huge or undefined.
+    if !pad.is_finite() {
         return ALL;
     }
-    let t_c = -q_perp.dot(d_perp) / a;
-    let dist = (q_perp + t_c * d_perp).length();
+    let Some(AxisApproach { t_c, dist, a }) = axis_approach(camera_ray, -direction, c, 1e-12)
+    else {
+        // The camera ray runs (nearly) along the light: the range would be huge or undefined.
+        return ALL;
+    };
     let r_pad = r + pad;
     if !(dist < r_pad) {
         return if dist.is_nan() || t_c.is_nan() {
