@@ -15,6 +15,21 @@ pub fn opacity(tau: f64) -> f64 {
     }
 }
 
+/// Opacity a = 1 − e^{−τ} and transmittance e^{−τ} of a piece of optical depth τ ≥ 0 from one
+/// exponential: `expm1` where a ≤ 1/2 (τ < ln 2, so thin pieces keep their digits) and e = 1 − a,
+/// which is exact to an ulp there since e ≥ 1/2; `exp` beyond, with a = 1 − e ≥ 1/2 likewise.
+/// τ = +∞ gives (1, 0).
+#[inline]
+pub fn opacity_and_transmittance(tau: f64) -> (f64, f64) {
+    if tau < std::f64::consts::LN_2 {
+        let a = -(-tau).exp_m1();
+        (a, 1.0 - a)
+    } else {
+        let e = (-tau).exp();
+        (1.0 - e, e)
+    }
+}
+
 /// Radiance and transmittance of a ray through `intervals` (in ray order) towards a background
 /// of radiance `background`.
 #[derive(Debug, Clone, Copy, PartialEq)]

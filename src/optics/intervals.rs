@@ -18,6 +18,7 @@
 // degenerate input takes the safe branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+use super::emission::{opacity_and_transmittance, Composite};
 use super::particle::Particle;
 use crate::geometry::Hit;
 use glam::DVec3;
@@ -146,15 +147,41 @@ impl<'a> IntervalCutter<'a> {
             out,
         )
     }
+
+    /// The emission model (DESIGN.md §2) along the part (t_min, t_max) of a ray crossing the
+    /// spheres `hits` (any order), towards `background`: what [`composite`] gives on the
+    /// intervals of [`IntervalCutter::cut`], without building them (shadow rays only need the
+    /// result). Same sums in the same canonical order; the last bits may differ from
+    /// [`composite`], which divides E = S/σ first.
+    ///
+    /// [`composite`]: super::emission::composite
+    pub fn composite(
+        &self,
+        hits: &[Hit],
+        (t_min, t_max): (f64, f64),
+        skip: impl Fn(u32) -> bool,
+        background: DVec3,
+        scratch: &mut IntervalScratch,
+    ) -> Composite {
+        composite_spans(
+            hits,
+            (t_min, t_max),
+            self.particles,
+            &self.ranks,
+            skip,
+            background,
+            scratch,
+        )
+    }
 }
 
 /// `IntervalCutter::cut`: the chords clipped to (t_min, t_max), then the general sweep over
-/// their ends ([`sweep_intervals`]). Most shadow rays cross a few spheres whose chords do not
+/// their ends ([`merge_intervals`]). Most shadow rays cross a few spheres whose chords do not
 /// overlap; those take [`disjoint_intervals`] instead, which gives the same intervals, bit for
 /// bit, without the sweep (a test compares the two).
 fn cut_into_intervals(
     hits: &[Hit],
-    (t_min, t_max): (f64, f64),
+    range: (f64, f64),
     particles: &[Particle],
     ranks: &[u32],
     skip: impl Fn(u32) -> bool,
@@ -162,7 +189,26 @@ fn cut_into_intervals(
     out: &mut Vec<Interval>,
 ) {
     out.clear();
-    let spans = &mut scratch.spans;
+    if clipped_spans(hits, range, particles, skip, &mut scratch.spans) {
+        disjoint_intervals(&scratch.spans, particles, out);
+    } else {
+        let (spans, active, exits) = (&scratch.spans, &mut scratch.active, &mut scratch.exits);
+        merge_intervals(spans, ranks, active, exits, |set, t0, t1| {
+            out.push(medium_of(set, particles, t0, t1));
+            true
+        });
+    }
+}
+
+/// The chords of `hits` clipped to (t_min, t_max), of particles with σ > 0 not skipped, sorted
+/// by start into `spans`; whether no two of them overlap.
+fn clipped_spans(
+    hits: &[Hit],
+    (t_min, t_max): (f64, f64),
+    particles: &[Particle],
+    skip: impl Fn(u32) -> bool,
+    spans: &mut Vec<Span>,
+) -> bool {
     spans.clear();
     for h in hits {
         let p = &particles[h.index as usize];
@@ -180,11 +226,92 @@ fn cut_into_intervals(
         }
     }
     spans.sort_unstable_by(|a, b| a.t0.total_cmp(&b.t0));
-    if spans.windows(2).all(|w| w[0].t1 <= w[1].t0) {
-        disjoint_intervals(spans, particles, out);
+    spans.windows(2).all(|w| w[0].t1 <= w[1].t0)
+}
+
+/// `IntervalCutter::composite`: the emission model (DESIGN.md §2) along the chords of `hits`
+/// in (t_min, t_max), in one sweep with no intervals built. Per interval it needs only
+/// σ = Σσᵢ and S = Σσᵢ·Cᵢ (summed in canonical order, as [`medium_of`]), and adds
+/// T·(1 − e^{−σΔ})/σ·S, which is T·(1 − e^{−σΔ})·E of [`composite`](super::emission::composite)
+/// without the divisions of E and α; a set with a Θmax = 1 particle or an overflowing Σσᵢ
+/// takes [`medium_of`] as the general cut does.
+fn composite_spans(
+    hits: &[Hit],
+    range: (f64, f64),
+    particles: &[Particle],
+    ranks: &[u32],
+    skip: impl Fn(u32) -> bool,
+    background: DVec3,
+    scratch: &mut IntervalScratch,
+) -> Composite {
+    let mut acc = Accumulator {
+        radiance: DVec3::ZERO,
+        transmittance: 1.0,
+    };
+    if clipped_spans(hits, range, particles, skip, &mut scratch.spans) {
+        for s in &scratch.spans {
+            let p = &particles[s.index as usize];
+            let more = if p.sigma.is_infinite() {
+                acc.add_interval(disjoint_interval(s, p))
+            } else {
+                acc.add(p.sigma, p.sigma * p.color, s.t1 - s.t0)
+            };
+            if !more {
+                break;
+            }
+        }
     } else {
-        let (active, exits) = (&mut scratch.active, &mut scratch.exits);
-        merge_intervals(spans, particles, ranks, active, exits, out);
+        let (spans, active, exits) = (&scratch.spans, &mut scratch.active, &mut scratch.exits);
+        merge_intervals(spans, ranks, active, exits, |set, t0, t1| {
+            let mut sigma = 0.0;
+            let mut weighted = DVec3::ZERO;
+            for &(_, index) in set {
+                let p = &particles[index as usize];
+                sigma += p.sigma;
+                weighted += p.sigma * p.color;
+            }
+            if sigma.is_finite() {
+                acc.add(sigma, weighted, t1 - t0)
+            } else {
+                // A Θmax = 1 particle (σ = ∞, and then `weighted` is NaN or ∞) or Σσᵢ overflowing.
+                acc.add_interval(medium_of(set, particles, t0, t1))
+            }
+        });
+    }
+    Composite {
+        radiance: acc.radiance + acc.transmittance * background,
+        transmittance: acc.transmittance,
+    }
+}
+
+/// The running front-to-back composite of [`composite_spans`].
+struct Accumulator {
+    radiance: DVec3,
+    transmittance: f64,
+}
+
+impl Accumulator {
+    /// Adds a homogeneous piece of finite extinction σ, σ-weighted colour S = Σσᵢ·Cᵢ and the
+    /// given length; false once nothing behind it can be seen.
+    #[inline]
+    fn add(&mut self, sigma: f64, weighted: DVec3, length: f64) -> bool {
+        let (a, e) = opacity_and_transmittance(sigma * length);
+        self.radiance += (self.transmittance * a / sigma) * weighted;
+        self.transmittance *= e;
+        self.transmittance > 0.0
+    }
+
+    /// Adds an interval as [`composite`](super::emission::composite) does (σ may be ∞).
+    fn add_interval(&mut self, iv: Interval) -> bool {
+        if iv.sigma.is_infinite() {
+            self.radiance += self.transmittance * iv.emission;
+            self.transmittance = 0.0;
+        } else {
+            let (a, e) = opacity_and_transmittance(iv.sigma * iv.length());
+            self.radiance += (self.transmittance * a) * iv.emission;
+            self.transmittance *= e;
+        }
+        self.transmittance > 0.0
     }
 }
 
@@ -195,11 +322,10 @@ fn cut_into_intervals(
 /// the plain event sweep bit for bit (`sweep_intervals` in the tests). Appends to `out`.
 fn merge_intervals(
     spans: &[Span],
-    particles: &[Particle],
     ranks: &[u32],
     active: &mut Vec<(u32, u32)>,
     exits: &mut Vec<f64>,
-    out: &mut Vec<Interval>,
+    mut emit: impl FnMut(&[(u32, u32)], f64, f64) -> bool,
 ) {
     active.clear();
     exits.clear();
@@ -243,7 +369,9 @@ fn merge_intervals(
             }
         }
         if !active.is_empty() {
-            out.push(medium_of(active, particles, t, t_next));
+            if !emit(active, t, t_next) {
+                return;
+            }
         } else if next >= spans.len() {
             return;
         }
@@ -314,26 +442,30 @@ fn sweep_intervals(
 /// divided by 1 for σ = ∞), so every interval is bit-identical to the sweep's.
 fn disjoint_intervals(spans: &[Span], particles: &[Particle], out: &mut Vec<Interval>) {
     for s in spans {
-        let p = &particles[s.index as usize];
-        let (t0, t1) = (s.t0, s.t1);
-        out.push(if p.sigma.is_infinite() {
-            Interval {
-                t0,
-                t1,
-                sigma: f64::INFINITY,
-                emission: (DVec3::ZERO + p.color) / 1.0,
-                albedo: (DVec3::ZERO + p.albedo) / 1.0,
-            }
-        } else {
-            let sigma = 0.0 + p.sigma;
-            Interval {
-                t0,
-                t1,
-                sigma,
-                emission: (DVec3::ZERO + p.sigma * p.color) / sigma,
-                albedo: (DVec3::ZERO + p.sigma * p.albedo) / sigma,
-            }
-        });
+        out.push(disjoint_interval(s, &particles[s.index as usize]));
+    }
+}
+
+/// The interval of one span crossed by particle `p` alone ([`disjoint_intervals`]).
+fn disjoint_interval(s: &Span, p: &Particle) -> Interval {
+    let (t0, t1) = (s.t0, s.t1);
+    if p.sigma.is_infinite() {
+        Interval {
+            t0,
+            t1,
+            sigma: f64::INFINITY,
+            emission: (DVec3::ZERO + p.color) / 1.0,
+            albedo: (DVec3::ZERO + p.albedo) / 1.0,
+        }
+    } else {
+        let sigma = 0.0 + p.sigma;
+        Interval {
+            t0,
+            t1,
+            sigma,
+            emission: (DVec3::ZERO + p.sigma * p.color) / sigma,
+            albedo: (DVec3::ZERO + p.sigma * p.albedo) / sigma,
+        }
     }
 }
 
@@ -464,7 +596,7 @@ mod tests {
         let (mut fast, mut swept) = (Vec::new(), Vec::new());
         let mut s = IntervalScratch::default();
         let (mut events, mut active) = (Vec::new(), Vec::new());
-        let mut fallbacks = 0;
+        let (mut fallbacks, mut opaque) = (0, 0);
         for trial in 0..1000 {
             let n = 1 + trial % 7;
             let mut t = -1.0 + rng.next_f64();
@@ -518,8 +650,24 @@ mod tests {
             if !s.spans.windows(2).all(|w| w[0].t1 <= w[1].t0) {
                 fallbacks += 1;
             }
+            // The fused composite of shadow rays is `composite` of these intervals, to the last
+            // bits (it divides by σ once instead of forming E = S/σ, and takes e^{−τ} = 1 − a).
+            let background = DVec3::new(0.3, 2.0, 7.0);
+            let want = crate::optics::emission::composite(&swept, background);
+            let got = cutter.composite(&hits, (0.0, 4.0), |_| false, background, &mut s);
+            let close = |a: f64, b: f64| (a - b).abs() <= 1e-13 * (1.0 + a.abs());
+            assert!(
+                close(got.transmittance, want.transmittance)
+                    && (0..3).all(|c| close(got.radiance[c], want.radiance[c])),
+                "trial {trial}: {got:?} against {want:?}"
+            );
+            opaque += usize::from(want.transmittance == 0.0);
         }
         assert!(fallbacks > 150, "many trials must overlap: {fallbacks}");
+        assert!(
+            opaque > 50,
+            "many trials must cross the σ = ∞ particle: {opaque}"
+        );
     }
 
     #[test]

@@ -70,7 +70,7 @@ use super::riemann::midpoint_sum;
 use super::shadow::Occluders;
 use super::{Integrator, RadianceEstimator, Sample};
 use crate::geometry::{Bvh, Hit, Ray};
-use crate::optics::emission::{composite, composite_by, opacity};
+use crate::optics::emission::{composite_by, opacity};
 use crate::optics::intervals::{Interval, IntervalCutter, IntervalScratch};
 use crate::optics::kinks::shadow_tangencies;
 use crate::optics::model::{LightNeed, Model};
@@ -105,7 +105,6 @@ pub struct VolumeRenderer<'a> {
 #[derive(Default)]
 struct ShadowScratch {
     hits: Vec<Hit>,
-    intervals: Vec<Interval>,
     cut: IntervalScratch,
     lights: Vec<LightSample>,
     rays: u64,
@@ -163,15 +162,9 @@ impl<'a> VolumeRenderer<'a> {
         skip: impl Fn(u32) -> bool,
         sh: &mut ShadowScratch,
     ) -> LightSample {
-        self.cutter.cut(
-            &sh.hits,
-            0.0,
-            distance,
-            skip,
-            &mut sh.cut,
-            &mut sh.intervals,
-        );
-        let c = composite(&sh.intervals, irradiance);
+        let c = self
+            .cutter
+            .composite(&sh.hits, (0.0, distance), skip, irradiance, &mut sh.cut);
         LightSample {
             radiance: c.radiance,
             irradiance,
