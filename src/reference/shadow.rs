@@ -114,6 +114,18 @@ impl Occluders {
                 }
             }
         });
+        // In the order of their centres along a directional light's shadow rays (which all
+        // share its direction), so that each node's hits arrive nearly sorted by entry and the
+        // interval cutter's sort has little to do. The order does not change any result.
+        if let Light::Directional { direction, .. } = *light {
+            let toward = -direction;
+            candidates.sort_unstable_by(|a, b| {
+                a.center
+                    .dot(toward)
+                    .total_cmp(&b.center.dot(toward))
+                    .then(a.index.cmp(&b.index))
+            });
+        }
     }
 
     /// Every candidate whose chord overlaps (0, t_max) along `ray`, the shadow ray from the
