@@ -100,6 +100,8 @@ pub struct IntervalScratch {
     /// Active particles as (rank, index), kept sorted by rank, and where each one's chord ends.
     active: Vec<(u32, u32)>,
     exits: Vec<f64>,
+    /// Open chords of the compositing sweep.
+    open: Vec<Open>,
 }
 
 /// The particles of a scene with their canonical ranks: cuts rays into intervals.
@@ -261,26 +263,98 @@ fn composite_spans(
             }
         }
     } else {
-        let (spans, active, exits) = (&scratch.spans, &mut scratch.active, &mut scratch.exits);
-        merge_intervals(spans, ranks, active, exits, |set, t0, t1| {
-            let mut sigma = 0.0;
-            let mut weighted = DVec3::ZERO;
-            for &(_, index) in set {
-                let p = &particles[index as usize];
-                sigma += p.sigma;
-                weighted += p.sigma * p.color;
-            }
-            if sigma.is_finite() {
-                acc.add(sigma, weighted, t1 - t0)
-            } else {
-                // A Θmax = 1 particle (σ = ∞, and then `weighted` is NaN or ∞) or Σσᵢ overflowing.
-                acc.add_interval(medium_of(set, particles, t0, t1))
-            }
-        });
+        composite_overlapping(particles, ranks, scratch, &mut acc);
     }
     Composite {
         radiance: acc.radiance + acc.transmittance * background,
         transmittance: acc.transmittance,
+    }
+}
+
+/// One chord open in [`composite_overlapping`]'s sweep, with what its sums need.
+#[derive(Debug, Clone, Copy)]
+struct Open {
+    exit: f64,
+    rank: u32,
+    index: u32,
+    sigma: f64,
+    /// σᵢ·Cᵢ.
+    weighted: DVec3,
+}
+
+/// The sweep of [`merge_intervals`] over overlapping spans (`scratch.spans`, sorted by start),
+/// compositing each interval into `acc` as it is formed. The open chords are kept in arrival
+/// order and put in canonical rank order only where that changes a sum: σ and S of one or two
+/// chords are the same in either order (0 + a + b = 0 + b + a in IEEE arithmetic), so only sets
+/// of three or more are sorted (insertion sort: they are nearly sorted from the last interval).
+/// The sums, and so the result, are those of the canonical order bit for bit.
+fn composite_overlapping(
+    particles: &[Particle],
+    ranks: &[u32],
+    scratch: &mut IntervalScratch,
+    acc: &mut Accumulator,
+) {
+    let (spans, open) = (&scratch.spans, &mut scratch.open);
+    open.clear();
+    let Some(first) = spans.first() else {
+        return;
+    };
+    let mut t = first.t0;
+    let mut next = 0;
+    loop {
+        open.retain(|o| o.exit != t);
+        while next < spans.len() && spans[next].t0 == t {
+            let s = spans[next];
+            // A particle entered twice cannot happen on a ray; ignoring it keeps the sweep total.
+            if !open.iter().any(|o| o.index == s.index) {
+                let p = &particles[s.index as usize];
+                open.push(Open {
+                    exit: s.t1,
+                    rank: ranks[s.index as usize],
+                    index: s.index,
+                    sigma: p.sigma,
+                    weighted: p.sigma * p.color,
+                });
+            }
+            next += 1;
+        }
+        // The earliest remaining event, by the same total order as the sorted starts.
+        let mut t_next = spans.get(next).map_or(f64::INFINITY, |s| s.t0);
+        for o in open.iter() {
+            if o.exit.total_cmp(&t_next).is_lt() {
+                t_next = o.exit;
+            }
+        }
+        if open.is_empty() {
+            if next >= spans.len() {
+                return;
+            }
+        } else {
+            if open.len() > 2 {
+                open.sort_by_key(|o| (o.rank, o.index));
+            }
+            let mut sigma = 0.0;
+            let mut weighted = DVec3::ZERO;
+            for o in open.iter() {
+                sigma += o.sigma;
+                weighted += o.weighted;
+            }
+            let more = if sigma.is_finite() {
+                acc.add(sigma, weighted, t_next - t)
+            } else {
+                // A Θmax = 1 particle (σ = ∞, and then `weighted` is NaN or ∞) or Σσᵢ
+                // overflowing: the general medium, over the set in canonical order.
+                open.sort_by_key(|o| (o.rank, o.index));
+                let set = &mut scratch.active;
+                set.clear();
+                set.extend(open.iter().map(|o| (o.rank, o.index)));
+                acc.add_interval(medium_of(set, particles, t, t_next))
+            };
+            if !more {
+                return;
+            }
+        }
+        t = t_next;
     }
 }
 
