@@ -23,16 +23,16 @@
 //! segment is first integrated by G7 alone, whose estimate is its difference from the
 //! interpolatory 5-node rule on five of its nodes (degree 5, as pessimistic about G7 as G7 is
 //! about K15), and raised to K15 by eight more nodes only where that does not meet the budget.
-//! On the 1UUN benchmark most segments stop at 7 nodes. A nested family that shares more nodes
-//! between its two rules (Patterson's 7 → 15 extension of G3–K7) was tried and rejected: on the
-//! honesty scenes of `tests/volume_error.rs` its two 15- and 7-node rules missed the same
-//! feature of a smooth-looking lit integrand (estimate 1.9e-8, actual error 1.6e-7), where K15
-//! against G7 reported 1.8e-5 and refined.
+//! On the 1UUN benchmark about two thirds of the segments stop at 7 nodes. A nested family
+//! whose two rules share more nodes (Patterson's 7 → 15 extension of G3–K7) was tried and
+//! rejected: on the honesty scenes of `tests/volume_error.rs` its 15- and 7-node rules missed
+//! the same feature of a smooth-looking lit integrand (estimate 1.9e-8, actual error 1.6e-7),
+//! where K15 against G7 reported 1.8e-5 and refined.
 //!
 //! **Global adaptivity.** All segments of one pixel (every interval of the camera ray) share
 //! one error budget: the segment with the largest estimate is raised or split until the summed
-//! estimate is ≤ `tol` in every channel. A segment with a kink inside is split at the kink nearest to its
-//! middle (so the pieces are smooth), others are bisected. After `max_segments` segments, or
+//! estimate is ≤ `tol` in every channel. A segment with a kink inside is split at the kink
+//! nearest to its middle (so the pieces are smooth), others are bisected. After `max_segments` segments, or
 //! when no segment can be split any more in f64, it stops and reports the remaining summed
 //! estimate honestly (`converged = false`).
 
@@ -228,10 +228,10 @@ impl NestedSegment {
     }
 
     /// The integrand at abscissa x ∈ [−1, 1] of the segment (after the endpoint-smoothing
-    /// substitution of [`gauss_kronrod_smoothed`] when `smoothed`).
+    /// substitution of [`gauss_kronrod_15_smoothed`] when `smoothed`).
     fn node(&self, x: f64, f: &mut dyn FnMut(usize, f64) -> DVec3) -> DVec3 {
         if self.smoothed {
-            // s ∈ [0, 1], the variable of `gauss_kronrod_smoothed` (half-width 1/2).
+            // s ∈ [0, 1], the variable of `gauss_kronrod_15_smoothed` (half-width 1/2).
             let w = self.hi - self.lo;
             let s = 0.5 + 0.5 * x;
             let g = s * s * (3.0 - 2.0 * s);
@@ -246,7 +246,7 @@ impl NestedSegment {
 
     /// Evaluates the nodes that `level` adds (G7's at level 1, the other eight of K15's at
     /// level 2), and the segment's value and error estimate at that level: G7 against the
-    /// 5-node rule on its own nodes ([`WG7_SUB5`]), or K15 against G7 as in [`gauss_kronrod`].
+    /// 5-node rule on its own nodes ([`WG7_SUB5`]), or K15 against G7 (QUADPACK's `qk15`).
     fn raise_to(&mut self, level: u8, f: &mut dyn FnMut(usize, f64) -> DVec3) {
         self.level = level;
         let js: &[usize] = if level == 1 {
