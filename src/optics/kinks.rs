@@ -209,6 +209,12 @@ pub(crate) struct SweptPolygon {
 
 impl SweptPolygon {
     fn new(poly: &[DVec3]) -> SweptPolygon {
+        Self::with_axes(poly, true)
+    }
+
+    /// The polygon with the edge axes of every edge (`distinct_only` false: the plain
+    /// separating-axis set, the test oracle) or once per edge direction, without zero axes.
+    fn with_axes(poly: &[DVec3], distinct_only: bool) -> SweptPolygon {
         let mut p = SweptPolygon {
             axes: [DVec3::ZERO; 16],
             lo: [0.0; 16],
@@ -223,10 +229,36 @@ impl SweptPolygon {
         for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
             p.push(poly, axis);
         }
+        // Edge × coordinate axes, once per edge direction: the far edge of a parallelogram
+        // repeats the near one's axes, and an edge along a coordinate axis gives a zero axis.
+        // Leaving out an axis can only make the test more conservative, never wrong.
+        let mut seen: [DVec3; 4] = [DVec3::ZERO; 4];
+        let mut distinct = 0;
         for i in 0..poly.len() {
             let edge = poly[(i + 1) % poly.len()] - poly[i];
+            let e2 = edge.length_squared();
+            if !distinct_only {
+                for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
+                    p.push(poly, edge.cross(axis));
+                }
+                continue;
+            }
+            if !(e2 > 0.0)
+                || seen[..distinct]
+                    .iter()
+                    .any(|s| s.cross(edge).length_squared() <= 1e-24 * s.length_squared() * e2)
+            {
+                continue;
+            }
+            if distinct < seen.len() {
+                seen[distinct] = edge;
+                distinct += 1;
+            }
             for axis in [DVec3::X, DVec3::Y, DVec3::Z] {
-                p.push(poly, edge.cross(axis));
+                let a = edge.cross(axis);
+                if a.length_squared() > 1e-24 * e2 {
+                    p.push(poly, a);
+                }
             }
         }
         p
@@ -301,6 +333,53 @@ mod tests {
         t_c > 0.0
             && t_c <= inc.distance * (1.0 + 1e-9)
             && (dist - p.radius).abs() < 1e-9 * p.radius.max(1.0)
+    }
+
+    /// Leaving out the repeated and zero edge axes changes no decision of the separating-axis
+    /// test: parallelograms for directional lights along a coordinate axis (the thesis's) and
+    /// oblique ones, and triangles for point lights, against random boxes.
+    #[test]
+    fn distinct_edge_axes_decide_like_all_sixteen() {
+        let mut rng = crate::formats::random::SplitMix64::new(5);
+        let mut v = |s: f64| {
+            DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * 2.0 * s - DVec3::splat(s)
+        };
+        let (mut overlapping, mut separated) = (0, 0);
+        for trial in 0..400 {
+            let (y0, y1) = (v(3.0), v(3.0));
+            let poly: Vec<DVec3> = match trial % 3 {
+                0 => vec![y0, y1, y1 + DVec3::Y * 20.0, y0 + DVec3::Y * 20.0],
+                1 => {
+                    let w = v(1.0).normalize() * 20.0;
+                    vec![y0, y1, y1 + w, y0 + w]
+                }
+                _ => vec![y0, y1, v(5.0)],
+            };
+            let (fast, all) = (
+                SweptPolygon::with_axes(&poly, true),
+                SweptPolygon::with_axes(&poly, false),
+            );
+            assert!(fast.count <= all.count);
+            for _ in 0..50 {
+                let c = v(4.0);
+                let h = v(1.5).abs() + DVec3::splat(0.01);
+                let got = fast.overlaps_box(c - h, c + h);
+                assert_eq!(
+                    got,
+                    all.overlaps_box(c - h, c + h),
+                    "trial {trial}: {poly:?}"
+                );
+                if got {
+                    overlapping += 1;
+                } else {
+                    separated += 1;
+                }
+            }
+        }
+        assert!(
+            overlapping > 1000 && separated > 1000,
+            "{overlapping} {separated}"
+        );
     }
 
     #[test]
