@@ -97,10 +97,7 @@ struct Span {
 #[derive(Debug, Default, Clone)]
 pub struct IntervalScratch {
     spans: Vec<Span>,
-    /// Active particles as (rank, index), kept sorted by rank, and where each one's chord ends.
-    active: Vec<(u32, u32)>,
-    exits: Vec<f64>,
-    /// Open chords of the compositing sweep.
+    /// Open chords of the sweep.
     open: Vec<Open>,
 }
 
@@ -178,7 +175,7 @@ impl<'a> IntervalCutter<'a> {
 }
 
 /// `IntervalCutter::cut`: the chords clipped to (t_min, t_max), then the general sweep over
-/// their ends ([`merge_intervals`]). Most shadow rays cross a few spheres whose chords do not
+/// their ends ([`sweep_open`]). Most shadow rays cross a few spheres whose chords do not
 /// overlap; those take [`disjoint_intervals`] instead, which gives the same intervals, bit for
 /// bit, without the sweep (a test compares the two).
 fn cut_into_intervals(
@@ -194,9 +191,9 @@ fn cut_into_intervals(
     if clipped_spans(hits, range, particles, skip, &mut scratch.spans) {
         disjoint_intervals(&scratch.spans, particles, out);
     } else {
-        let (spans, active, exits) = (&scratch.spans, &mut scratch.active, &mut scratch.exits);
-        merge_intervals(spans, ranks, active, exits, |set, t0, t1| {
-            out.push(medium_of(set, particles, t0, t1));
+        let (spans, open) = (&scratch.spans, &mut scratch.open);
+        sweep_open(spans, particles, ranks, open, |set, t0, t1| {
+            out.push(medium_of(set.iter().map(|o| o.index), particles, t0, t1));
             true
         });
     }
@@ -271,7 +268,7 @@ fn composite_spans(
     }
 }
 
-/// One chord open in [`composite_overlapping`]'s sweep, with what its sums need.
+/// One chord open in [`sweep_open`], with what the sums of its interval need.
 #[derive(Debug, Clone, Copy)]
 struct Open {
     exit: f64,
@@ -282,19 +279,22 @@ struct Open {
     weighted: DVec3,
 }
 
-/// The sweep of [`merge_intervals`] over overlapping spans (`scratch.spans`, sorted by start),
-/// compositing each interval into `acc` as it is formed. The open chords are kept in arrival
-/// order and put in canonical rank order only where that changes a sum: σ and S of one or two
-/// chords are the same in either order (0 + a + b = 0 + b + a in IEEE arithmetic), so only sets
-/// of three or more are sorted (insertion sort: they are nearly sorted from the last interval).
-/// The sums, and so the result, are those of the canonical order bit for bit.
-fn composite_overlapping(
+/// The general cut of `spans` sorted by start: a sweep over the chord ends, taking the next
+/// event as the earlier of the next start and the earliest end among the open chords (no list
+/// of events to sort). All ends and starts at one t are applied before the interval from t is
+/// formed and handed to `emit` (which returns false to stop), with the open chords in
+/// canonical rank order wherever that changes a sum: the chords are kept in arrival order, and
+/// sorted only when three or more are open, since sums of one or two are the same in either
+/// order (0 + a + b = 0 + b + a in IEEE arithmetic). So the intervals are those of the plain
+/// event sweep in rank order bit for bit (`sweep_intervals` in the tests), and shuffling the
+/// particles changes none of them.
+fn sweep_open(
+    spans: &[Span],
     particles: &[Particle],
     ranks: &[u32],
-    scratch: &mut IntervalScratch,
-    acc: &mut Accumulator,
+    open: &mut Vec<Open>,
+    mut emit: impl FnMut(&[Open], f64, f64) -> bool,
 ) {
-    let (spans, open) = (&scratch.spans, &mut scratch.open);
     open.clear();
     let Some(first) = spans.first() else {
         return;
@@ -331,31 +331,41 @@ fn composite_overlapping(
             }
         } else {
             if open.len() > 2 {
+                // Insertion sort: nearly sorted from the last interval.
                 open.sort_by_key(|o| (o.rank, o.index));
             }
-            let mut sigma = 0.0;
-            let mut weighted = DVec3::ZERO;
-            for o in open.iter() {
-                sigma += o.sigma;
-                weighted += o.weighted;
-            }
-            let more = if sigma.is_finite() {
-                acc.add(sigma, weighted, t_next - t)
-            } else {
-                // A Θmax = 1 particle (σ = ∞, and then `weighted` is NaN or ∞) or Σσᵢ
-                // overflowing: the general medium, over the set in canonical order.
-                open.sort_by_key(|o| (o.rank, o.index));
-                let set = &mut scratch.active;
-                set.clear();
-                set.extend(open.iter().map(|o| (o.rank, o.index)));
-                acc.add_interval(medium_of(set, particles, t, t_next))
-            };
-            if !more {
+            if !emit(open, t, t_next) {
                 return;
             }
         }
         t = t_next;
     }
+}
+
+/// [`sweep_open`] over overlapping spans (`scratch.spans`), compositing each interval into
+/// `acc` as it is formed from σ = Σσᵢ and S = Σσᵢ·Cᵢ alone.
+fn composite_overlapping(
+    particles: &[Particle],
+    ranks: &[u32],
+    scratch: &mut IntervalScratch,
+    acc: &mut Accumulator,
+) {
+    let (spans, open) = (&scratch.spans, &mut scratch.open);
+    sweep_open(spans, particles, ranks, open, |set, t0, t1| {
+        let mut sigma = 0.0;
+        let mut weighted = DVec3::ZERO;
+        for o in set {
+            sigma += o.sigma;
+            weighted += o.weighted;
+        }
+        if sigma.is_finite() {
+            acc.add(sigma, weighted, t1 - t0)
+        } else {
+            // A Θmax = 1 particle (σ = ∞, and then `weighted` is NaN or ∞) or Σσᵢ
+            // overflowing: the general medium.
+            acc.add_interval(medium_of(set.iter().map(|o| o.index), particles, t0, t1))
+        }
+    });
 }
 
 /// The running front-to-back composite of [`composite_spans`].
@@ -389,72 +399,8 @@ impl Accumulator {
     }
 }
 
-/// The general cut of `spans` sorted by start: a sweep over the chord ends, taking the next event
-/// as the earlier of the next start and the earliest end among the active chords (no list of
-/// events to sort). All ends and starts at one t are applied before the interval from t is
-/// formed, and the active set is kept sorted by canonical rank, so the intervals are those of
-/// the plain event sweep bit for bit (`sweep_intervals` in the tests). Appends to `out`.
-fn merge_intervals(
-    spans: &[Span],
-    ranks: &[u32],
-    active: &mut Vec<(u32, u32)>,
-    exits: &mut Vec<f64>,
-    mut emit: impl FnMut(&[(u32, u32)], f64, f64) -> bool,
-) {
-    active.clear();
-    exits.clear();
-    let Some(first) = spans.first() else {
-        return;
-    };
-    let mut t = first.t0;
-    let mut next = 0;
-    loop {
-        // The active set is a handful of particles: shifting by hand beats `Vec::insert` and
-        // `Vec::remove`, whose memmove calls cost more than the few elements they move.
-        let mut kept = 0;
-        for k in 0..active.len() {
-            if exits[k] != t {
-                active[kept] = active[k];
-                exits[kept] = exits[k];
-                kept += 1;
-            }
-        }
-        active.truncate(kept);
-        exits.truncate(kept);
-        while next < spans.len() && spans[next].t0 == t {
-            let s = spans[next];
-            let key = (ranks[s.index as usize], s.index);
-            // A particle entered twice cannot happen on a ray; ignoring it keeps the sweep total.
-            if let Err(pos) = active.binary_search(&key) {
-                active.push(key);
-                exits.push(s.t1);
-                for k in (pos + 1..active.len()).rev() {
-                    active.swap(k, k - 1);
-                    exits.swap(k, k - 1);
-                }
-            }
-            next += 1;
-        }
-        // The earliest remaining event, by the same total order as the sorted starts.
-        let mut t_next = spans.get(next).map_or(f64::INFINITY, |s| s.t0);
-        for &e in exits.iter() {
-            if e.total_cmp(&t_next).is_lt() {
-                t_next = e;
-            }
-        }
-        if !active.is_empty() {
-            if !emit(active, t, t_next) {
-                return;
-            }
-        } else if next >= spans.len() {
-            return;
-        }
-        t = t_next;
-    }
-}
-
 /// The plain event sweep over the chord ends of `spans` (in any order), keeping the active set
-/// sorted by canonical rank: the oracle of [`merge_intervals`] and [`disjoint_intervals`].
+/// sorted by canonical rank: the oracle of [`sweep_open`] and [`disjoint_intervals`].
 #[cfg(test)]
 fn sweep_intervals(
     spans: &[Span],
@@ -504,7 +450,12 @@ fn sweep_intervals(
             continue;
         }
         let t_next = events[i].t;
-        out.push(medium_of(active, particles, t, t_next));
+        out.push(medium_of(
+            active.iter().map(|&(_, i)| i),
+            particles,
+            t,
+            t_next,
+        ));
     }
 }
 
@@ -543,16 +494,21 @@ fn disjoint_interval(s: &Span, p: &Particle) -> Interval {
     }
 }
 
-/// σ, E and α of a fixed set of particles (sorted by canonical rank, so the sums are
-/// order-independent).
-fn medium_of(active: &[(u32, u32)], particles: &[Particle], t0: f64, t1: f64) -> Interval {
+/// σ, E and α of a fixed set of particles, given by index (in canonical rank order, or at most
+/// two of them, so the sums do not depend on the input order).
+fn medium_of(
+    set: impl Iterator<Item = u32> + Clone,
+    particles: &[Particle],
+    t0: f64,
+    t1: f64,
+) -> Interval {
     let mut sigma = 0.0;
     let mut weighted_color = DVec3::ZERO;
     let mut weighted_albedo = DVec3::ZERO;
     let mut n_inf = 0u32;
     let mut inf_color = DVec3::ZERO;
     let mut inf_albedo = DVec3::ZERO;
-    for &(_, index) in active {
+    for index in set.clone() {
         let p = &particles[index as usize];
         if p.sigma.is_infinite() {
             n_inf += 1;
@@ -584,12 +540,12 @@ fn medium_of(active: &[(u32, u32)], particles: &[Particle], t0: f64, t1: f64) ->
     } else {
         // Σσᵢ overflowed (σ near f64::MAX from a huge κ): weigh by σᵢ/σ_max instead, so the
         // colour stays a convex combination rather than ∞/∞.
-        let scale = active
-            .iter()
-            .map(|&(_, i)| particles[i as usize].sigma)
+        let scale = set
+            .clone()
+            .map(|i| particles[i as usize].sigma)
             .fold(0.0, f64::max);
         let (mut w, mut c, mut a) = (0.0, DVec3::ZERO, DVec3::ZERO);
-        for &(_, index) in active {
+        for index in set {
             let p = &particles[index as usize];
             let s = p.sigma / scale;
             w += s;

@@ -413,6 +413,16 @@ pub fn integrate_adaptive(
 mod tests {
     use super::*;
 
+    /// The single piece [lo, hi] with weight `weight`.
+    fn one_piece(lo: f64, hi: f64, weight: f64) -> [Piece; 1] {
+        [Piece {
+            lo,
+            hi,
+            weight,
+            tag: 0,
+        }]
+    }
+
     #[test]
     fn k15_integrates_polynomials_of_degree_22_exactly() {
         let r = gauss_kronrod_15(&mut |x| DVec3::new(x.powi(22), x.powi(3), 1.0), -1.0, 2.0);
@@ -429,12 +439,7 @@ mod tests {
         // ∫_0^2 sqrt|x − 0.7| dx, kink not announced: adaptivity alone.
         let exact = (2.0 / 3.0) * (0.7f64.powf(1.5) + 1.3f64.powf(1.5));
         for tol in [1e-4, 1e-7, 1e-10] {
-            let pieces = [Piece {
-                lo: 0.0,
-                hi: 2.0,
-                weight: 1.0,
-                tag: 0,
-            }];
+            let pieces = one_piece(0.0, 2.0, 1.0);
             let r = integrate_adaptive(
                 &pieces,
                 tol,
@@ -457,12 +462,7 @@ mod tests {
     #[test]
     fn announced_kinks_and_max_segments() {
         let f = |_: usize, x: f64| DVec3::splat((x - 0.7f64).abs().sqrt());
-        let pieces = [Piece {
-            lo: 0.0,
-            hi: 2.0,
-            weight: 0.5,
-            tag: 0,
-        }];
+        let pieces = one_piece(0.0, 2.0, 0.5);
         let kink = |_: usize, lo: f64, hi: f64| (lo < 0.7 && 0.7 < hi).then_some(0.7);
         let coarse = |_: usize, _: f64, _: f64| true;
         let with = integrate_adaptive(&pieces, 1e-9, 10_000, f, kink, coarse);
@@ -499,12 +499,7 @@ mod tests {
     #[test]
     fn smooth_segments_stop_at_seven_nodes_and_a_coarse_refusal_starts_at_fifteen() {
         // e^x on [0, 0.5]: G7 is exact to ~1e-20, its estimate against the 5-node rule ~1e-8.
-        let pieces = [Piece {
-            lo: 0.0,
-            hi: 0.5,
-            weight: 1.0,
-            tag: 0,
-        }];
+        let pieces = one_piece(0.0, 0.5, 1.0);
         let f = |_: usize, x: f64| DVec3::splat(x.exp());
         let exact = 0.5f64.exp() - 1.0;
         let coarse = integrate_adaptive(&pieces, 1e-6, 100, f, |_, _, _| None, |_, _, _| true);
@@ -540,12 +535,7 @@ mod tests {
         ];
         for (i, (g, exact)) in cases.iter().enumerate() {
             for tol in [1e-3, 1e-6, 1e-9] {
-                let pieces = [Piece {
-                    lo: 0.0,
-                    hi: 1.0,
-                    weight: 1.0,
-                    tag: 0,
-                }];
+                let pieces = one_piece(0.0, 1.0, 1.0);
                 let r = integrate_adaptive(
                     &pieces,
                     tol,

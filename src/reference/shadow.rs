@@ -93,6 +93,7 @@ impl Occluders {
         self.candidates.clear();
         let (ya, yb) = (camera_ray.at(ta), camera_ray.at(tb));
         let poly = swept_polygon(bvh, light, ya, yb);
+        let ahead = AheadOfSegment::new(light, ya, yb);
         let candidates = &mut self.candidates;
         for_each_swept_leaf(bvh, &poly, |leaf| {
             for &i in leaf {
@@ -108,11 +109,13 @@ impl Occluders {
                     p.radius * (1.0 + BOX_PADDING) + BOX_PADDING * p.center.abs().max_element();
                 // A finite reach range is the cylinder test of a directional light; with the
                 // half-space test below it is as tight as the polygon's (which is the
-                // cylinder's inside, cut at the segment) and far cheaper than its sixteen axes.
-                let near = if t_lo.is_finite() && t_hi.is_finite() {
-                    ahead_of_segment(light, ya, yb, p.center, pad)
-                } else {
-                    poly.overlaps_box(p.center - DVec3::splat(pad), p.center + DVec3::splat(pad))
+                // cylinder's inside, cut at the segment) and far cheaper than its axes.
+                let near = match &ahead {
+                    Some(ahead) if t_lo.is_finite() && t_hi.is_finite() => {
+                        ahead.keeps(p.center, pad)
+                    }
+                    _ => poly
+                        .overlaps_box(p.center - DVec3::splat(pad), p.center + DVec3::splat(pad)),
                 };
                 if near {
                     candidates.push(Candidate {
@@ -172,20 +175,38 @@ impl Occluders {
     }
 }
 
-/// Whether a sphere about `c` whose padded radius is `r_pad` is not wholly behind both ends y_a,
-/// y_b of a camera segment as seen along a directional light's shadow rays: a shadow ray from x
-/// leaves it behind (t_exit ≤ 0) when (c − x)·ω < −r, and (c − x)·ω is linear along the segment,
-/// so the test at the two ends holds for every point between. The padding (the box padding of
-/// the polygon test, `BOX_PADDING`) covers the round-off of both sides. Anything but a
-/// directional light, and non-finite ends, keep the sphere.
-fn ahead_of_segment(light: &Light, ya: DVec3, yb: DVec3, c: DVec3, r_pad: f64) -> bool {
-    let Light::Directional { direction, .. } = *light else {
-        return true;
-    };
-    let toward = -direction;
-    let slack = BOX_PADDING * (ya.abs().max_element() + yb.abs().max_element());
-    let behind = |y: DVec3| (c - y).dot(toward) < -(r_pad + slack);
-    !(behind(ya) && behind(yb))
+/// The half-space test of [`Occluders::gather`] for one camera segment [y_a, y_b] and a
+/// directional light: a shadow ray from x leaves a sphere (c, r) behind (t_exit ≤ 0) when
+/// (c − x)·ω < −r, and (c − x)·ω is linear along the segment, so a sphere behind both ends is
+/// behind every point between. The slack (the box padding of the polygon test, `BOX_PADDING`,
+/// of the ends' size) covers the round-off of both sides. Prepared once per gather.
+struct AheadOfSegment {
+    toward: DVec3,
+    ya: DVec3,
+    yb: DVec3,
+    slack: f64,
+}
+
+impl AheadOfSegment {
+    /// `None` for anything but a directional light.
+    fn new(light: &Light, ya: DVec3, yb: DVec3) -> Option<Self> {
+        let Light::Directional { direction, .. } = *light else {
+            return None;
+        };
+        Some(AheadOfSegment {
+            toward: -direction,
+            ya,
+            yb,
+            slack: BOX_PADDING * (ya.abs().max_element() + yb.abs().max_element()),
+        })
+    }
+
+    /// Whether the sphere about `c` with padded radius `r_pad` is not wholly behind the
+    /// segment (also true for NaN, and so for non-finite ends).
+    fn keeps(&self, c: DVec3, r_pad: f64) -> bool {
+        let behind = |y: DVec3| (c - y).dot(self.toward) < -(r_pad + self.slack);
+        !(behind(self.ya) && behind(self.yb))
+    }
 }
 
 /// A superset [t_lo, t_hi] of the camera-ray parameters t ≤ `t_end` whose shadow ray towards
