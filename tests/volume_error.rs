@@ -186,3 +186,86 @@ fn error_estimate_is_honest_near_opacity_one() {
     let s = scene(models::LIT, particles, two_lights(), SIZE);
     check_honest("lit near opacity 1", s, 1e-9);
 }
+
+/// A deep cloud: 60 overlapping spheres of Θmax 0.9 to 0.99 in a column along the view, with a
+/// point light deep inside it and a directional light. Camera rays become nearly opaque long
+/// before they leave it, so the far end of each ray is bounded instead of integrated
+/// (`VolumeRenderer::tail_cut`); err must still cover the actual error.
+#[test]
+fn error_estimate_is_honest_where_the_far_end_of_the_ray_is_bounded() {
+    let mut rng = Rng::new(47);
+    let particles: Vec<_> = (0..60)
+        .map(|i| {
+            let mut p = particle(
+                DVec3::new(
+                    rng.range(-0.9, 0.9),
+                    rng.range(-0.9, 0.9),
+                    -1.5 + 0.1 * i as f64,
+                ),
+                rng.range(0.4, 0.8),
+                rng.vec3(0.0, 1.0),
+                1.0,
+            );
+            let opacity = rng.range(0.9, 0.99);
+            p.sigma = pgt::optics::extinction::sigma_from_opacity(opacity, p.radius);
+            p.albedo = rng.vec3(0.0, 1.0);
+            p
+        })
+        .collect();
+    let lights = vec![
+        Light::Point {
+            position: DVec3::new(0.1, 0.0, 2.0),
+            intensity: DVec3::new(40.0, 20.0, 60.0),
+            falloff: Falloff::InverseSquare,
+        },
+        two_lights()[0],
+    ];
+    for model in [models::LIT, models::SINGLE_SCATTER] {
+        let s = scene(model, particles.clone(), lights.clone(), SIZE);
+        check_honest(&format!("{} deep cloud", model.name()), s, 1e-9);
+    }
+}
+
+/// The far end of a ray that the gas in front has made nearly opaque is bounded, not
+/// integrated: a row of 80 overlapping spheres along the view costs about the shadow rays of
+/// its first 20, and both give the same pixel within their estimates.
+#[test]
+fn a_deeper_row_behind_an_opaque_front_costs_no_more_shadow_rays() {
+    let row = |n: usize| -> Vec<_> {
+        (0..n)
+            .map(|i| {
+                let c = DVec3::new(0.03 * (i % 3) as f64, 0.02 * (i % 5) as f64, 0.3 * i as f64);
+                let mut p = particle(c, 0.5, DVec3::new(0.9, 0.5, 0.2), 1.0);
+                p.sigma = pgt::optics::extinction::sigma_from_opacity(0.9, p.radius);
+                p
+            })
+            .collect()
+    };
+    for model in [models::LIT, models::SINGLE_SCATTER] {
+        let samples: Vec<_> = [20, 80]
+            .into_iter()
+            .map(|n| {
+                let mut s = scene(model, row(n), two_lights(), 8);
+                s.render.tol = 1e-6;
+                let ray = pgt::geometry::Ray::new(DVec3::new(0.01, 0.01, -8.0), DVec3::Z);
+                radiance(&s, Integrator::Adaptive, &ray)
+            })
+            .collect();
+        let (short, long) = (&samples[0], &samples[1]);
+        assert!(
+            long.shadow_rays as f64 <= 1.1 * short.shadow_rays as f64,
+            "{}: 80 spheres cost {} shadow rays, 20 cost {}",
+            model.name(),
+            long.shadow_rays,
+            short.shadow_rays
+        );
+        for c in 0..3 {
+            let diff = (long.radiance[c] - short.radiance[c]).abs();
+            assert!(
+                diff <= long.error[c] + short.error[c],
+                "{}: channel {c} differs by {diff:e}",
+                model.name()
+            );
+        }
+    }
+}

@@ -94,9 +94,88 @@ impl Light {
     }
 }
 
+impl Light {
+    /// A per-channel upper bound of the unoccluded irradiance at every point o + s·d, s ≥ `t`,
+    /// of the ray (o, d) (d unit length): E for a directional light; I/d_min² for a point light,
+    /// d_min its distance from that half-line (∞ where the half-line passes through it, and I
+    /// with `falloff = "none"`). Rounded up by a relative 1e-12, far above the round-off of d_min.
+    pub fn max_irradiance_beyond(&self, origin: DVec3, direction: DVec3, t: f64) -> DVec3 {
+        match *self {
+            Light::Directional { irradiance, .. } => irradiance,
+            Light::Point {
+                falloff: Falloff::None,
+                intensity,
+                ..
+            } => intensity,
+            Light::Point {
+                position,
+                intensity,
+                falloff: Falloff::InverseSquare,
+            } => {
+                let v = position - origin;
+                let s = v.dot(direction).max(t);
+                let d = (v - s * direction).length();
+                intensity / (d * d) * (1.0 + 1e-12)
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The bound holds at every sampled point of the half-line, and is reached (to its rounding
+    /// margin) at the point nearest to a point light that lies beside the half-line.
+    #[test]
+    fn the_irradiance_bound_covers_the_half_line() {
+        let mut rng = crate::formats::random::SplitMix64::new(3);
+        let mut v = || DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * 2.0 - 1.0;
+        for _ in 0..200 {
+            let light = Light::Point {
+                position: v() * 3.0,
+                intensity: DVec3::new(1.0, 2.0, 0.5),
+                falloff: Falloff::InverseSquare,
+            };
+            let (o, d) = (v() * 5.0, v().normalize());
+            let t0 = 4.0 * v().x;
+            let bound = light.max_irradiance_beyond(o, d, t0);
+            let mut best = DVec3::ZERO;
+            for k in 0..2000 {
+                let x = o + (t0 + k as f64 * 0.005) * d;
+                let e = light.incident_at(x).unwrap().irradiance;
+                assert!(e.cmple(bound).all(), "{e} above {bound}");
+                best = best.max(e);
+            }
+            // The nearest point lies within the sampled stretch when the light is near the ray.
+            let Light::Point { position, .. } = light else {
+                unreachable!()
+            };
+            let s = (position - o).dot(d).max(t0);
+            if s < t0 + 9.0 {
+                assert!(best.x > 0.99 * bound.x, "{best} far below {bound}");
+            }
+        }
+        let sun = Light::Directional {
+            direction: DVec3::NEG_Y,
+            irradiance: DVec3::new(0.1, 0.2, 0.3),
+        };
+        assert_eq!(
+            sun.max_irradiance_beyond(DVec3::ZERO, DVec3::X, 5.0),
+            DVec3::new(0.1, 0.2, 0.3)
+        );
+        let through = Light::Point {
+            position: DVec3::new(3.0, 0.0, 0.0),
+            intensity: DVec3::ONE,
+            falloff: Falloff::InverseSquare,
+        };
+        let on_it = through.max_irradiance_beyond(DVec3::ZERO, DVec3::X, 1.0);
+        assert!(on_it.x.is_infinite(), "{on_it}");
+        assert!(through
+            .max_irradiance_beyond(DVec3::ZERO, DVec3::X, 4.0)
+            .cmplt(DVec3::splat(1.0 + 1e-9))
+            .all());
+    }
 
     #[test]
     fn weights() {

@@ -41,6 +41,12 @@ pub trait Model: Sync + Send {
     /// k of the constant part k·E(x) of Q.
     fn emission_factor(&self, params: &SourceParams) -> f64;
     /// q_l(x), the part of Q that one light contributes, at a point inside `interval`.
+    ///
+    /// Must be ≥ 0 and non-decreasing in the sample's radiance, irradiance and transmittance and
+    /// in the interval's emission and albedo (true of every model of DESIGN.md §2, which are
+    /// products and sums of them with non-negative weights): the renderer bounds the far end of
+    /// a nearly opaque ray by this function of their largest values, and puts that bound into
+    /// err instead of integrating it (`reference::volume`, `VolumeRenderer::tail_cut`).
     fn light_source(
         &self,
         params: &SourceParams,
