@@ -20,6 +20,13 @@
 //! from which a shadow ray can reach it at all (the inside of its tangency cylinder, padded for
 //! round-off: `reach_range`), and a node outside that range skips the sphere test: the effect of
 //! a list per kink-free stretch without the extra queries.
+//!
+//! For a directional light even the query per interval is more than needed: the renderer
+//! gathers one list for the whole finite stretch of the camera ray ([`Occluders::gather`] over
+//! it, one BVH query per light and camera ray), and each interval's list is *narrowed* from it
+//! ([`Occluders::narrow`]: the same reach-range and half-space tests, no BVH). The narrowed list
+//! keeps the wide one's order and is a superset of the spheres crossed, so the hits are the
+//! same, in the same order (tested). On 1UUN this took about 10 % of the instructions off.
 
 // `!(a > b)` is deliberate: unlike `a <= b` it is also true when a value is NaN, so degenerate
 // input takes the safe branch.
@@ -139,6 +146,44 @@ impl Occluders {
                     .total_cmp(&b.center.dot(toward))
                     .then(a.index.cmp(&b.index))
             });
+        }
+    }
+
+    /// The candidates of `wide` (gathered for a stretch of the same camera ray that contains
+    /// [ta, tb], towards the same directional light) that shadow rays from x(t), t ∈ [ta, tb],
+    /// can reach: those whose reach range meets [ta, tb] and that are not wholly behind the
+    /// segment (the tests of [`Occluders::gather`], without its BVH query). A superset of the
+    /// spheres those shadow rays cross, in `wide`'s order, so [`Occluders::hits`] gives exactly
+    /// what it gives after a gather of its own. Candidates of `wide` with an unbounded reach range
+    /// are all kept.
+    pub fn narrow(
+        &mut self,
+        wide: &Occluders,
+        camera_ray: &Ray,
+        (tag, l): (usize, usize),
+        light: &Light,
+        (ta, tb): (f64, f64),
+    ) {
+        self.key = Some((tag, l));
+        self.ta = ta;
+        self.tb = tb;
+        self.candidates.clear();
+        let ahead = AheadOfSegment::new(light, camera_ray.at(ta), camera_ray.at(tb));
+        for c in &wide.candidates {
+            if !(c.t_lo <= tb && c.t_hi >= ta) {
+                continue;
+            }
+            let keep = match &ahead {
+                Some(ahead) if c.t_lo.is_finite() && c.t_hi.is_finite() => {
+                    let pad =
+                        c.radius * (1.0 + BOX_PADDING) + BOX_PADDING * c.center.abs().max_element();
+                    ahead.keeps(c.center, pad)
+                }
+                _ => true,
+            };
+            if keep {
+                self.candidates.push(*c);
+            }
         }
     }
 
@@ -293,13 +338,23 @@ mod tests {
             },
         ];
         let mut occ = Occluders::default();
-        let (mut a, mut b) = (Vec::new(), Vec::new());
-        let (mut compared, mut grazing) = (0, 0);
+        let (mut wide, mut narrowed) = (Occluders::default(), Occluders::default());
+        let (mut a, mut b, mut c) = (Vec::new(), Vec::new(), Vec::new());
+        let (mut compared, mut grazing, mut narrowed_compared) = (0, 0, 0);
         for trial in 0..200 {
             let ray = Ray::new(v(8.0) - DVec3::Z * 10.0, (v(0.3) + DVec3::Z).normalize());
             let (ta, tb) = (5.0 + v(3.0).x, 12.0 + v(3.0).x);
             for (l, light) in lights.iter().enumerate() {
                 occ.gather(&bvh, &particles, &ray, (trial, l), light, (ta, tb));
+                // The list narrowed from one gathered for a longer stretch of the same ray
+                // (directional lights only, as the renderer uses it).
+                let directional = matches!(light, Light::Directional { .. });
+                if directional {
+                    let stretch = (ta - 2.0 + v(1.0).x, tb + 2.0 + v(1.0).x);
+                    wide.gather(&bvh, &particles, &ray, (usize::MAX, l), light, stretch);
+                    narrowed.narrow(&wide, &ray, (trial, l), light, (ta, tb));
+                    assert!(narrowed.len() <= wide.len());
+                }
                 // Evenly spaced nodes, and nodes on and a few ulps around every kink (where a
                 // shadow ray grazes a sphere: the ends of the candidates' reach ranges).
                 let mut ts: Vec<f64> = (0..=20)
@@ -331,6 +386,15 @@ mod tests {
                             .then(a.index.cmp(&b.index))
                     });
                     assert_eq!(a, b, "trial {trial} light {l} t {t}");
+                    if directional {
+                        assert!(narrowed.covers(trial, l, t));
+                        let mut unsorted = Vec::new();
+                        narrowed.hits(t, &sray, inc.distance, &mut unsorted);
+                        occ.hits(t, &sray, inc.distance, &mut c);
+                        // The same hits in the same order as the list's own gather.
+                        assert_eq!(unsorted, c, "narrowed: trial {trial} light {l} t {t}");
+                        narrowed_compared += unsorted.len();
+                    }
                     compared += a.len();
                     grazing += usize::from(j >= 21);
                 }
@@ -339,5 +403,9 @@ mod tests {
         }
         assert!(compared > 1000, "the rays should hit something: {compared}");
         assert!(grazing > 100, "the kinks should be tested: {grazing}");
+        assert!(
+            narrowed_compared > 500,
+            "narrowed lists: {narrowed_compared}"
+        );
     }
 }

@@ -124,6 +124,9 @@ struct ShadowScratch {
     rays: u64,
     /// Candidate occluders per interval of the camera ray, for the light being integrated.
     occluders: Vec<Occluders>,
+    /// For a directional light, the candidates of the whole camera ray, which the intervals'
+    /// lists are narrowed from (one BVH query per light instead of one per interval).
+    wide: Occluders,
 }
 
 impl<'a> VolumeRenderer<'a> {
@@ -222,14 +225,18 @@ impl<'a> VolumeRenderer<'a> {
             sh.occluders.resize_with(k + 1, Occluders::default);
         }
         if !sh.occluders[k].covers(k, l, t) {
-            sh.occluders[k].gather(
-                &self.bvh,
-                self.cutter.particles(),
-                ray,
-                (k, l),
-                light,
-                (iv.t0, iv.t1),
-            );
+            if sh.wide.covers(usize::MAX, l, t) {
+                sh.occluders[k].narrow(&sh.wide, ray, (k, l), light, (iv.t0, iv.t1));
+            } else {
+                sh.occluders[k].gather(
+                    &self.bvh,
+                    self.cutter.particles(),
+                    ray,
+                    (k, l),
+                    light,
+                    (iv.t0, iv.t1),
+                );
+            }
         }
         let shadow_ray = Ray {
             origin: x,
@@ -291,6 +298,16 @@ impl<'a> VolumeRenderer<'a> {
                 &self.scene.particles,
                 &mut kinks,
             );
+            if let Light::Directional { .. } = light {
+                sh.wide.gather(
+                    &self.bvh,
+                    &self.scene.particles,
+                    ray,
+                    (usize::MAX, l),
+                    light,
+                    (first.t0, last.t1),
+                );
+            }
             // Every kink is a breakpoint from the start: a shadow that falls between the nodes
             // of a segment would otherwise go unseen by both rules, and by the error estimate.
             split.clear();
