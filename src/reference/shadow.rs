@@ -81,6 +81,14 @@ impl Occluders {
         self.key == Some((tag, light)) && t >= self.ta && t <= self.tb
     }
 
+    /// Empties the list and keys it to (interval `tag`, light `l`) over [ta, tb].
+    fn start(&mut self, (tag, l): (usize, usize), (ta, tb): (f64, f64)) {
+        self.key = Some((tag, l));
+        self.ta = ta;
+        self.tb = tb;
+        self.candidates.clear();
+    }
+
     /// Gathers the spheres with σ > 0 whose padded box the polygon swept from [x(ta), x(tb)]
     /// towards `light` may touch, for interval `tag` and light index `l`.
     #[allow(clippy::too_many_arguments)]
@@ -93,11 +101,8 @@ impl Occluders {
         light: &Light,
         (ta, tb): (f64, f64),
     ) {
-        self.key = Some((tag, l));
-        self.ta = ta;
-        self.tb = tb;
+        self.start((tag, l), (ta, tb));
         self.gathers += 1;
-        self.candidates.clear();
         let (ya, yb) = (camera_ray.at(ta), camera_ray.at(tb));
         let poly = swept_polygon(bvh, light, ya, yb);
         let ahead = AheadOfSegment::new(light, ya, yb);
@@ -112,8 +117,7 @@ impl Occluders {
                 if !(t_lo <= tb && t_hi >= ta) {
                     continue;
                 }
-                let pad =
-                    p.radius * (1.0 + BOX_PADDING) + BOX_PADDING * p.center.abs().max_element();
+                let pad = padded_radius(p.center, p.radius);
                 // A finite reach range is the cylinder test of a directional light; with the
                 // half-space test below it is as tight as the polygon's (which is the
                 // cylinder's inside, cut at the segment) and far cheaper than its axes.
@@ -164,10 +168,7 @@ impl Occluders {
         light: &Light,
         (ta, tb): (f64, f64),
     ) {
-        self.key = Some((tag, l));
-        self.ta = ta;
-        self.tb = tb;
-        self.candidates.clear();
+        self.start((tag, l), (ta, tb));
         let ahead = AheadOfSegment::new(light, camera_ray.at(ta), camera_ray.at(tb));
         for c in &wide.candidates {
             if !(c.t_lo <= tb && c.t_hi >= ta) {
@@ -175,9 +176,7 @@ impl Occluders {
             }
             let keep = match &ahead {
                 Some(ahead) if c.t_lo.is_finite() && c.t_hi.is_finite() => {
-                    let pad =
-                        c.radius * (1.0 + BOX_PADDING) + BOX_PADDING * c.center.abs().max_element();
-                    ahead.keeps(c.center, pad)
+                    ahead.keeps(c.center, padded_radius(c.center, c.radius))
                 }
                 _ => true,
             };
@@ -218,6 +217,12 @@ impl Occluders {
     pub fn is_empty(&self) -> bool {
         self.candidates.is_empty()
     }
+}
+
+/// The radius of a sphere padded by [`BOX_PADDING`], relative to it and to its coordinates, for
+/// the conservative box and half-space tests.
+fn padded_radius(center: DVec3, radius: f64) -> f64 {
+    radius * (1.0 + BOX_PADDING) + BOX_PADDING * center.abs().max_element()
 }
 
 /// The half-space test of [`Occluders::gather`] for one camera segment [y_a, y_b] and a
