@@ -71,8 +71,9 @@
 //! cuts most of each ray.
 //!
 //! **Shadow rays** test only the candidate occluders of their camera-ray interval
-//! (`reference::shadow`): one BVH query per interval and light, the same hits as a traversal of
-//! the whole BVH.
+//! (`reference::shadow`), with the same hits as a traversal of the whole BVH: one BVH query per
+//! interval and point light, and one per camera ray and directional light, from which each
+//! interval's list is narrowed.
 
 use super::quadrature::{integrate_adaptive, Piece};
 use super::riemann::midpoint_sum;
@@ -281,7 +282,7 @@ impl<'a> VolumeRenderer<'a> {
         let share = render.tol / m as f64;
         for (l, light) in self.scene.lights.iter().enumerate() {
             // The far end of the ray, whose weight cannot matter, is bounded instead of
-            // integrated: its bound goes into the error, half of it into the value.
+            // integrated: half its bound goes into the value, half into the error.
             let (kept, tail) = self.tail_cut(ray, intervals, pieces, light, TAIL_SHARE * share);
             value += 0.5 * tail;
             error += 0.5 * tail;
