@@ -175,7 +175,7 @@ fn cone_roots(ray: &Ray, p: DVec3, c: DVec3, r: f64) -> [Option<f64>; 2] {
 }
 
 /// Real roots of a·t² + b·t + c = 0 without cancellation (the q = −(b + sign(b)·√disc)/2 form).
-fn solve_quadratic(a: f64, b: f64, c: f64) -> [Option<f64>; 2] {
+pub(crate) fn solve_quadratic(a: f64, b: f64, c: f64) -> [Option<f64>; 2] {
     if a == 0.0 {
         return [(b != 0.0).then(|| -c / b), None];
     }

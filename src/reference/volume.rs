@@ -72,8 +72,7 @@
 //!
 //! **Shadow rays** test only the candidate occluders of their camera-ray interval
 //! (`reference::shadow`), with the same hits as a traversal of the whole BVH: one BVH query per
-//! interval and point light, and one per camera ray and directional light, from which each
-//! interval's list is narrowed.
+//! camera ray and light, from which each interval's list is narrowed.
 
 use super::quadrature::{integrate_adaptive, Piece};
 use super::riemann::midpoint_sum;
@@ -125,8 +124,8 @@ struct ShadowScratch {
     rays: u64,
     /// Candidate occluders per interval of the camera ray, for the light being integrated.
     occluders: Vec<Occluders>,
-    /// For a directional light, the candidates of the whole camera ray, which the intervals'
-    /// lists are narrowed from (one BVH query per light instead of one per interval).
+    /// The candidates of the whole camera ray for the light being integrated, which the
+    /// intervals' lists are narrowed from (one BVH query per light instead of one per interval).
     wide: Occluders,
 }
 
@@ -299,16 +298,14 @@ impl<'a> VolumeRenderer<'a> {
                 &self.scene.particles,
                 &mut kinks,
             );
-            if let Light::Directional { .. } = light {
-                sh.wide.gather(
-                    &self.bvh,
-                    &self.scene.particles,
-                    ray,
-                    (usize::MAX, l),
-                    light,
-                    (first.t0, last.t1),
-                );
-            }
+            sh.wide.gather(
+                &self.bvh,
+                &self.scene.particles,
+                ray,
+                (usize::MAX, l),
+                light,
+                (first.t0, last.t1),
+            );
             // Every kink is a breakpoint from the start: a shadow that falls between the nodes
             // of a segment would otherwise go unseen by both rules, and by the error estimate.
             split.clear();
