@@ -425,6 +425,18 @@ mod tests {
         }]
     }
 
+    /// ∫_lo^hi g to `tol` with no kinks announced and every segment free to start at G7.
+    fn integrate_plain(lo: f64, hi: f64, tol: f64, g: impl Fn(f64) -> f64) -> AdaptiveResult {
+        integrate_adaptive(
+            &one_piece(lo, hi, 1.0),
+            tol,
+            10_000,
+            |_, x| DVec3::splat(g(x)),
+            |_, _, _| None,
+            |_, _, _| true,
+        )
+    }
+
     #[test]
     fn k15_integrates_polynomials_of_degree_22_exactly() {
         let r = gauss_kronrod_15(&mut |x| DVec3::new(x.powi(22), x.powi(3), 1.0), -1.0, 2.0);
@@ -441,15 +453,7 @@ mod tests {
         // ∫_0^2 sqrt|x − 0.7| dx, kink not announced: adaptivity alone.
         let exact = (2.0 / 3.0) * (0.7f64.powf(1.5) + 1.3f64.powf(1.5));
         for tol in [1e-4, 1e-7, 1e-10] {
-            let pieces = one_piece(0.0, 2.0, 1.0);
-            let r = integrate_adaptive(
-                &pieces,
-                tol,
-                10_000,
-                |_, x| DVec3::splat((x - 0.7f64).abs().sqrt()),
-                |_, _, _| None,
-                |_, _, _| true,
-            );
+            let r = integrate_plain(0.0, 2.0, tol, |x| (x - 0.7f64).abs().sqrt());
             assert!(r.converged);
             let actual = (r.value.x - exact).abs();
             assert!(
@@ -537,15 +541,7 @@ mod tests {
         ];
         for (i, (g, exact)) in cases.iter().enumerate() {
             for tol in [1e-3, 1e-6, 1e-9] {
-                let pieces = one_piece(0.0, 1.0, 1.0);
-                let r = integrate_adaptive(
-                    &pieces,
-                    tol,
-                    10_000,
-                    |_, x| DVec3::splat(g(x)),
-                    |_, _, _| None,
-                    |_, _, _| true,
-                );
+                let r = integrate_plain(0.0, 1.0, tol, g);
                 assert!(r.converged, "case {i} tol {tol}");
                 let actual = (r.value.x - exact).abs();
                 assert!(

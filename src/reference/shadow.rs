@@ -75,8 +75,6 @@ pub struct Occluders {
     ta: f64,
     tb: f64,
     candidates: Vec<Candidate>,
-    /// BVH polygon queries made (for statistics and tests).
-    pub gathers: u64,
 }
 
 impl Occluders {
@@ -108,7 +106,6 @@ impl Occluders {
         (ta, tb): (f64, f64),
     ) {
         self.start((tag, l), (ta, tb));
-        self.gathers += 1;
         let (ya, yb) = (camera_ray.at(ta), camera_ray.at(tb));
         let poly = swept_polygon(bvh, light, ya, yb);
         let ahead = AheadOfSegment::new(light, ya, yb);
@@ -162,10 +159,10 @@ impl Occluders {
     /// The candidates of `wide` (gathered for a stretch of the same camera ray that contains
     /// [ta, tb], towards the same light) that shadow rays from x(t), t ∈ [ta, tb], can reach:
     /// those whose reach range meets [ta, tb] and, for a directional light, that are not wholly
-    /// behind the segment (the tests of [`Occluders::gather`], without its BVH query). A superset of the
-    /// spheres those shadow rays cross, in `wide`'s order, so [`Occluders::hits`] gives exactly
-    /// what it gives after a gather of its own. Candidates of `wide` with an unbounded reach range
-    /// are all kept.
+    /// behind the segment (the tests of [`Occluders::gather`], without its BVH query). A
+    /// superset of the spheres those shadow rays cross, in `wide`'s order, so
+    /// [`Occluders::hits`] gives exactly what it gives after a gather of its own. Candidates of
+    /// `wide` with an unbounded reach range are all kept.
     pub fn narrow(
         &mut self,
         wide: &Occluders,

@@ -95,6 +95,10 @@ use glam::DVec3;
 /// errors on the honesty scenes, while at τ ≤ 0.25 it is ≥ 3.5 widths away.
 pub const COARSE_DEPTH: f64 = 0.25;
 
+/// The interval tag of the whole camera ray's occluder list (`ShadowScratch::wide`): no
+/// interval has it.
+const WHOLE_RAY: usize = usize::MAX;
+
 /// Segments per pixel and light at most; beyond it the remaining error estimate is reported as
 /// it stands (the pixel then may miss `tol`, and says so in its `err` value).
 pub const MAX_SEGMENTS: usize = 4000;
@@ -204,7 +208,7 @@ impl<'a> VolumeRenderer<'a> {
     /// The part of Q(x) that light `l` contributes at x = ray.at(t) in interval `k` (Q is
     /// linear in the lights, DESIGN.md §2): lit w·L_l(x); single-scatter α(x)·E_l(x)·T_l(x)/4π.
     /// The shadow ray tests only the candidate occluders of interval `k` (`reference::shadow`),
-    /// gathered on first use.
+    /// narrowed on first use from the list of the whole camera ray (`ShadowScratch::wide`).
     fn light_source(
         &self,
         ray: &Ray,
@@ -225,18 +229,10 @@ impl<'a> VolumeRenderer<'a> {
             sh.occluders.resize_with(k + 1, Occluders::default);
         }
         if !sh.occluders[k].covers(k, l, t) {
-            if sh.wide.covers(usize::MAX, l, t) {
-                sh.occluders[k].narrow(&sh.wide, ray, (k, l), light, (iv.t0, iv.t1));
-            } else {
-                sh.occluders[k].gather(
-                    &self.bvh,
-                    self.cutter.particles(),
-                    ray,
-                    (k, l),
-                    light,
-                    (iv.t0, iv.t1),
-                );
-            }
+            // `integrate_per_light` gathers the whole ray's list for light l before its
+            // quadrature, and every node lies in one of the ray's intervals.
+            debug_assert!(sh.wide.covers(WHOLE_RAY, l, t));
+            sh.occluders[k].narrow(&sh.wide, ray, (k, l), light, (iv.t0, iv.t1));
         }
         let shadow_ray = Ray {
             origin: x,
@@ -302,7 +298,7 @@ impl<'a> VolumeRenderer<'a> {
                 &self.bvh,
                 &self.scene.particles,
                 ray,
-                (usize::MAX, l),
+                (WHOLE_RAY, l),
                 light,
                 (first.t0, last.t1),
             );
