@@ -226,6 +226,42 @@ fn error_estimate_is_honest_where_the_far_end_of_the_ray_is_bounded() {
     }
 }
 
+/// Shadow rays through a dark roof stop where their transmittance has fallen to ε and take the
+/// middle of what is left out (`VolumeRenderer::shadow_cut`): a roof of overlapping spheres of
+/// opacity 0.99–0.999 over six random particles, lit through it by a directional light and by a
+/// point light inside the roof's gas. err must still cover the actual error.
+#[test]
+fn error_estimate_is_honest_where_shadow_rays_are_cut_under_a_dark_roof() {
+    let mut rng = Rng::new(53);
+    let mut particles = random_particles(&mut rng, 6);
+    for i in 0..36 {
+        let c = DVec3::new(
+            -2.1 + 0.84 * (i % 6) as f64 + rng.range(-0.1, 0.1),
+            1.6 + 0.5 * (i / 18) as f64,
+            -2.1 + 0.84 * ((i / 6) % 3) as f64 * 2.0 + rng.range(-0.1, 0.1),
+        );
+        let mut p = particle(c, rng.range(0.6, 0.8), rng.vec3(0.0, 1.0), 1.0);
+        p.sigma = pgt::optics::extinction::sigma_from_opacity(rng.range(0.99, 0.999), p.radius);
+        p.albedo = rng.vec3(0.0, 1.0);
+        particles.push(p);
+    }
+    let lights = vec![
+        Light::Directional {
+            direction: DVec3::new(0.1, -1.0, 0.05).normalize(),
+            irradiance: DVec3::new(1.0, 2.0, 0.5),
+        },
+        Light::Point {
+            position: DVec3::new(0.3, 1.9, 0.2),
+            intensity: DVec3::new(20.0, 10.0, 30.0),
+            falloff: Falloff::InverseSquare,
+        },
+    ];
+    for model in [models::LIT, models::SINGLE_SCATTER] {
+        let s = scene(model, particles.clone(), lights.clone(), SIZE);
+        check_honest(&format!("{} dark roof", model.name()), s, 1e-9);
+    }
+}
+
 /// The far end of a ray that the gas in front has made nearly opaque is bounded, not
 /// integrated: a row of 80 overlapping spheres along the view costs about the shadow rays of
 /// its first 20, and both give the same pixel within their estimates.

@@ -153,6 +153,14 @@ impl<'a> IntervalCutter<'a> {
     /// result). Same sums in the same canonical order; the last bits may differ from
     /// [`composite`], which divides E = S/σ first.
     ///
+    /// With `cut = Some((ε, M))` the sweep stops once the transmittance T has fallen to ε or
+    /// below (after the interval that took it there) and the rest of the ray is replaced by the
+    /// middle of its range: what lies behind contributes T·L_rest with 0 ≤ L_rest ≤ M per
+    /// channel (M ≥ `background` and every colour behind, a caller's bound), so the radiance
+    /// becomes F + T·M/2 and the transmittance T/2, each off by at most half its range
+    /// (T·M/2 and T/2, both ≤ ε·(M, 1)/2). The flag says whether that happened; an exactly
+    /// opaque stop (T = 0) is exact and is not a cut.
+    ///
     /// [`composite`]: super::emission::composite
     pub fn composite(
         &self,
@@ -160,15 +168,16 @@ impl<'a> IntervalCutter<'a> {
         (t_min, t_max): (f64, f64),
         skip: impl Fn(u32) -> bool,
         background: DVec3,
+        cut: Option<(f64, DVec3)>,
         scratch: &mut IntervalScratch,
-    ) -> Composite {
+    ) -> (Composite, bool) {
         composite_spans(
             hits,
             (t_min, t_max),
             self.particles,
             &self.ranks,
             skip,
-            background,
+            (background, cut),
             scratch,
         )
     }
@@ -240,12 +249,13 @@ fn composite_spans(
     particles: &[Particle],
     ranks: &[u32],
     skip: impl Fn(u32) -> bool,
-    background: DVec3,
+    (background, cut): (DVec3, Option<(f64, DVec3)>),
     scratch: &mut IntervalScratch,
-) -> Composite {
+) -> (Composite, bool) {
     let mut acc = Accumulator {
         radiance: DVec3::ZERO,
         transmittance: 1.0,
+        stop_at: cut.map_or(0.0, |(epsilon, _)| epsilon),
     };
     if clipped_spans(hits, range, particles, skip, &mut scratch.spans) {
         for s in &scratch.spans {
@@ -262,9 +272,24 @@ fn composite_spans(
     } else {
         composite_overlapping(particles, ranks, scratch, &mut acc);
     }
-    Composite {
-        radiance: acc.radiance + acc.transmittance * background,
-        transmittance: acc.transmittance,
+    let t = acc.transmittance;
+    // Stopped with something still visible behind: the rest is replaced by its middle. (Also
+    // where the stop came at the last interval: conservative, and within the same bound.)
+    match cut {
+        Some((epsilon, bound)) if t > 0.0 && t <= epsilon => (
+            Composite {
+                radiance: acc.radiance + t * (0.5 * bound),
+                transmittance: 0.5 * t,
+            },
+            true,
+        ),
+        _ => (
+            Composite {
+                radiance: acc.radiance + t * background,
+                transmittance: t,
+            },
+            false,
+        ),
     }
 }
 
@@ -372,17 +397,19 @@ fn composite_overlapping(
 struct Accumulator {
     radiance: DVec3,
     transmittance: f64,
+    /// Transmittance at or below which nothing more is added (0: only an opaque stop).
+    stop_at: f64,
 }
 
 impl Accumulator {
     /// Adds a homogeneous piece of finite extinction σ, σ-weighted colour S = Σσᵢ·Cᵢ and the
-    /// given length; false once nothing behind it can be seen.
+    /// given length; false once nothing more is to be added (T ≤ `stop_at`).
     #[inline]
     fn add(&mut self, sigma: f64, weighted: DVec3, length: f64) -> bool {
         let (a, e) = opacity_and_transmittance(sigma * length);
         self.radiance += (self.transmittance * a / sigma) * weighted;
         self.transmittance *= e;
-        self.transmittance > 0.0
+        self.transmittance > self.stop_at
     }
 
     /// Adds an interval as [`composite`](super::emission::composite) does (σ may be ∞).
@@ -395,7 +422,7 @@ impl Accumulator {
             self.radiance += (self.transmittance * a) * iv.emission;
             self.transmittance *= e;
         }
-        self.transmittance > 0.0
+        self.transmittance > self.stop_at
     }
 }
 
@@ -626,7 +653,7 @@ mod tests {
         let (mut fast, mut swept) = (Vec::new(), Vec::new());
         let mut s = IntervalScratch::default();
         let (mut events, mut active) = (Vec::new(), Vec::new());
-        let (mut fallbacks, mut opaque) = (0, 0);
+        let (mut fallbacks, mut opaque, mut cuts) = (0, 0, 0);
         for trial in 0..1000 {
             let n = 1 + trial % 7;
             let mut t = -1.0 + rng.next_f64();
@@ -684,16 +711,56 @@ mod tests {
             // bits (it divides by σ once instead of forming E = S/σ, and takes e^{−τ} = 1 − a).
             let background = DVec3::new(0.3, 2.0, 7.0);
             let want = crate::optics::emission::composite(&swept, background);
-            let got = cutter.composite(&hits, (0.0, 4.0), |_| false, background, &mut s);
+            let (got, was_cut) =
+                cutter.composite(&hits, (0.0, 4.0), |_| false, background, None, &mut s);
             let close = |a: f64, b: f64| (a - b).abs() <= 1e-13 * (1.0 + a.abs());
             assert!(
-                close(got.transmittance, want.transmittance)
+                !was_cut
+                    && close(got.transmittance, want.transmittance)
                     && (0..3).all(|c| close(got.radiance[c], want.radiance[c])),
                 "trial {trial}: {got:?} against {want:?}"
             );
+            // Cut where T falls to ε: within half the range of what was left out, T·M/2 for
+            // the radiance (M bounds the background and every colour) and T/2 for the
+            // transmittance, T the transmittance where it stopped.
+            let bound = ps.iter().fold(background, |m, p| m.max(p.color));
+            for epsilon in [0.5, 0.05, 1e-3] {
+                let (c, was_cut) = cutter.composite(
+                    &hits,
+                    (0.0, 4.0),
+                    |_| false,
+                    background,
+                    Some((epsilon, bound)),
+                    &mut s,
+                );
+                if !was_cut {
+                    // Never fell to ε, or fell straight to an exact 0: nothing was left out.
+                    assert_eq!(c, got, "trial {trial}");
+                    continue;
+                }
+                cuts += 1;
+                let t_stop = 2.0 * c.transmittance;
+                assert!(
+                    t_stop > 0.0 && t_stop <= epsilon,
+                    "trial {trial}: T {t_stop}"
+                );
+                let slack = 1e-12 * (1.0 + want.radiance.max_element());
+                assert!(
+                    (c.transmittance - want.transmittance).abs() <= 0.5 * t_stop + 1e-15,
+                    "trial {trial}: {c:?} against {want:?}"
+                );
+                for ch in 0..3 {
+                    assert!(
+                        (c.radiance[ch] - want.radiance[ch]).abs()
+                            <= 0.5 * t_stop * bound[ch] + slack,
+                        "trial {trial}, ε {epsilon}: {c:?} against {want:?}"
+                    );
+                }
+            }
             opaque += usize::from(want.transmittance == 0.0);
         }
         assert!(fallbacks > 150, "many trials must overlap: {fallbacks}");
+        assert!(cuts > 300, "many trials must be cut: {cuts}");
         assert!(
             opaque > 50,
             "many trials must cross the σ = ∞ particle: {opaque}"

@@ -46,7 +46,11 @@ pub trait Model: Sync + Send {
     /// in the interval's emission and albedo (true of every model of DESIGN.md §2, which are
     /// products and sums of them with non-negative weights): the renderer bounds the far end of
     /// a nearly opaque ray by this function of their largest values, and puts that bound into
-    /// err instead of integrating it (`reference::volume`, `VolumeRenderer::tail_cut`).
+    /// err instead of integrating it (`reference::volume`, `VolumeRenderer::tail_cut`). It must
+    /// also be linear in the shadow ray's radiance and transmittance together, at a fixed
+    /// irradiance (lit: w·L_l; single-scatter: α·E_l·T_l/4π), so that a shadow ray cut where
+    /// its transmittance has fallen to ε changes q_l by at most ε/2 of that bound
+    /// (`VolumeRenderer::shadow_cut`; a test in `optics::models` checks every model).
     fn light_source(
         &self,
         params: &SourceParams,

@@ -85,6 +85,39 @@ mod tests {
     }
 
     #[test]
+    fn light_parts_are_linear_in_the_shadow_rays_radiance_and_transmittance() {
+        // The renderer's shadow-ray cut (`reference::volume`) bounds q_l's error through this:
+        // q_l(λ·s₁ + μ·s₂) = λ·q_l(s₁) + μ·q_l(s₂) in (L_l, T_l) at one irradiance E_l
+        // (`Model::light_source`).
+        let p = SourceParams {
+            light_weight: 0.5,
+            emission_weight: 0.3,
+        };
+        let iv = interval();
+        let [s1, s2] = samples();
+        let s2 = LightSample {
+            irradiance: s1.irradiance,
+            ..s2
+        };
+        for m in ALL {
+            let (q1, q2) = (m.light_source(&p, &iv, &s1), m.light_source(&p, &iv, &s2));
+            for (lambda, mu) in [(0.0, 0.0), (1e-9, 0.0), (0.5, 0.25), (3.0, 1.0)] {
+                let mixed = LightSample {
+                    radiance: lambda * s1.radiance + mu * s2.radiance,
+                    transmittance: lambda * s1.transmittance + mu * s2.transmittance,
+                    irradiance: s1.irradiance,
+                };
+                let want = lambda * q1 + mu * q2;
+                let got = m.light_source(&p, &iv, &mixed);
+                assert!(
+                    (got - want).abs().max_element() <= 1e-15 * want.abs().max_element(),
+                    "{m}, λ = {lambda}, μ = {mu}: {got} against {want}"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn source_is_the_constant_part_plus_the_light_parts() {
         let p = SourceParams {
             light_weight: 0.5,
