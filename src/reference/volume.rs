@@ -595,7 +595,7 @@ pub const TAIL_SHARE: f64 = 1e-3;
 
 /// Part of each light's share of `tol` that the quadrature's shadow rays may spend by stopping
 /// where their transmittance has fallen to ε (`VolumeRenderer::shadow_cut`): ε is this part
-/// of the share over twice the bound of q_l, about 1e-8 on the 1UUN benchmark, where no shadow
+/// of the share over twice the bound of q_l, a few times 1e-8 on the 1UUN benchmark, where no shadow
 /// ray gets that dark. In a million random spheres half of the shadow rays' intervals lie
 /// behind that point.
 pub const CUT_SHARE: f64 = 1e-3;
