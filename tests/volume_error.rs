@@ -5,7 +5,7 @@
 mod volume_support;
 
 use glam::DVec3;
-use pgt::optics::{models, Falloff, Light, OpticalModel};
+use pgt::optics::{models, Falloff, Light, OpticalModel, Particle};
 use pgt::reference::volume::VolumeRenderer;
 use pgt::reference::{Integrator, RadianceEstimator, Sample};
 use pgt::scene::Scene;
@@ -168,10 +168,23 @@ fn error_estimate_is_honest_with_grazing_shadows() {
             falloff: Falloff::InverseSquare,
         },
     ];
+    check_honest_lit_models("grazing", &particles, &lights);
+}
+
+/// [`check_honest`] against a tol 1e-9 render, for the lit and the single-scatter model.
+fn check_honest_lit_models(name: &str, particles: &[Particle], lights: &[Light]) {
     for model in [models::LIT, models::SINGLE_SCATTER] {
-        let s = scene(model, particles.clone(), lights.clone(), SIZE);
-        check_honest(&format!("{} grazing", model.name()), s, 1e-9);
+        let s = scene(model, particles.to_vec(), lights.to_vec(), SIZE);
+        check_honest(&format!("{} {name}", model.name()), s, 1e-9);
     }
+}
+
+/// A sphere of gas of opacity (Θmax) `opacity` and albedo `albedo`, otherwise as [`particle`].
+fn gas(center: DVec3, radius: f64, color: DVec3, opacity: f64, albedo: DVec3) -> Particle {
+    let mut p = particle(center, radius, color, 1.0);
+    p.sigma = pgt::optics::extinction::sigma_from_opacity(opacity, radius);
+    p.albedo = albedo;
+    p
 }
 
 /// Θmax from 0.99 to 1 − 1e-6 (σ = −ln(1 − Θmax)/(2r)), overlapping, two lights.
@@ -196,7 +209,7 @@ fn error_estimate_is_honest_where_the_far_end_of_the_ray_is_bounded() {
     let mut rng = Rng::new(47);
     let particles: Vec<_> = (0..60)
         .map(|i| {
-            let mut p = particle(
+            gas(
                 DVec3::new(
                     rng.range(-0.9, 0.9),
                     rng.range(-0.9, 0.9),
@@ -204,12 +217,9 @@ fn error_estimate_is_honest_where_the_far_end_of_the_ray_is_bounded() {
                 ),
                 rng.range(0.4, 0.8),
                 rng.vec3(0.0, 1.0),
-                1.0,
-            );
-            let opacity = rng.range(0.9, 0.99);
-            p.sigma = pgt::optics::extinction::sigma_from_opacity(opacity, p.radius);
-            p.albedo = rng.vec3(0.0, 1.0);
-            p
+                rng.range(0.9, 0.99),
+                rng.vec3(0.0, 1.0),
+            )
         })
         .collect();
     let lights = vec![
@@ -220,10 +230,7 @@ fn error_estimate_is_honest_where_the_far_end_of_the_ray_is_bounded() {
         },
         two_lights()[0],
     ];
-    for model in [models::LIT, models::SINGLE_SCATTER] {
-        let s = scene(model, particles.clone(), lights.clone(), SIZE);
-        check_honest(&format!("{} deep cloud", model.name()), s, 1e-9);
-    }
+    check_honest_lit_models("deep cloud", &particles, &lights);
 }
 
 /// Shadow rays through a dark roof stop where their transmittance has fallen to ε and take the
@@ -240,10 +247,9 @@ fn error_estimate_is_honest_where_shadow_rays_are_cut_under_a_dark_roof() {
             1.6 + 0.5 * (i / 18) as f64,
             -2.1 + 0.84 * ((i / 6) % 3) as f64 * 2.0 + rng.range(-0.1, 0.1),
         );
-        let mut p = particle(c, rng.range(0.6, 0.8), rng.vec3(0.0, 1.0), 1.0);
-        p.sigma = pgt::optics::extinction::sigma_from_opacity(rng.range(0.99, 0.999), p.radius);
-        p.albedo = rng.vec3(0.0, 1.0);
-        particles.push(p);
+        let (radius, color) = (rng.range(0.6, 0.8), rng.vec3(0.0, 1.0));
+        let (opacity, albedo) = (rng.range(0.99, 0.999), rng.vec3(0.0, 1.0));
+        particles.push(gas(c, radius, color, opacity, albedo));
     }
     let lights = vec![
         Light::Directional {
@@ -256,10 +262,7 @@ fn error_estimate_is_honest_where_shadow_rays_are_cut_under_a_dark_roof() {
             falloff: Falloff::InverseSquare,
         },
     ];
-    for model in [models::LIT, models::SINGLE_SCATTER] {
-        let s = scene(model, particles.clone(), lights.clone(), SIZE);
-        check_honest(&format!("{} dark roof", model.name()), s, 1e-9);
-    }
+    check_honest_lit_models("dark roof", &particles, &lights);
 }
 
 /// The far end of a ray that the gas in front has made nearly opaque is bounded, not
