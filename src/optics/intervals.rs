@@ -97,8 +97,10 @@ struct Span {
 #[derive(Debug, Default, Clone)]
 pub struct IntervalScratch {
     spans: Vec<Span>,
-    /// Open chords of the sweep.
-    open: Vec<Open>,
+    /// The chords of the sweep, in start order, with what their sums need.
+    chords: Vec<Open>,
+    /// The open chords of the sweep: positions in `chords`, in canonical rank order.
+    open: Vec<u32>,
 }
 
 /// The particles of a scene with their canonical ranks: cuts rays into intervals.
@@ -121,6 +123,11 @@ impl<'a> IntervalCutter<'a> {
     /// The particles, in input order.
     pub fn particles(&self) -> &'a [Particle] {
         self.particles
+    }
+
+    /// The canonical rank of every particle, by index ([`canonical_ranks`]).
+    pub fn ranks(&self) -> &[u32] {
+        &self.ranks
     }
 
     /// Cuts the part (t_min, t_max) of a ray into intervals (DESIGN.md §3), given every sphere
@@ -200,11 +207,18 @@ fn cut_into_intervals(
     if clipped_spans(hits, range, particles, skip, &mut scratch.spans) {
         disjoint_intervals(&scratch.spans, particles, out);
     } else {
-        let (spans, open) = (&scratch.spans, &mut scratch.open);
-        sweep_open(spans, particles, ranks, open, |set, t0, t1| {
-            out.push(medium_of(set.iter().map(|o| o.index), particles, t0, t1));
-            true
-        });
+        let (spans, chords, open) = (&scratch.spans, &mut scratch.chords, &mut scratch.open);
+        sweep_open(
+            spans,
+            particles,
+            ranks,
+            (chords, open),
+            |chords, set, t0, t1| {
+                let set = set.iter().map(|&j| chords[j as usize].index);
+                out.push(medium_of(set, particles, t0, t1));
+                true
+            },
+        );
     }
 }
 
@@ -270,7 +284,7 @@ fn composite_spans(
             }
         }
     } else {
-        composite_overlapping(particles, ranks, scratch, &mut acc);
+        acc = composite_overlapping(particles, ranks, scratch, acc);
     }
     let t = acc.transmittance;
     // Stopped with something still visible behind: the rest is replaced by its middle. (Also
@@ -293,7 +307,7 @@ fn composite_spans(
     }
 }
 
-/// One chord open in [`sweep_open`], with what the sums of its interval need.
+/// One chord of [`sweep_open`], with what the sums of its interval need.
 #[derive(Debug, Clone, Copy)]
 struct Open {
     exit: f64,
@@ -307,90 +321,118 @@ struct Open {
 /// The general cut of `spans` sorted by start: a sweep over the chord ends, taking the next
 /// event as the earlier of the next start and the earliest end among the open chords (no list
 /// of events to sort). All ends and starts at one t are applied before the interval from t is
-/// formed and handed to `emit` (which returns false to stop), with the open chords in
-/// canonical rank order wherever that changes a sum: the chords are kept in arrival order, and
-/// sorted only when three or more are open, since sums of one or two are the same in either
-/// order (0 + a + b = 0 + b + a in IEEE arithmetic). So the intervals are those of the plain
-/// event sweep in rank order bit for bit (`sweep_intervals` in the tests), and shuffling the
-/// particles changes none of them.
+/// formed and handed to `emit` (which returns false to stop) with the table of chords and the
+/// open ones, as positions in it, in canonical rank order: a chord is inserted at its place
+/// when it opens, and leaving keeps the order, so no interval sorts. So the intervals are those
+/// of the plain event sweep in rank order bit for bit (`sweep_intervals` in the tests), and
+/// shuffling the particles changes none of them.
+///
+/// The chords' data are written to the table once, before the sweep, and the open set moves
+/// only their positions, so the sums read data stored long before. The sweep used to move
+/// whole records through a sorted open list; with that code, changes elsewhere in the crate
+/// that the lit model never runs (the single-scatter path of issue 10) made its shadow rays on
+/// 1UUN about 25 % slower, through how the compiler happened to lay out the moves and the
+/// loads after them. With the table, those builds are within a few per cent of the old one.
 fn sweep_open(
     spans: &[Span],
     particles: &[Particle],
     ranks: &[u32],
-    open: &mut Vec<Open>,
-    mut emit: impl FnMut(&[Open], f64, f64) -> bool,
+    (chords, open): (&mut Vec<Open>, &mut Vec<u32>),
+    mut emit: impl FnMut(&[Open], &[u32], f64, f64) -> bool,
 ) {
+    chords.clear();
     open.clear();
+    for s in spans {
+        let p = &particles[s.index as usize];
+        chords.push(Open {
+            exit: s.t1,
+            rank: ranks[s.index as usize],
+            index: s.index,
+            sigma: p.sigma,
+            weighted: p.sigma * p.color,
+        });
+    }
+    let chords = &chords[..];
     let Some(first) = spans.first() else {
         return;
+    };
+    let key = |j: u32| {
+        let c = &chords[j as usize];
+        (c.rank, c.index)
     };
     let mut t = first.t0;
     let mut next = 0;
     loop {
-        open.retain(|o| o.exit != t);
+        open.retain(|&j| chords[j as usize].exit != t);
         while next < spans.len() && spans[next].t0 == t {
-            let s = spans[next];
+            let j = next as u32;
+            let index = chords[next].index;
             // A particle entered twice cannot happen on a ray; ignoring it keeps the sweep total.
-            if !open.iter().any(|o| o.index == s.index) {
-                let p = &particles[s.index as usize];
-                open.push(Open {
-                    exit: s.t1,
-                    rank: ranks[s.index as usize],
-                    index: s.index,
-                    sigma: p.sigma,
-                    weighted: p.sigma * p.color,
-                });
+            if !open.iter().any(|&o| chords[o as usize].index == index) {
+                // Insertion at its place in rank order.
+                open.push(j);
+                let mut k = open.len() - 1;
+                while k > 0 && key(open[k - 1]) > key(j) {
+                    open[k] = open[k - 1];
+                    k -= 1;
+                }
+                open[k] = j;
             }
             next += 1;
         }
         // The earliest remaining event, by the same total order as the sorted starts.
         let mut t_next = spans.get(next).map_or(f64::INFINITY, |s| s.t0);
-        for o in open.iter() {
-            if o.exit.total_cmp(&t_next).is_lt() {
-                t_next = o.exit;
+        for &j in open.iter() {
+            let exit = chords[j as usize].exit;
+            if exit.total_cmp(&t_next).is_lt() {
+                t_next = exit;
             }
         }
         if open.is_empty() {
             if next >= spans.len() {
                 return;
             }
-        } else {
-            if open.len() > 2 {
-                // Insertion sort: nearly sorted from the last interval.
-                open.sort_by_key(|o| (o.rank, o.index));
-            }
-            if !emit(open, t, t_next) {
-                return;
-            }
+        } else if !emit(chords, open, t, t_next) {
+            return;
         }
         t = t_next;
     }
 }
 
 /// [`sweep_open`] over overlapping spans (`scratch.spans`), compositing each interval into
-/// `acc` as it is formed from σ = Σσᵢ and S = Σσᵢ·Cᵢ alone.
+/// `acc` as it is formed from σ = Σσᵢ and S = Σσᵢ·Cᵢ alone. The accumulator is passed and
+/// returned by value.
 fn composite_overlapping(
     particles: &[Particle],
     ranks: &[u32],
     scratch: &mut IntervalScratch,
-    acc: &mut Accumulator,
-) {
-    let (spans, open) = (&scratch.spans, &mut scratch.open);
-    sweep_open(spans, particles, ranks, open, |set, t0, t1| {
-        let mut sigma = 0.0;
-        let mut weighted = DVec3::ZERO;
-        for o in set {
-            sigma += o.sigma;
-            weighted += o.weighted;
-        }
-        if sigma.is_finite() {
-            acc.add(sigma, weighted, t1 - t0)
-        } else {
-            // A Θmax = 1 particle (σ = ∞, and then `weighted` is NaN or ∞) or Σσᵢ
-            // overflowing: the general medium.
-            acc.add_interval(medium_of(set.iter().map(|o| o.index), particles, t0, t1))
-        }
-    });
+    mut acc: Accumulator,
+) -> Accumulator {
+    let (spans, chords, open) = (&scratch.spans, &mut scratch.chords, &mut scratch.open);
+    sweep_open(
+        spans,
+        particles,
+        ranks,
+        (chords, open),
+        |chords, set, t0, t1| {
+            let mut sigma = 0.0;
+            let mut weighted = DVec3::ZERO;
+            for &j in set {
+                let c = &chords[j as usize];
+                sigma += c.sigma;
+                weighted += c.weighted;
+            }
+            if sigma.is_finite() {
+                acc.add(sigma, weighted, t1 - t0)
+            } else {
+                // A Θmax = 1 particle (σ = ∞, and then `weighted` is NaN or ∞) or Σσᵢ
+                // overflowing: the general medium.
+                let set = set.iter().map(|&j| chords[j as usize].index);
+                acc.add_interval(medium_of(set, particles, t0, t1))
+            }
+        },
+    );
+    acc
 }
 
 /// The running front-to-back composite of [`composite_spans`].
@@ -403,11 +445,14 @@ struct Accumulator {
 
 impl Accumulator {
     /// Adds a homogeneous piece of finite extinction σ, σ-weighted colour S = Σσᵢ·Cᵢ and the
-    /// given length; false once nothing more is to be added (T ≤ `stop_at`).
+    /// given length; false once nothing more is to be added (T ≤ `stop_at`). E = S·(1/σ) is
+    /// formed before the exponential, which it does not depend on: dividing after it (T·a/σ)
+    /// put the division's latency on the path from each exponential to the running sums.
     #[inline]
     fn add(&mut self, sigma: f64, weighted: DVec3, length: f64) -> bool {
+        let emission = weighted * (1.0 / sigma);
         let (a, e) = opacity_and_transmittance(sigma * length);
-        self.radiance += (self.transmittance * a / sigma) * weighted;
+        self.radiance += (self.transmittance * a) * emission;
         self.transmittance *= e;
         self.transmittance > self.stop_at
     }

@@ -14,6 +14,7 @@ pub mod model;
 pub mod models;
 pub mod particle;
 pub mod source;
+pub mod transmittance;
 
 pub use light::{Falloff, Incident, Light, LightWeight};
 pub use model::{LightNeed, Model, OpticalModel};

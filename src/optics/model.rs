@@ -21,7 +21,11 @@ pub enum LightNeed {
     /// L_l(x): the emission model along the shadow ray, the light as its background (lit).
     Radiance,
     /// E_l(x)·T_l(x): the unoccluded irradiance and the transmittance to the light
-    /// (single-scatter).
+    /// (single-scatter). The renderer then traces the transmittance alone, one sum of σᵢ·chordᵢ
+    /// per shadow ray, and leaves [`LightSample::radiance`] at zero: such a model must not read
+    /// it (a test in `optics::models` checks every model).
+    ///
+    /// [`LightSample::radiance`]: super::source::LightSample::radiance
     IrradianceTransmittance,
 }
 

@@ -12,7 +12,8 @@ pub use super::light::light_weight;
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct LightSample {
     /// L_l(x): the emission model along the shadow ray with the light's arriving irradiance as
-    /// its background (DESIGN.md §2, lit model).
+    /// its background (DESIGN.md §2, lit model). Zero where the model needs only E_l and T_l
+    /// (`LightNeed::IrradianceTransmittance`): the renderer does not trace it then.
     pub radiance: DVec3,
     /// E_l(x): the unoccluded irradiance (E, or I/d²).
     pub irradiance: DVec3,

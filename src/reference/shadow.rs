@@ -78,6 +78,12 @@ pub struct Occluders {
 }
 
 impl Occluders {
+    /// Forgets the list's key, so that it covers nothing until the next gather or narrowing:
+    /// for a buffer reused on another camera ray, whose intervals have the same tags.
+    pub fn invalidate(&mut self) {
+        self.key = None;
+    }
+
     /// Whether the list holds for the shadow rays towards light `light` from x(t) in interval
     /// `tag`.
     #[inline]

@@ -98,8 +98,10 @@ use crate::optics::kinks::shadow_tangencies;
 use crate::optics::light::Light;
 use crate::optics::model::{LightNeed, Model};
 use crate::optics::source::{surface_limit_weight, LightSample, SourceParams};
+use crate::optics::transmittance::transmittance;
 use crate::scene::Scene;
 use glam::DVec3;
+use std::cell::RefCell;
 
 /// Optical depth σ·Δt of a segment above which it starts at K15 rather than G7
 /// (`quadrature::integrate_adaptive`'s `coarse_ok`). In u = 1 − e^{−σ(t−t0)} the map t(u) has
@@ -126,17 +128,23 @@ pub struct VolumeRenderer<'a> {
     model: &'static dyn Model,
     /// Its parameters (w, a), resolved once.
     params: SourceParams,
+    /// Whether the model reads only E_l and T_l of a shadow ray
+    /// (`LightNeed::IrradianceTransmittance`): then no radiance is traced.
+    transmittance_only: bool,
     /// Per channel, the largest particle colour and albedo: with the lights, a bound of the
     /// per-light sources (`VolumeRenderer::tail_cut`). `None` where a colour, albedo or light
     /// is negative (no bound, so no tail is cut).
     source_bounds: Option<(DVec3, DVec3)>,
 }
 
-/// Per-camera-ray buffers for shadow rays (reused, so shadow rays do not allocate).
+/// Per-camera-ray buffers for shadow rays (reused, so shadow rays do not allocate; and kept
+/// per thread from one camera ray to the next, [`ShadowScratch::reset`] between them).
 #[derive(Default)]
 struct ShadowScratch {
     hits: Vec<Hit>,
     cut: IntervalScratch,
+    /// `optics::transmittance`'s buffer.
+    depths: Vec<(u32, f64)>,
     lights: Vec<LightSample>,
     rays: u64,
     /// Candidate occluders per interval of the camera ray, for the light being integrated.
@@ -151,6 +159,22 @@ struct ShadowScratch {
     was_cut: bool,
 }
 
+impl ShadowScratch {
+    /// Makes a buffer used for one camera ray ready for the next: counters and flags to their
+    /// start, and every occluder list keyed to nothing, since the next ray's intervals have
+    /// the same tags (a list left keyed would be taken for the new ray's and give it another
+    /// ray's occluders).
+    fn reset(&mut self) {
+        self.rays = 0;
+        self.was_cut = false;
+        self.shadow_cut = None;
+        self.wide.invalidate();
+        for o in &mut self.occluders {
+            o.invalidate();
+        }
+    }
+}
+
 impl<'a> VolumeRenderer<'a> {
     /// Builds the BVH and the canonical particle order for `scene`; `integrator` chooses how the
     /// per-light parts of Q are integrated (a model without them, emission, is closed-form).
@@ -161,6 +185,8 @@ impl<'a> VolumeRenderer<'a> {
             cutter: IntervalCutter::new(&scene.particles),
             integrator,
             model: scene.render.model.model(),
+            transmittance_only: scene.render.model.model().light_need()
+                == LightNeed::IrradianceTransmittance,
             params: SourceParams::new(
                 scene.render.light_weight,
                 scene.lights.len(),
@@ -190,7 +216,37 @@ impl<'a> VolumeRenderer<'a> {
         };
         sh.rays += 1;
         self.bvh.all_hits(&ray, 0.0, inc.distance, &mut sh.hits);
-        Some(self.shadow_composite(inc.distance, inc.irradiance, skip, None, sh))
+        Some(if self.transmittance_only {
+            self.shadow_transmittance(inc.distance, inc.irradiance, skip, sh)
+        } else {
+            self.shadow_composite(inc.distance, inc.irradiance, skip, None, sh)
+        })
+    }
+
+    /// What a model that reads only E_l and T_l (`LightNeed::IrradianceTransmittance`) needs
+    /// of the shadow ray of length `distance` whose hits are in `sh.hits`: the transmittance
+    /// alone, one sum and one exponential (`optics::transmittance`), with no sweep and
+    /// no cut, and the radiance left at zero (such a model must not read it; tested for every
+    /// model).
+    fn shadow_transmittance(
+        &self,
+        distance: f64,
+        irradiance: DVec3,
+        skip: impl Fn(u32) -> bool,
+        sh: &mut ShadowScratch,
+    ) -> LightSample {
+        let transmittance = transmittance(
+            &self.cutter,
+            &sh.hits,
+            (0.0, distance),
+            skip,
+            &mut sh.depths,
+        );
+        LightSample {
+            radiance: DVec3::ZERO,
+            irradiance,
+            transmittance,
+        }
     }
 
     /// The emission model along a shadow ray of length `distance` whose hits are in `sh.hits`,
@@ -268,7 +324,11 @@ impl<'a> VolumeRenderer<'a> {
         sh.rays += 1;
         sh.occluders[k].hits(t, &shadow_ray, inc.distance, &mut sh.hits);
         let cut = sh.shadow_cut;
-        let s = self.shadow_composite(inc.distance, inc.irradiance, |_| false, cut, sh);
+        let s = if self.transmittance_only {
+            self.shadow_transmittance(inc.distance, inc.irradiance, |_| false, sh)
+        } else {
+            self.shadow_composite(inc.distance, inc.irradiance, |_| false, cut, sh)
+        };
         self.model.light_source(&self.params, iv, &s)
     }
 
@@ -665,7 +725,19 @@ fn t_at(iv: &Interval, u_max: f64, u: f64) -> f64 {
 
 impl RadianceEstimator for VolumeRenderer<'_> {
     fn radiance(&self, ray: &Ray) -> Sample {
-        self.radiance_with(ray, &mut ShadowScratch::default())
+        // One set of buffers per thread instead of new ones per camera ray: a pixel of 1UUN
+        // allocated a few dozen vectors (an occluder list per interval) and grew them again.
+        thread_local! {
+            static SCRATCH: RefCell<ShadowScratch> = RefCell::default();
+        }
+        SCRATCH.with(|cell| match cell.try_borrow_mut() {
+            Ok(mut sh) => {
+                sh.reset();
+                self.radiance_with(ray, &mut sh)
+            }
+            // Re-entered on this thread (not done today): fresh buffers.
+            Err(_) => self.radiance_with(ray, &mut ShadowScratch::default()),
+        })
     }
 
     /// The adaptive integrator estimates its error (0 for the closed-form emission model); the
@@ -819,6 +891,9 @@ mod tests {
         }
     }
 
+    /// The lit model's shadow rays under a dark roof are cut, and err covers the cut;
+    /// single-scatter's are not (it traces the transmittance alone, exactly,
+    /// `VolumeRenderer::shadow_transmittance`), and its err covers the rest.
     #[test]
     fn shadow_rays_under_a_dark_roof_are_cut_and_err_covers_the_cut() {
         for model in [models::LIT, models::SINGLE_SCATTER] {
@@ -832,7 +907,11 @@ mod tests {
                 let ray = Ray::new(DVec3::new(x, y, -8.0), DVec3::Z);
                 let mut sh = ShadowScratch::default();
                 let got = r.radiance_with(&ray, &mut sh);
-                assert!(sh.was_cut, "{model} ({x}, {y}): no shadow ray was cut");
+                assert_eq!(
+                    sh.was_cut,
+                    model == models::LIT,
+                    "{model} ({x}, {y}): whether a shadow ray was cut"
+                );
                 let want = truth.radiance(&ray);
                 assert!(!got.unconverged && !want.unconverged);
                 let actual = (got.radiance - want.radiance).abs();
@@ -842,6 +921,48 @@ mod tests {
                     got.error
                 );
                 assert!(got.error.max_element() <= 1e-4 * (1.0 + 1e-9));
+            }
+        }
+    }
+
+    /// The shadow-ray buffers are kept per thread from one camera ray to the next
+    /// (`RadianceEstimator::radiance`): a camera ray gives the same bits whatever ray came
+    /// before it on the thread, as with fresh buffers. The occluder lists are keyed by interval
+    /// and light, which the next ray reuses; a list left keyed would give it the wrong
+    /// occluders.
+    #[test]
+    fn reused_shadow_buffers_change_no_bit() {
+        for model in [models::LIT, models::SINGLE_SCATTER] {
+            let scene = roof_scene(model, 1e-4);
+            let r = VolumeRenderer::new(&scene, Integrator::Adaptive);
+            let rays: Vec<Ray> = (0..24)
+                .map(|i| {
+                    let (x, y) = (-1.2 + 0.1 * i as f64, 0.9 - 0.07 * i as f64);
+                    Ray::new(DVec3::new(x, y, -8.0), DVec3::Z)
+                })
+                .collect();
+            let bits = |s: Sample| {
+                (
+                    s.radiance.to_array().map(f64::to_bits),
+                    s.error.to_array().map(f64::to_bits),
+                    s.shadow_rays,
+                )
+            };
+            let fresh: Vec<_> = rays
+                .iter()
+                .map(|ray| bits(r.radiance_with(ray, &mut ShadowScratch::default())))
+                .collect();
+            assert!(fresh.iter().filter(|f| f.2 > 0).count() > 12, "{model}");
+            // Forwards, backwards and forwards again on this thread's buffers.
+            for pass in 0..3 {
+                let order: Vec<usize> = if pass == 1 {
+                    (0..rays.len()).rev().collect()
+                } else {
+                    (0..rays.len()).collect()
+                };
+                for i in order {
+                    assert_eq!(bits(r.radiance(&rays[i])), fresh[i], "{model} ray {i}");
+                }
             }
         }
     }

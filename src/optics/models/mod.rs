@@ -138,6 +138,18 @@ mod tests {
             if m.light_need() == crate::optics::model::LightNeed::None {
                 assert_eq!(m.source(&p, &iv, &[]), whole, "{m} reads its lights");
             }
+            if m.light_need() == crate::optics::model::LightNeed::IrradianceTransmittance {
+                // The renderer does not trace the shadow rays' radiance for these models
+                // (`VolumeRenderer::shadow_composite`) and passes zero.
+                let dark = s.map(|l| LightSample {
+                    radiance: DVec3::ZERO,
+                    ..l
+                });
+                assert_eq!(m.source(&p, &iv, &dark), whole, "{m} reads L_l");
+                for (l, d) in s.iter().zip(&dark) {
+                    assert_eq!(m.light_source(&p, &iv, d), m.light_source(&p, &iv, l));
+                }
+            }
         }
     }
 }
