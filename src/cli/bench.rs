@@ -7,6 +7,7 @@
 //! | `random` | the random set of `pgt gen random` with its defaults (73,642 spheres) |
 //! | `million` | 1,000,000 random spheres (`pgt gen random --count 1000000`), emission model only |
 //! | `million-lit` | the same, lit (not in the default list: minutes on two cores) |
+//! | `1uun-scatter` | 1UUN as `1uun`, single-scatter model, two point lights: one at the centre of the particles' bounding sphere (inside the gas) and one above it (not in the default list) |
 //!
 //! Every scene is the bare-file default (DESIGN.md §1): the camera frames the bounding sphere,
 //! the thesis's two directional lights (green down, blue up), black background, Θmax = 0.5, lit
@@ -23,7 +24,8 @@ use crate::optics::model::LightNeed;
 use crate::optics::models;
 use crate::reference::{self, Integrator, RenderOptions, RenderOutput};
 use crate::scene::{
-    default_camera, thesis_lights, OpticalModel, Particle, RenderSettings, Scene, SceneLoadOptions,
+    bounding_sphere, default_camera, thesis_lights, Falloff, Light, OpticalModel, Particle,
+    RenderSettings, Scene, SceneLoadOptions,
 };
 use anyhow::Context;
 use clap::{Args, ValueEnum};
@@ -58,6 +60,9 @@ pub enum Workload {
     Million,
     /// 1,000,000 random spheres, lit.
     MillionLit,
+    /// 1UUN (or the protein-sized set), single-scatter, point lights inside and above.
+    #[value(name = "1uun-scatter")]
+    ProteinScatter,
 }
 
 /// Options of `pgt bench`.
@@ -212,18 +217,25 @@ fn max_difference(a: &RenderOutput, b: &RenderOutput) -> f64 {
 /// The scene of a workload and its name in the table.
 fn workload_scene(w: Workload, size: u32, data: &Path) -> anyhow::Result<(String, Scene)> {
     match w {
-        Workload::Protein => {
+        Workload::Protein | Workload::ProteinScatter => {
             let pdb = data.join("pdb").join("1uun_opm_oriented.pdb");
-            if pdb.is_file() {
-                Ok(("1UUN A+B".into(), protein_scene(&pdb, size)?))
+            let (name, mut scene) = if pdb.is_file() {
+                ("1UUN A+B".to_string(), protein_scene(&pdb, size)?)
             } else {
                 eprintln!(
                     "bench: {} not found; using a generated protein-sized set",
                     pdb.display()
                 );
                 let particles = protein_like();
-                Ok(("protein-like".into(), bare_scene(particles, size)))
+                ("protein-like".to_string(), bare_scene(particles, size))
+            };
+            if w == Workload::ProteinScatter {
+                scene.render.model = models::SINGLE_SCATTER;
+                scene.lights = inside_and_above(&scene.particles);
+                let short = if pdb.is_file() { "1UUN" } else { "protein" };
+                return Ok((format!("{short} scatter"), scene));
             }
+            Ok((name, scene))
         }
         Workload::Random => Ok((
             "random 73,642".into(),
@@ -237,6 +249,25 @@ fn workload_scene(w: Workload, size: u32, data: &Path) -> anyhow::Result<(String
             Ok(("random 1,000,000".into(), s))
         }
     }
+}
+
+/// The point lights of `1uun-scatter`: one at the centre c of the particles' bounding sphere
+/// (radius R), inside the gas, whose unoccluded irradiance at distance R is (0.5, 0.4, 0.3),
+/// and a white one at c + 1.5·R·ŷ with irradiance 1 at c.
+fn inside_and_above(particles: &[Particle]) -> Vec<Light> {
+    let (c, r) = bounding_sphere(particles);
+    vec![
+        Light::Point {
+            position: c,
+            intensity: DVec3::new(0.5, 0.4, 0.3) * (r * r),
+            falloff: Falloff::InverseSquare,
+        },
+        Light::Point {
+            position: c + DVec3::new(0.0, 1.5 * r, 0.0),
+            intensity: DVec3::ONE * (1.5 * r).powi(2),
+            falloff: Falloff::InverseSquare,
+        },
+    ]
 }
 
 /// 1UUN chains A and B with the bare-file defaults (DESIGN.md §1), through the scene loader.

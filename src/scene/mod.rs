@@ -7,7 +7,7 @@ mod framing;
 mod validate;
 
 pub use crate::formats::{ColorBy, IncludeSpec, ParticleRecord};
-pub use framing::{default_camera, thesis_lights};
+pub use framing::{bounding_sphere, default_camera, thesis_lights};
 // The light physics, the resolved particle and the optical models live in `optics` (the scene
 // builds on optics, never the reverse); re-exported so that `scene::Light` etc. keep working.
 pub use crate::optics::light::{Falloff, Incident, Light, LightWeight};
