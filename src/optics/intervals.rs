@@ -207,18 +207,11 @@ fn cut_into_intervals(
     if clipped_spans(hits, range, particles, skip, &mut scratch.spans) {
         disjoint_intervals(&scratch.spans, particles, out);
     } else {
-        let (spans, chords, open) = (&scratch.spans, &mut scratch.chords, &mut scratch.open);
-        sweep_open(
-            spans,
-            particles,
-            ranks,
-            (chords, open),
-            |chords, set, t0, t1| {
-                let set = set.iter().map(|&j| chords[j as usize].index);
-                out.push(medium_of(set, particles, t0, t1));
-                true
-            },
-        );
+        sweep_open(scratch, particles, ranks, |chords, set, t0, t1| {
+            let set = set.iter().map(|&j| chords[j as usize].index);
+            out.push(medium_of(set, particles, t0, t1));
+            true
+        });
     }
 }
 
@@ -318,9 +311,9 @@ struct Open {
     weighted: DVec3,
 }
 
-/// The general cut of `spans` sorted by start: a sweep over the chord ends, taking the next
-/// event as the earlier of the next start and the earliest end among the open chords (no list
-/// of events to sort). All ends and starts at one t are applied before the interval from t is
+/// The general cut of `scratch.spans` (sorted by start): a sweep over the chord ends, taking
+/// the next event as the earlier of the next start and the earliest end among the open chords
+/// (no list of events to sort). All ends and starts at one t are applied before the interval from t is
 /// formed and handed to `emit` (which returns false to stop) with the table of chords and the
 /// open ones, as positions in it, in canonical rank order: a chord is inserted at its place
 /// when it opens, and leaving keeps the order, so no interval sorts. So the intervals are those
@@ -334,12 +327,18 @@ struct Open {
 /// 1UUN about 25 % slower, through how the compiler happened to lay out the moves and the
 /// loads after them. With the table, those builds are within a few per cent of the old one.
 fn sweep_open(
-    spans: &[Span],
+    scratch: &mut IntervalScratch,
     particles: &[Particle],
     ranks: &[u32],
-    (chords, open): (&mut Vec<Open>, &mut Vec<u32>),
     mut emit: impl FnMut(&[Open], &[u32], f64, f64) -> bool,
 ) {
+    let IntervalScratch {
+        spans,
+        chords,
+        open,
+        ..
+    } = scratch;
+    let spans = &spans[..];
     chords.clear();
     open.clear();
     for s in spans {
@@ -408,30 +407,23 @@ fn composite_overlapping(
     scratch: &mut IntervalScratch,
     mut acc: Accumulator,
 ) -> Accumulator {
-    let (spans, chords, open) = (&scratch.spans, &mut scratch.chords, &mut scratch.open);
-    sweep_open(
-        spans,
-        particles,
-        ranks,
-        (chords, open),
-        |chords, set, t0, t1| {
-            let mut sigma = 0.0;
-            let mut weighted = DVec3::ZERO;
-            for &j in set {
-                let c = &chords[j as usize];
-                sigma += c.sigma;
-                weighted += c.weighted;
-            }
-            if sigma.is_finite() {
-                acc.add(sigma, weighted, t1 - t0)
-            } else {
-                // A Θmax = 1 particle (σ = ∞, and then `weighted` is NaN or ∞) or Σσᵢ
-                // overflowing: the general medium.
-                let set = set.iter().map(|&j| chords[j as usize].index);
-                acc.add_interval(medium_of(set, particles, t0, t1))
-            }
-        },
-    );
+    sweep_open(scratch, particles, ranks, |chords, set, t0, t1| {
+        let mut sigma = 0.0;
+        let mut weighted = DVec3::ZERO;
+        for &j in set {
+            let c = &chords[j as usize];
+            sigma += c.sigma;
+            weighted += c.weighted;
+        }
+        if sigma.is_finite() {
+            acc.add(sigma, weighted, t1 - t0)
+        } else {
+            // A Θmax = 1 particle (σ = ∞, and then `weighted` is NaN or ∞) or Σσᵢ
+            // overflowing: the general medium.
+            let set = set.iter().map(|&j| chords[j as usize].index);
+            acc.add_interval(medium_of(set, particles, t0, t1))
+        }
+    });
     acc
 }
 
