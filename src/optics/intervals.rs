@@ -313,19 +313,20 @@ struct Open {
 
 /// The general cut of `scratch.spans` (sorted by start): a sweep over the chord ends, taking
 /// the next event as the earlier of the next start and the earliest end among the open chords
-/// (no list of events to sort). All ends and starts at one t are applied before the interval from t is
-/// formed and handed to `emit` (which returns false to stop) with the table of chords and the
-/// open ones, as positions in it, in canonical rank order: a chord is inserted at its place
-/// when it opens, and leaving keeps the order, so no interval sorts. So the intervals are those
-/// of the plain event sweep in rank order bit for bit (`sweep_intervals` in the tests), and
-/// shuffling the particles changes none of them.
+/// (no list of events to sort). All ends and starts at one t are applied before the interval
+/// from t is formed and handed to `emit` (which returns false to stop) with the table of chords
+/// and the open ones, as positions in it, in canonical rank order: a chord is inserted at its
+/// place when it opens, and leaving keeps the order, so no interval sorts. So the intervals are
+/// those of the plain event sweep in rank order bit for bit (`sweep_intervals` in the tests),
+/// and shuffling the particles changes none of them.
 ///
 /// The chords' data are written to the table once, before the sweep, and the open set moves
 /// only their positions, so the sums read data stored long before. The sweep used to move
 /// whole records through a sorted open list; with that code, changes elsewhere in the crate
 /// that the lit model never runs (the single-scatter path of issue 10) made its shadow rays on
 /// 1UUN about 25 % slower, through how the compiler happened to lay out the moves and the
-/// loads after them. With the table, those builds are within a few per cent of the old one.
+/// loads after them. With the table, those builds come within 3–14 % of the old one
+/// (same-run comparisons on a noisy machine, issue 10).
 fn sweep_open(
     scratch: &mut IntervalScratch,
     particles: &[Particle],
