@@ -690,7 +690,7 @@ mod tests {
         };
         let (mut fast, mut swept) = (Vec::new(), Vec::new());
         let mut s = IntervalScratch::default();
-        let (mut events, mut active) = (Vec::new(), Vec::new());
+        let (mut events, mut active, mut depths) = (Vec::new(), Vec::new(), Vec::new());
         let (mut fallbacks, mut opaque, mut cuts) = (0, 0, 0);
         for trial in 0..1000 {
             let n = 1 + trial % 7;
@@ -752,6 +752,19 @@ mod tests {
             let (got, was_cut) =
                 cutter.composite(&hits, (0.0, 4.0), |_| false, background, None, &mut s);
             let close = |a: f64, b: f64| (a - b).abs() <= 1e-13 * (1.0 + a.abs());
+            // The transmittance alone, summed per particle (single-scatter's shadow rays), is
+            // the composite's up to rounding, and exactly 0 where it is.
+            let alone = crate::optics::transmittance::transmittance(
+                &cutter,
+                &hits,
+                (0.0, 4.0),
+                |_| false,
+                &mut depths,
+            );
+            assert!(
+                close(alone, want.transmittance) && (alone == 0.0) == (want.transmittance == 0.0),
+                "trial {trial}: {alone} against {want:?}"
+            );
             assert!(
                 !was_cut
                     && close(got.transmittance, want.transmittance)
