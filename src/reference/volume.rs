@@ -422,7 +422,12 @@ impl<'a> VolumeRenderer<'a> {
             };
             // Shadow rays through dense gas stop where their transmittance falls to ε; what
             // that can change is bounded below, if it happened.
-            let cut = self.shadow_cut(ray, first.t0, light, CUT_SHARE * share);
+            // (Single-scatter's shadow rays trace the transmittance alone and are never cut.)
+            let cut = if self.transmittance_only {
+                None
+            } else {
+                self.shadow_cut(ray, first.t0, light, CUT_SHARE * share)
+            };
             sh.shadow_cut = cut.map(|(epsilon, bound, _)| (epsilon, bound));
             sh.was_cut = false;
             let tol = share * (1.0 - 0.5 * TAIL_SHARE - CUT_SHARE);
@@ -860,13 +865,9 @@ mod tests {
     use crate::optics::{models, OpticalModel, Particle};
     use crate::scene::{LightWeight, RenderMode, RenderSettings};
 
-    /// One sphere under a roof of 3×3×3 overlapping spheres of opacity 0.999 (optical depth 6.9
-    /// through a centre), lit from straight above: every shadow ray from the sphere crosses
-    /// three layers of the roof, most of them near a centre, and its transmittance falls far
-    /// below the cut's ε at tol 1e-4 (about 2.5e-8); near the gaps between the columns it
-    /// does not, so the cut comes and goes along each camera ray.
-    fn roof_scene(model: OpticalModel, tol: f64) -> Scene {
-        let sphere = |center: DVec3, radius: f64, color: DVec3, opacity: f64| Particle {
+    /// A gas sphere of the given opacity Θmax, its albedo its colour.
+    fn sphere(center: DVec3, radius: f64, color: DVec3, opacity: f64) -> Particle {
+        Particle {
             center,
             radius,
             color,
@@ -874,7 +875,15 @@ mod tests {
             albedo: color,
             ks: 0.0,
             shininess: 32.0,
-        };
+        }
+    }
+
+    /// One sphere under a roof of 3×3×3 overlapping spheres of opacity 0.999 (optical depth 6.9
+    /// through a centre), lit from straight above: every shadow ray from the sphere crosses
+    /// three layers of the roof, most of them near a centre, and its transmittance falls far
+    /// below the cut's ε at tol 1e-4 (about 2.5e-8); near the gaps between the columns it
+    /// does not, so the cut comes and goes along each camera ray.
+    fn roof_scene(model: OpticalModel, tol: f64) -> Scene {
         let mut particles = vec![sphere(DVec3::ZERO, 1.0, DVec3::new(0.9, 0.6, 0.3), 0.5)];
         for i in 0..27 {
             let c = DVec3::new((i % 3) as f64, 3.0 + (i / 9) as f64, ((i / 3) % 3) as f64);
@@ -994,15 +1003,7 @@ mod tests {
     /// hold the light's closest approach t* with the graded mesh t* ± h·3ᵏ around it.
     #[test]
     fn rays_passing_close_to_a_point_light_inside_gas_are_honest() {
-        let gas = |center: DVec3, color: DVec3| Particle {
-            center,
-            radius: 1.0,
-            color,
-            sigma: crate::optics::extinction::sigma_from_opacity(0.9, 1.0),
-            albedo: color,
-            ks: 0.0,
-            shininess: 32.0,
-        };
+        let gas = |center: DVec3, color: DVec3| sphere(center, 1.0, color, 0.9);
         for model in [models::LIT, models::SINGLE_SCATTER] {
             let scene = |tol: f64| {
                 let mut s = roof_scene(model, tol);
