@@ -93,7 +93,8 @@ struct Span {
     index: u32,
 }
 
-/// Reusable buffers of [`IntervalCutter::cut`], so that shadow rays do not allocate.
+/// Reusable buffers of [`IntervalCutter::cut`] and [`IntervalCutter::composite`], so that
+/// shadow rays do not allocate; they also keep the [`Layout`] of the last composite.
 #[derive(Debug, Default, Clone)]
 pub struct IntervalScratch {
     spans: Vec<Span>,
@@ -101,6 +102,28 @@ pub struct IntervalScratch {
     chords: Vec<Open>,
     /// The open chords of the sweep: positions in `chords`, in canonical rank order.
     open: Vec<u32>,
+    /// The particles of the current composite's clipped chords, in the order of its hits.
+    members: Vec<u32>,
+    /// Their clipped ends: `ends[2m]` where member m starts, `ends[2m + 1]` where it ends.
+    ends: Vec<f64>,
+    /// The layouts of recent composites, the most recently used first ([`LAYOUTS`] at most).
+    layouts: Vec<Layout>,
+    layout_work: LayoutWork,
+}
+
+/// How many [`Layout`]s an [`IntervalScratch`] keeps: the nodes of a quadrature segment
+/// alternate between its two halves, so a segment in which two chord ends cross asks for two
+/// layouts in turn.
+const LAYOUTS: usize = 4;
+
+impl IntervalScratch {
+    /// Forgets the kept [`Layout`]: for buffers that move on to another scene (the layout is
+    /// keyed by particle indices, which mean other particles there).
+    pub fn forget(&mut self) {
+        for layout in &mut self.layouts {
+            layout.valid = false;
+        }
+    }
 }
 
 /// The particles of a scene with their canonical ranks: cuts rays into intervals.
@@ -245,43 +268,84 @@ fn clipped_spans(
 }
 
 /// `IntervalCutter::composite`: the emission model (DESIGN.md §2) along the chords of `hits`
-/// in (t_min, t_max), in one sweep with no intervals built. Per interval it needs only
-/// σ = Σσᵢ and S = Σσᵢ·Cᵢ (summed in canonical order, as [`medium_of`]), and adds
-/// T·(1 − e^{−σΔ})/σ·S, which is T·(1 − e^{−σΔ})·E of [`composite`](super::emission::composite)
-/// without the divisions of E and α; a set with a Θmax = 1 particle or an overflowing Σσᵢ
-/// takes [`medium_of`] as the general cut does.
+/// in (t_min, t_max), with no intervals built. Per interval it needs only σ = Σσᵢ and
+/// E = S·(1/σ), S = Σσᵢ·Cᵢ (summed in canonical order, as [`medium_of`]), and adds
+/// T·(1 − e^{−σΔ})·E as [`composite`](super::emission::composite) does without forming the
+/// albedo. The order of the chord ends, and with it every interval's particles, σ and E, is
+/// kept between calls as a [`Layout`]; a shadow ray whose ends come in the same order (the
+/// next node of a quadrature segment, nearly always) only checks that order and takes each
+/// interval's length from its own ends. A set with a Θmax = 1 particle or an overflowing Σσᵢ
+/// takes [`composite_by_sweep`].
 fn composite_spans(
     hits: &[Hit],
-    range: (f64, f64),
+    (t_min, t_max): (f64, f64),
     particles: &[Particle],
     ranks: &[u32],
     skip: impl Fn(u32) -> bool,
     (background, cut): (DVec3, Option<(f64, DVec3)>),
     scratch: &mut IntervalScratch,
 ) -> (Composite, bool) {
-    let mut acc = Accumulator {
-        radiance: DVec3::ZERO,
-        transmittance: 1.0,
-        stop_at: cut.map_or(0.0, |(epsilon, _)| epsilon),
-    };
-    if clipped_spans(hits, range, particles, skip, &mut scratch.spans) {
-        for s in &scratch.spans {
-            let p = &particles[s.index as usize];
-            let more = if p.sigma.is_infinite() {
-                acc.add_interval(disjoint_interval(s, p))
-            } else {
-                acc.add(p.sigma, p.sigma * p.color, s.t1 - s.t0)
-            };
-            if !more {
+    let mut acc = Accumulator::new(cut);
+    let IntervalScratch {
+        members,
+        ends,
+        layouts,
+        layout_work,
+        ..
+    } = &mut *scratch;
+    members.clear();
+    ends.clear();
+    for h in hits {
+        let p = &particles[h.index as usize];
+        if !(p.sigma > 0.0) || skip(h.index) {
+            continue;
+        }
+        let t0 = h.chord.t_enter.max(t_min);
+        let t1 = h.chord.t_exit.min(t_max);
+        if t1 > t0 {
+            members.push(h.index);
+            ends.extend([t0, t1]);
+        }
+    }
+    match layouts
+        .iter()
+        .position(|l| l.fits(particles, members, ends))
+    {
+        Some(0) => {}
+        Some(i) => layouts[..=i].rotate_right(1),
+        None => {
+            // A layout of the same chords in another order: its order is nearly this one.
+            let seed = layouts
+                .iter()
+                .position(|l| l.same_members(particles, members));
+            layout_work.seed(seed.map(|i| &layouts[i]), ends);
+            if layouts.len() < LAYOUTS {
+                layouts.push(Layout::default());
+            }
+            layouts.rotate_right(1);
+            layouts[0].build(particles, ranks, members, layout_work);
+        }
+    }
+    let layout = &layouts[0];
+    if layout.general {
+        acc = composite_by_sweep(hits, (t_min, t_max), particles, ranks, &skip, scratch, acc);
+    } else {
+        for iv in &layout.intervals {
+            let length = ends[iv.to as usize] - ends[iv.from as usize];
+            if !acc.add_emission(iv.sigma, iv.emission, length) {
                 break;
             }
         }
-    } else {
-        acc = composite_overlapping(particles, ranks, scratch, acc);
     }
+    finish(acc, background, cut)
+}
+
+/// The end of [`composite_spans`]: the background behind what was composited, or, where the
+/// composite stopped with something still visible behind, the middle of what the rest could
+/// add (also where the stop came at the last interval: conservative, and within the same
+/// bound); whether it stopped so.
+fn finish(acc: Accumulator, background: DVec3, cut: Option<(f64, DVec3)>) -> (Composite, bool) {
     let t = acc.transmittance;
-    // Stopped with something still visible behind: the rest is replaced by its middle. (Also
-    // where the stop came at the last interval: conservative, and within the same bound.)
     match cut {
         Some((epsilon, bound)) if t > 0.0 && t <= epsilon => (
             Composite {
@@ -297,6 +361,242 @@ fn composite_spans(
             },
             false,
         ),
+    }
+}
+
+/// The composite of [`composite_spans`] by the sweep over the chord ends itself
+/// ([`sweep_open`], or in order where no two chords overlap), for any σ: the general path, and
+/// the oracle of [`Layout`] in the tests.
+fn composite_by_sweep(
+    hits: &[Hit],
+    range: (f64, f64),
+    particles: &[Particle],
+    ranks: &[u32],
+    skip: impl Fn(u32) -> bool,
+    scratch: &mut IntervalScratch,
+    mut acc: Accumulator,
+) -> Accumulator {
+    if clipped_spans(hits, range, particles, skip, &mut scratch.spans) {
+        for s in &scratch.spans {
+            let p = &particles[s.index as usize];
+            let more = if p.sigma.is_infinite() {
+                acc.add_interval(disjoint_interval(s, p))
+            } else {
+                acc.add(p.sigma, p.sigma * p.color, s.t1 - s.t0)
+            };
+            if !more {
+                break;
+            }
+        }
+        acc
+    } else {
+        composite_overlapping(particles, ranks, scratch, acc)
+    }
+}
+
+/// The order of the chord ends of a shadow ray and the intervals it makes, kept by
+/// [`composite_spans`] for the next shadow ray.
+///
+/// Shadow rays from the nodes of one quadrature segment cross the same spheres (segments end
+/// where a shadow ray grazes one, `optics::kinks`), and their chord ends nearly always come in
+/// the same order. The sweep over those ends ([`sweep_open`]: the open set, its canonical order,
+/// the sums σ = Σσᵢ and S = Σσᵢ·Cᵢ) depends on nothing but that order, so it is done once and
+/// the next ray only checks that its ends are in it. On 1UUN lit that was most of the shadow
+/// ray's cost outside the exponentials (issue 10).
+///
+/// **Same bits.** A layout holds for a ray with the same members (particle indices, in the
+/// order of its hits) whose ends, taken in the layout's `order`, are equal (`==`) within each
+/// group and strictly increasing from group to group: then the sweep would open and close the
+/// same chords at the same events and form the same intervals with the same sums, and each
+/// interval's length is the difference of the same two end values (the sweep's t is the
+/// first of its group in `f64::total_cmp` order, as here). A test compares the bits with
+/// [`composite_by_sweep`] on reused and fresh layouts.
+#[derive(Debug, Default, Clone)]
+struct Layout {
+    /// Whether the layout was built (and not forgotten).
+    valid: bool,
+    /// The particle slice it was built for (address and length): a guard against reuse with
+    /// another scene's particles that `IntervalScratch::forget` did not catch.
+    scene: (usize, usize),
+    members: Vec<u32>,
+    /// Positions in the ends (2m: start of member m, 2m + 1: its end), sorted by value.
+    order: Vec<u32>,
+    /// `new_group[k]`: whether `order[k]` starts a new group (a larger value than `order[k − 1]`).
+    new_group: Vec<bool>,
+    intervals: Vec<LayoutInterval>,
+    /// Some interval's Σσᵢ is not finite (a Θmax = 1 particle, or an overflow): the general
+    /// sweep instead of the intervals.
+    general: bool,
+}
+
+/// Buffers of [`Layout::build`].
+#[derive(Debug, Default, Clone)]
+struct LayoutWork {
+    /// (canonical key: rank, then index; member position), sorted.
+    by_key: Vec<(u64, u32)>,
+    /// The mask bit of each member.
+    bit: Vec<u64>,
+    /// σᵢ and σᵢ·Cᵢ of the members in canonical order.
+    terms: Vec<(f64, DVec3)>,
+    /// (end value, end position), sorted.
+    sorted: Vec<(f64, u32)>,
+}
+
+impl LayoutWork {
+    /// Sorts `ends` into `sorted` by value (`total_cmp`), then position (a total order):
+    /// starting from the order of `seed` (a layout of the same chords, whose order is nearly
+    /// this one) by insertion, or from scratch.
+    fn seed(&mut self, seed: Option<&Layout>, ends: &[f64]) {
+        let less = |a: &(f64, u32), b: &(f64, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).is_lt();
+        self.sorted.clear();
+        match seed {
+            Some(layout) => {
+                self.sorted
+                    .extend(layout.order.iter().map(|&e| (ends[e as usize], e)));
+                for i in 1..self.sorted.len() {
+                    let x = self.sorted[i];
+                    let mut j = i;
+                    while j > 0 && less(&x, &self.sorted[j - 1]) {
+                        self.sorted[j] = self.sorted[j - 1];
+                        j -= 1;
+                    }
+                    self.sorted[j] = x;
+                }
+            }
+            None => {
+                self.sorted
+                    .extend(ends.iter().enumerate().map(|(e, &t)| (t, e as u32)));
+                self.sorted
+                    .sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            }
+        }
+    }
+}
+
+/// One interval of a [`Layout`]: from the end at `from` to the end at `to` (positions in the
+/// ends), with σ = Σσᵢ and E = S·(1/σ) of its particles.
+#[derive(Debug, Clone, Copy)]
+struct LayoutInterval {
+    from: u32,
+    to: u32,
+    sigma: f64,
+    emission: DVec3,
+}
+
+impl Layout {
+    /// Whether the layout holds for a ray with these `members` and `ends` (type docs).
+    fn fits(&self, particles: &[Particle], members: &[u32], ends: &[f64]) -> bool {
+        if !self.same_members(particles, members) {
+            return false;
+        }
+        // No ends (no chords), or more chords than `build` lays out: nothing to check.
+        let Some(&first) = self.order.first() else {
+            return true;
+        };
+        let mut previous = ends[first as usize];
+        for (&j, &new_group) in self.order[1..].iter().zip(&self.new_group[1..]) {
+            let t = ends[j as usize];
+            let in_order = if new_group {
+                previous < t
+            } else {
+                previous == t
+            };
+            if !in_order {
+                return false;
+            }
+            previous = t;
+        }
+        true
+    }
+
+    /// Whether the layout was built for these particles and members (in any order of ends).
+    fn same_members(&self, particles: &[Particle], members: &[u32]) -> bool {
+        self.valid
+            && self.scene == (particles.as_ptr() as usize, particles.len())
+            && self.members == members
+    }
+
+    /// The layout of a ray with these `members` and `ends`: the sweep of [`sweep_open`] over
+    /// groups of equal ends (a chord cannot start and end in one group, since t1 > t0), with
+    /// the open set as a bit mask whose bits are the members in canonical order, so that its
+    /// sums run in that order. `work` holds the ends sorted ([`LayoutWork::seed`]). More than
+    /// 64 chords, or a sum that is not finite: the general sweep.
+    fn build(
+        &mut self,
+        particles: &[Particle],
+        ranks: &[u32],
+        members: &[u32],
+        work: &mut LayoutWork,
+    ) {
+        self.valid = true;
+        self.scene = (particles.as_ptr() as usize, particles.len());
+        self.members.clear();
+        self.members.extend_from_slice(members);
+        self.order.clear();
+        self.new_group.clear();
+        self.intervals.clear();
+        self.general = members.len() > 64;
+        if self.general || members.is_empty() {
+            return;
+        }
+        // The members in canonical order (rank, then index): bit b of the mask is the b-th.
+        work.by_key.clear();
+        work.by_key
+            .extend(members.iter().enumerate().map(|(m, &index)| {
+                (
+                    (u64::from(ranks[index as usize]) << 32) | u64::from(index),
+                    m as u32,
+                )
+            }));
+        work.by_key.sort_unstable();
+        work.bit.clear();
+        work.bit.resize(members.len(), 0);
+        work.terms.clear();
+        for (b, &(_, m)) in work.by_key.iter().enumerate() {
+            work.bit[m as usize] = 1 << b;
+            let p = &particles[members[m as usize] as usize];
+            work.terms.push((p.sigma, p.sigma * p.color));
+        }
+        let sorted = &work.sorted;
+        self.order.extend(sorted.iter().map(|&(_, e)| e));
+        let mut open = 0u64;
+        let mut k = 0;
+        while k < sorted.len() {
+            let t = sorted[k].0;
+            let mut next = k;
+            while next < sorted.len() && sorted[next].0 == t {
+                self.new_group.push(next == k && k > 0);
+                let e = sorted[next].1;
+                let bit = work.bit[(e / 2) as usize];
+                if e % 2 == 1 {
+                    open &= !bit;
+                } else {
+                    open |= bit;
+                }
+                next += 1;
+            }
+            if next < sorted.len() && open != 0 {
+                let mut sigma = 0.0;
+                let mut weighted = DVec3::ZERO;
+                let mut rest = open;
+                while rest != 0 {
+                    let (s, w) = work.terms[rest.trailing_zeros() as usize];
+                    sigma += s;
+                    weighted += w;
+                    rest &= rest - 1;
+                }
+                if !sigma.is_finite() {
+                    self.general = true;
+                }
+                self.intervals.push(LayoutInterval {
+                    from: sorted[k].1,
+                    to: sorted[next].1,
+                    sigma,
+                    emission: weighted * (1.0 / sigma),
+                });
+            }
+            k = next;
+        }
     }
 }
 
@@ -326,7 +626,8 @@ struct Open {
 /// that the lit model never runs (the single-scatter path of issue 10) made its shadow rays on
 /// 1UUN about 25 % slower, through how the compiler happened to lay out the moves and the
 /// loads after them. With the table, those builds come within 3–14 % of the old one
-/// (same-run comparisons on a noisy machine, issue 10).
+/// (same-run comparisons on a noisy machine, issue 10). Shadow rays now sweep only through a
+/// [`Layout`], where it cannot be kept, and where a sum is not finite.
 fn sweep_open(
     scratch: &mut IntervalScratch,
     particles: &[Particle],
@@ -437,13 +738,27 @@ struct Accumulator {
 }
 
 impl Accumulator {
+    /// Nothing composited yet; stopping where T falls to the cut's ε, if any.
+    fn new(cut: Option<(f64, DVec3)>) -> Self {
+        Accumulator {
+            radiance: DVec3::ZERO,
+            transmittance: 1.0,
+            stop_at: cut.map_or(0.0, |(epsilon, _)| epsilon),
+        }
+    }
+
     /// Adds a homogeneous piece of finite extinction σ, σ-weighted colour S = Σσᵢ·Cᵢ and the
     /// given length; false once nothing more is to be added (T ≤ `stop_at`). E = S·(1/σ) is
     /// formed before the exponential, which it does not depend on: dividing after it (T·a/σ)
     /// put the division's latency on the path from each exponential to the running sums.
     #[inline]
     fn add(&mut self, sigma: f64, weighted: DVec3, length: f64) -> bool {
-        let emission = weighted * (1.0 / sigma);
+        self.add_emission(sigma, weighted * (1.0 / sigma), length)
+    }
+
+    /// [`Accumulator::add`] with E = S·(1/σ) formed by the caller.
+    #[inline]
+    fn add_emission(&mut self, sigma: f64, emission: DVec3, length: f64) -> bool {
         let (a, e) = opacity_and_transmittance(sigma * length);
         self.radiance += (self.transmittance * a) * emission;
         self.transmittance *= e;
@@ -815,6 +1130,125 @@ mod tests {
         assert!(
             opaque > 50,
             "many trials must cross the σ = ∞ particle: {opaque}"
+        );
+    }
+
+    /// The composite through kept layouts is the sweep's, bit for bit: on shadow rays that
+    /// follow one another as the nodes of a quadrature segment do (the same chords, ends that
+    /// move a little, so that their order sometimes changes), with ends that coincide (chords
+    /// clipped at 0, and a grid of values), a σ = ∞ particle, more than 64 chords, the stop at
+    /// ε, and hit lists that change between rays (other members, other order).
+    #[test]
+    fn kept_layouts_give_the_sweeps_composite_bit_for_bit() {
+        let mut rng = crate::formats::random::SplitMix64::new(5);
+        let mut ps: Vec<Particle> = (0..120)
+            .map(|_| {
+                let c = DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * 2.0;
+                particle(0.05 + 3.0 * rng.next_f64(), c)
+            })
+            .collect();
+        ps[7].sigma = f64::INFINITY;
+        ps[8].sigma = 0.0;
+        let cutter = IntervalCutter::new(&ps);
+        let background = DVec3::new(0.5, 1.5, 3.0);
+        let bound = ps.iter().fold(background, |m, p| m.max(p.color));
+        let bits = |(c, cut): (Composite, bool)| {
+            let r = c.radiance;
+            ([r.x, r.y, r.z, c.transmittance].map(f64::to_bits), cut)
+        };
+        let mut kept = IntervalScratch::default();
+        let (mut reused, mut seeded, mut built, mut general) = (0, 0, 0, 0);
+        for trial in 0..400 {
+            let n = match trial % 10 {
+                9 => 70, // more than a mask holds
+                k => 1 + k,
+            };
+            let first = (trial * 11) % (ps.len() - n);
+            let base: Vec<(f64, f64)> = (0..n)
+                .map(|_| {
+                    let a = -1.0 + 5.0 * rng.next_f64();
+                    let a = if rng.next_f64() < 0.3 {
+                        (a * 4.0).round() / 4.0
+                    } else {
+                        a
+                    };
+                    (a, a + 0.05 + 2.0 * rng.next_f64())
+                })
+                .collect();
+            let range = (0.0, if trial % 3 == 0 { 3.0 } else { f64::INFINITY });
+            let cut = match trial % 4 {
+                0 => Some((0.05, bound)),
+                _ => None,
+            };
+            for node in 0..8 {
+                // Small moves (nearby nodes); every ninth trial, moves large enough to reorder.
+                let scale = if trial % 9 == 0 { 0.3 } else { 0.02 };
+                let mut hits: Vec<Hit> = base
+                    .iter()
+                    .enumerate()
+                    .map(|(k, &(a, b))| {
+                        let da = scale * (rng.next_f64() - 0.5);
+                        let db = scale * (rng.next_f64() - 0.5);
+                        // Ends on the grid stay there (as a chord clipped at 0 does).
+                        let a = if a == (a * 4.0).round() / 4.0 {
+                            a
+                        } else {
+                            a + da
+                        };
+                        hit((first + k) as u32, a, b + db)
+                    })
+                    .collect();
+                if node == 5 {
+                    hits.reverse(); // the same chords as other members' order
+                }
+                let skip = |i: u32| node == 6 && i as usize == first;
+                let members: Vec<u32> = {
+                    let mut m = Vec::new();
+                    for h in &hits {
+                        let p = &ps[h.index as usize];
+                        let (t0, t1) = (h.chord.t_enter.max(range.0), h.chord.t_exit.min(range.1));
+                        if p.sigma > 0.0 && !skip(h.index) && t1 > t0 {
+                            m.push(h.index);
+                        }
+                    }
+                    m
+                };
+                let ends: Vec<f64> = hits
+                    .iter()
+                    .filter(|h| members.contains(&h.index))
+                    .flat_map(|h| [h.chord.t_enter.max(range.0), h.chord.t_exit.min(range.1)])
+                    .collect();
+                if kept.layouts.iter().any(|l| l.fits(&ps, &members, &ends)) {
+                    reused += 1;
+                } else if kept.layouts.iter().any(|l| l.same_members(&ps, &members)) {
+                    seeded += 1;
+                } else {
+                    built += 1;
+                }
+                let got = cutter.composite(&hits, range, skip, background, cut, &mut kept);
+                general += usize::from(kept.layouts[0].general);
+                let mut fresh = IntervalScratch::default();
+                let acc = composite_by_sweep(
+                    &hits,
+                    range,
+                    &ps,
+                    &cutter.ranks,
+                    skip,
+                    &mut fresh,
+                    Accumulator::new(cut),
+                );
+                let want = finish(acc, background, cut);
+                assert_eq!(
+                    bits(got),
+                    bits(want),
+                    "trial {trial}, node {node}: {hits:?}"
+                );
+            }
+        }
+        // Every path was taken, many times.
+        assert!(
+            reused > 1000 && seeded > 100 && built > 300 && general > 200,
+            "reused {reused}, seeded {seeded}, built {built}, general {general}"
         );
     }
 

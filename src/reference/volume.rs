@@ -176,6 +176,9 @@ impl ShadowScratch {
         for o in &mut self.occluders {
             o.invalidate();
         }
+        // The kept layout of the shadow composite names particles by index: this may be
+        // another scene's camera ray.
+        self.cut.forget();
     }
 }
 
