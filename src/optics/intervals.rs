@@ -424,6 +424,10 @@ struct Layout {
     /// `new_group[k]`: whether `order[k]` starts a new group (a larger value than `order[k − 1]`).
     new_group: Vec<bool>,
     intervals: Vec<LayoutInterval>,
+    /// The mask bit of each member, and σᵢ, σᵢ·Cᵢ of the members in canonical order
+    /// (`LayoutWork::canonical_order`), for a later layout of the same members.
+    bit: Vec<u64>,
+    terms: Vec<(f64, DVec3)>,
     /// Some interval's Σσᵢ is not finite (a Θmax = 1 particle, or an overflow): the general
     /// sweep instead of the intervals.
     general: bool,
@@ -440,17 +444,49 @@ struct LayoutWork {
     terms: Vec<(f64, DVec3)>,
     /// (end value, end position), sorted.
     sorted: Vec<(f64, u32)>,
+    /// Whether `bit` and `terms` hold the members' already (copied from the seed).
+    canonical: bool,
 }
 
 impl LayoutWork {
+    /// The members in canonical order (rank, then index) into `bit` (bit b of the mask is the
+    /// b-th) and `terms` (σᵢ and σᵢ·Cᵢ by that order).
+    fn canonical_order(&mut self, particles: &[Particle], ranks: &[u32], members: &[u32]) {
+        self.by_key.clear();
+        self.by_key
+            .extend(members.iter().enumerate().map(|(m, &index)| {
+                (
+                    (u64::from(ranks[index as usize]) << 32) | u64::from(index),
+                    m as u32,
+                )
+            }));
+        self.by_key.sort_unstable();
+        self.bit.clear();
+        self.bit.resize(members.len(), 0);
+        self.terms.clear();
+        for (b, &(_, m)) in self.by_key.iter().enumerate() {
+            self.bit[m as usize] = 1 << b;
+            let p = &particles[members[m as usize] as usize];
+            self.terms.push((p.sigma, p.sigma * p.color));
+        }
+    }
+
     /// Sorts `ends` into `sorted` by value (`total_cmp`), then position (a total order):
     /// starting from the order of `seed` (a layout of the same chords, whose order is nearly
     /// this one) by insertion, or from scratch.
     fn seed(&mut self, seed: Option<&Layout>, ends: &[f64]) {
         let less = |a: &(f64, u32), b: &(f64, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).is_lt();
         self.sorted.clear();
+        self.canonical = false;
+        if ends.len() > 2 * 64 {
+            return; // `Layout::build` takes the general sweep
+        }
         match seed {
             Some(layout) => {
+                // The same members: the same canonical order and terms.
+                self.bit.clone_from(&layout.bit);
+                self.terms.clone_from(&layout.terms);
+                self.canonical = true;
                 self.sorted
                     .extend(layout.order.iter().map(|&e| (ends[e as usize], e)));
                 for i in 1..self.sorted.len() {
@@ -535,28 +571,17 @@ impl Layout {
         self.order.clear();
         self.new_group.clear();
         self.intervals.clear();
+        self.bit.clear();
+        self.terms.clear();
         self.general = members.len() > 64;
         if self.general || members.is_empty() {
             return;
         }
-        // The members in canonical order (rank, then index): bit b of the mask is the b-th.
-        work.by_key.clear();
-        work.by_key
-            .extend(members.iter().enumerate().map(|(m, &index)| {
-                (
-                    (u64::from(ranks[index as usize]) << 32) | u64::from(index),
-                    m as u32,
-                )
-            }));
-        work.by_key.sort_unstable();
-        work.bit.clear();
-        work.bit.resize(members.len(), 0);
-        work.terms.clear();
-        for (b, &(_, m)) in work.by_key.iter().enumerate() {
-            work.bit[m as usize] = 1 << b;
-            let p = &particles[members[m as usize] as usize];
-            work.terms.push((p.sigma, p.sigma * p.color));
+        if !work.canonical {
+            work.canonical_order(particles, ranks, members);
         }
+        self.bit.clone_from(&work.bit);
+        self.terms.clone_from(&work.terms);
         let sorted = &work.sorted;
         self.order.extend(sorted.iter().map(|&(_, e)| e));
         let mut open = 0u64;
