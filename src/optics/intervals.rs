@@ -238,6 +238,25 @@ fn cut_into_intervals(
     }
 }
 
+/// The chords of `hits` clipped to (t_min, t_max), of particles with σ > 0 not skipped, as
+/// (index, t0, t1) with t0 < t1, in the order of `hits`.
+fn clipped_chords<'a>(
+    hits: &'a [Hit],
+    (t_min, t_max): (f64, f64),
+    particles: &'a [Particle],
+    skip: impl Fn(u32) -> bool + 'a,
+) -> impl Iterator<Item = (u32, f64, f64)> + 'a {
+    hits.iter().filter_map(move |h| {
+        let p = &particles[h.index as usize];
+        if !(p.sigma > 0.0) || skip(h.index) {
+            return None;
+        }
+        let t0 = h.chord.t_enter.max(t_min);
+        let t1 = h.chord.t_exit.min(t_max);
+        (t1 > t0).then_some((h.index, t0, t1))
+    })
+}
+
 /// The chords of `hits` clipped to (t_min, t_max), of particles with σ > 0 not skipped, sorted
 /// by start into `spans`; whether no two of them overlap.
 fn clipped_spans(
@@ -248,21 +267,13 @@ fn clipped_spans(
     spans: &mut Vec<Span>,
 ) -> bool {
     spans.clear();
-    for h in hits {
-        let p = &particles[h.index as usize];
-        if !(p.sigma > 0.0) || skip(h.index) {
-            continue;
-        }
-        let t0 = h.chord.t_enter.max(t_min);
-        let t1 = h.chord.t_exit.min(t_max);
-        if t1 > t0 {
-            spans.push(Span {
-                t0,
-                t1,
-                index: h.index,
-            });
-        }
-    }
+    spans.extend(
+        clipped_chords(hits, (t_min, t_max), particles, skip).map(|(index, t0, t1)| Span {
+            t0,
+            t1,
+            index,
+        }),
+    );
     spans.sort_unstable_by(|a, b| a.t0.total_cmp(&b.t0));
     spans.windows(2).all(|w| w[0].t1 <= w[1].t0)
 }
@@ -295,17 +306,9 @@ fn composite_spans(
     } = &mut *scratch;
     members.clear();
     ends.clear();
-    for h in hits {
-        let p = &particles[h.index as usize];
-        if !(p.sigma > 0.0) || skip(h.index) {
-            continue;
-        }
-        let t0 = h.chord.t_enter.max(t_min);
-        let t1 = h.chord.t_exit.min(t_max);
-        if t1 > t0 {
-            members.push(h.index);
-            ends.extend([t0, t1]);
-        }
+    for (index, t0, t1) in clipped_chords(hits, (t_min, t_max), particles, &skip) {
+        members.push(index);
+        ends.extend([t0, t1]);
     }
     match layouts
         .iter()
@@ -988,6 +991,21 @@ mod tests {
         }
     }
 
+    /// `n` particles with colours in [0, `scale`)³ and σ in [lo, lo + span).
+    fn random_particles(
+        rng: &mut crate::formats::random::SplitMix64,
+        n: usize,
+        scale: f64,
+        (lo, span): (f64, f64),
+    ) -> Vec<Particle> {
+        (0..n)
+            .map(|_| {
+                let c = DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * scale;
+                particle(lo + span * rng.next_f64(), c)
+            })
+            .collect()
+    }
+
     fn hit(index: u32, t_enter: f64, t_exit: f64) -> Hit {
         Hit {
             index,
@@ -1016,12 +1034,7 @@ mod tests {
     #[test]
     fn the_cut_gives_the_event_sweeps_intervals_bit_for_bit() {
         let mut rng = crate::formats::random::SplitMix64::new(11);
-        let mut ps: Vec<Particle> = (0..50)
-            .map(|_| {
-                let c = DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * 3.0;
-                particle(0.1 + 7.0 * rng.next_f64(), c)
-            })
-            .collect();
+        let mut ps = random_particles(&mut rng, 50, 3.0, (0.1, 7.0));
         ps[3].sigma = f64::INFINITY;
         let cutter = IntervalCutter::new(&ps);
         let bits = |v: &[Interval]| -> Vec<[u64; 9]> {
@@ -1170,12 +1183,7 @@ mod tests {
     #[test]
     fn kept_layouts_give_the_sweeps_composite_bit_for_bit() {
         let mut rng = crate::formats::random::SplitMix64::new(5);
-        let mut ps: Vec<Particle> = (0..120)
-            .map(|_| {
-                let c = DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * 2.0;
-                particle(0.05 + 3.0 * rng.next_f64(), c)
-            })
-            .collect();
+        let mut ps = random_particles(&mut rng, 120, 2.0, (0.05, 3.0));
         ps[7].sigma = f64::INFINITY;
         ps[8].sigma = 0.0;
         let cutter = IntervalCutter::new(&ps);
