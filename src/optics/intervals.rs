@@ -116,6 +116,9 @@ pub struct IntervalScratch {
 /// layouts in turn.
 const LAYOUTS: usize = 4;
 
+/// The most chords a [`Layout`] holds: its open set is a 64-bit mask.
+const LAYOUT_CHORDS: usize = 64;
+
 impl IntervalScratch {
     /// Forgets the kept [`Layout`]: for buffers that move on to another scene (the layout is
     /// keyed by particle indices, which mean other particles there).
@@ -310,6 +313,12 @@ fn composite_spans(
         members.push(index);
         ends.extend([t0, t1]);
     }
+    if members.len() > LAYOUT_CHORDS {
+        // More chords than a layout's mask holds (77 % of the shadow rays in a million random
+        // spheres): the sweep, with no layout to compare or keep.
+        let acc = composite_by_sweep(hits, (t_min, t_max), particles, ranks, &skip, scratch, acc);
+        return finish(acc, background, cut);
+    }
     match layouts
         .iter()
         .position(|l| l.fits(particles, members, ends))
@@ -485,9 +494,6 @@ impl LayoutWork {
         let less = |a: &(f64, u32), b: &(f64, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).is_lt();
         self.sorted.clear();
         self.canonical = false;
-        if ends.len() > 2 * 64 {
-            return; // `Layout::build` takes the general sweep
-        }
         match seed {
             Some(layout) => {
                 // The same members: the same canonical order and terms.
@@ -532,7 +538,7 @@ impl Layout {
         if !self.same_members(particles, members) {
             return false;
         }
-        // No ends (no chords), or more chords than `build` lays out: nothing to check.
+        // No ends (no chords): nothing to check.
         let Some(&first) = self.order.first() else {
             return true;
         };
@@ -562,8 +568,8 @@ impl Layout {
     /// The layout of a ray with these `members` and `ends`: the sweep of [`sweep_open`] over
     /// groups of equal ends (a chord cannot start and end in one group, since t1 > t0), with
     /// the open set as a bit mask whose bits are the members in canonical order, so that its
-    /// sums run in that order. `work` holds the ends sorted ([`LayoutWork::seed`]). More than
-    /// 64 chords, or a sum that is not finite: the general sweep.
+    /// sums run in that order. `work` holds the ends sorted ([`LayoutWork::seed`]). A sum that
+    /// is not finite: the general sweep. At most [`LAYOUT_CHORDS`] members.
     fn build(
         &mut self,
         particles: &[Particle],
@@ -580,8 +586,8 @@ impl Layout {
         self.intervals.clear();
         self.bit.clear();
         self.terms.clear();
-        self.general = members.len() > 64;
-        if self.general || members.is_empty() {
+        self.general = false;
+        if members.is_empty() {
             return;
         }
         if !work.canonical {
@@ -658,8 +664,8 @@ struct Open {
 /// that the lit model never runs (the single-scatter path of issue 10) made its shadow rays on
 /// 1UUN about 25 % slower, through how the compiler happened to lay out the moves and the
 /// loads after them. With the table, those builds come within 3–14 % of the old one
-/// (same-run comparisons on a noisy machine, issue 10). Shadow rays now sweep only through a
-/// [`Layout`], where it cannot be kept, and where a sum is not finite.
+/// (same-run comparisons on a noisy machine, issue 10). Shadow rays now sweep only where no
+/// [`Layout`] can be kept (more than [`LAYOUT_CHORDS`] chords) or a sum is not finite.
 fn sweep_open(
     scratch: &mut IntervalScratch,
     particles: &[Particle],
@@ -1255,7 +1261,9 @@ mod tests {
                     .filter(|h| members.contains(&h.index))
                     .flat_map(|h| [h.chord.t_enter.max(range.0), h.chord.t_exit.min(range.1)])
                     .collect();
-                if kept.layouts.iter().any(|l| l.fits(&ps, &members, &ends)) {
+                if members.len() > LAYOUT_CHORDS {
+                    general += 1;
+                } else if kept.layouts.iter().any(|l| l.fits(&ps, &members, &ends)) {
                     reused += 1;
                 } else if kept.layouts.iter().any(|l| l.same_members(&ps, &members)) {
                     seeded += 1;
@@ -1263,7 +1271,9 @@ mod tests {
                     built += 1;
                 }
                 let got = cutter.composite(&hits, range, skip, background, cut, &mut kept);
-                general += usize::from(kept.layouts[0].general);
+                if members.len() <= LAYOUT_CHORDS {
+                    general += usize::from(kept.layouts[0].general);
+                }
                 let mut fresh = IntervalScratch::default();
                 let acc = composite_by_sweep(
                     &hits,
