@@ -119,6 +119,11 @@ const LAYOUTS: usize = 4;
 /// The most chords a [`Layout`] holds: its open set is a 64-bit mask.
 const LAYOUT_CHORDS: usize = 64;
 
+/// How far from an interval's own place [`Layout::form_intervals`] looks for its open set
+/// among the intervals before a reorder (two ends that cross shift the intervals behind them
+/// by at most one).
+const BEFORE_REACH: usize = 2;
+
 impl IntervalScratch {
     /// Forgets the kept [`Layout`]: for buffers that move on to another scene (the layout is
     /// keyed by particle indices, which mean other particles there).
@@ -325,18 +330,23 @@ fn composite_spans(
     {
         Some(0) => {}
         Some(i) => layouts[..=i].rotate_right(1),
-        None => {
-            // A layout of the same chords in another order: its order is nearly this one.
-            let seed = layouts
-                .iter()
-                .position(|l| l.same_members(particles, members));
-            layout_work.seed(seed.map(|i| &layouts[i]), ends);
-            if layouts.len() < LAYOUTS {
-                layouts.push(Layout::default());
+        None => match layouts
+            .iter()
+            .position(|l| l.same_members(particles, members))
+        {
+            // The same chords in another order: its order is nearly this one.
+            Some(i) => {
+                layouts[..=i].rotate_right(1);
+                layouts[0].reorder(ends, layout_work);
             }
-            layouts.rotate_right(1);
-            layouts[0].build(particles, ranks, members, layout_work);
-        }
+            None => {
+                if layouts.len() < LAYOUTS {
+                    layouts.push(Layout::default());
+                }
+                layouts.rotate_right(1);
+                layouts[0].build(particles, ranks, (members, ends), layout_work);
+            }
+        },
     }
     let layout = &layouts[0];
     if layout.general {
@@ -415,10 +425,11 @@ fn composite_by_sweep(
 /// the sums σ = Σσᵢ and S = Σσᵢ·Cᵢ) depends on nothing but that order, so it is done once and
 /// the next ray only checks that its ends are in it. On 1UUN lit (128², issue 10) the sweep
 /// took about 45 % of the render's time; 71 % of the shadow rays now find a kept layout, 17 %
-/// find one of the same chords in another order (two ends crossed between nodes, and the
-/// layout is rebuilt from that order), and 12 % start a new one (mostly the first node of a
-/// segment). A layout costs more to build than one sweep, so the gain is about 10 % of the
-/// render, not 45 %.
+/// find one of the same chords in another order (two ends crossed between nodes), and 12 %
+/// start a new one (mostly the first node of a segment). A layout of the same chords is
+/// reordered in place ([`Layout::reorder`]); where just two neighbouring ends crossed (three
+/// in four such rays) only the intervals about them change ([`Layout::swap_neighbours`]). A
+/// new layout costs more than one sweep, so the gain is about 15 % of the render, not 45 %.
 ///
 /// **Same bits.** A layout holds for a ray with the same members (particle indices, in the
 /// order of its hits) whose ends, taken in the layout's `order`, are equal (`==`) within each
@@ -440,8 +451,7 @@ struct Layout {
     /// `new_group[k]`: whether `order[k]` starts a new group (a larger value than `order[k − 1]`).
     new_group: Vec<bool>,
     intervals: Vec<LayoutInterval>,
-    /// The mask bit of each member, and σᵢ, σᵢ·Cᵢ of the members in canonical order
-    /// (`LayoutWork::canonical_order`), for a later layout of the same members.
+    /// The mask bit of each member, and σᵢ, σᵢ·Cᵢ of the members in canonical order.
     bit: Vec<u64>,
     terms: Vec<(f64, DVec3)>,
     /// Some interval's Σσᵢ is not finite (a Θmax = 1 particle, or an overflow): the general
@@ -449,77 +459,24 @@ struct Layout {
     general: bool,
 }
 
-/// Buffers of [`Layout::build`].
+/// Buffers of [`Layout::build`] and [`Layout::reorder`].
 #[derive(Debug, Default, Clone)]
 struct LayoutWork {
     /// (canonical key: rank, then index; member position), sorted.
     by_key: Vec<(u64, u32)>,
-    /// The mask bit of each member.
-    bit: Vec<u64>,
-    /// σᵢ and σᵢ·Cᵢ of the members in canonical order.
-    terms: Vec<(f64, DVec3)>,
     /// (end value, end position), sorted.
     sorted: Vec<(f64, u32)>,
-    /// Whether `bit` and `terms` hold the members' already (copied from the seed).
-    canonical: bool,
+    /// The intervals of a layout before [`Layout::reorder`].
+    before: Vec<LayoutInterval>,
+    /// Reorders done by [`Layout::swap_neighbours`] (read by a test).
+    #[cfg(test)]
+    swaps: usize,
 }
 
-impl LayoutWork {
-    /// The members in canonical order (rank, then index) into `bit` (bit b of the mask is the
-    /// b-th) and `terms` (σᵢ and σᵢ·Cᵢ by that order).
-    fn canonical_order(&mut self, particles: &[Particle], ranks: &[u32], members: &[u32]) {
-        self.by_key.clear();
-        self.by_key
-            .extend(members.iter().enumerate().map(|(m, &index)| {
-                (
-                    (u64::from(ranks[index as usize]) << 32) | u64::from(index),
-                    m as u32,
-                )
-            }));
-        self.by_key.sort_unstable();
-        self.bit.clear();
-        self.bit.resize(members.len(), 0);
-        self.terms.clear();
-        for (b, &(_, m)) in self.by_key.iter().enumerate() {
-            self.bit[m as usize] = 1 << b;
-            let p = &particles[members[m as usize] as usize];
-            self.terms.push((p.sigma, p.sigma * p.color));
-        }
-    }
-
-    /// Sorts `ends` into `sorted` by value (`total_cmp`), then position (a total order):
-    /// starting from the order of `seed` (a layout of the same chords, whose order is nearly
-    /// this one) by insertion, or from scratch.
-    fn seed(&mut self, seed: Option<&Layout>, ends: &[f64]) {
-        let less = |a: &(f64, u32), b: &(f64, u32)| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).is_lt();
-        self.sorted.clear();
-        self.canonical = false;
-        match seed {
-            Some(layout) => {
-                // The same members: the same canonical order and terms.
-                self.bit.clone_from(&layout.bit);
-                self.terms.clone_from(&layout.terms);
-                self.canonical = true;
-                self.sorted
-                    .extend(layout.order.iter().map(|&e| (ends[e as usize], e)));
-                for i in 1..self.sorted.len() {
-                    let x = self.sorted[i];
-                    let mut j = i;
-                    while j > 0 && less(&x, &self.sorted[j - 1]) {
-                        self.sorted[j] = self.sorted[j - 1];
-                        j -= 1;
-                    }
-                    self.sorted[j] = x;
-                }
-            }
-            None => {
-                self.sorted
-                    .extend(ends.iter().enumerate().map(|(e, &t)| (t, e as u32)));
-                self.sorted
-                    .sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
-            }
-        }
-    }
+/// The order of [`Layout::order`]: by value (`total_cmp`), then position (a total order, so
+/// a new layout and a reordered one of the same ends agree).
+fn end_before(a: (f64, u32), b: (f64, u32)) -> bool {
+    a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)).is_lt()
 }
 
 /// One interval of a [`Layout`]: from the end at `from` to the end at `to` (positions in the
@@ -530,6 +487,10 @@ struct LayoutInterval {
     to: u32,
     sigma: f64,
     emission: DVec3,
+    /// The open set: the bits of its particles (members in canonical order).
+    mask: u64,
+    /// The place of `from` in the layout's order.
+    at: u32,
 }
 
 impl Layout {
@@ -565,47 +526,177 @@ impl Layout {
             && self.members == members
     }
 
-    /// The layout of a ray with these `members` and `ends`: the sweep of [`sweep_open`] over
-    /// groups of equal ends (a chord cannot start and end in one group, since t1 > t0), with
-    /// the open set as a bit mask whose bits are the members in canonical order, so that its
-    /// sums run in that order. `work` holds the ends sorted ([`LayoutWork::seed`]). A sum that
-    /// is not finite: the general sweep. At most [`LAYOUT_CHORDS`] members.
+    /// A new layout of a ray with these `members` and `ends`: the members' bits and terms in
+    /// canonical order (rank, then index; bit b of the mask is the b-th), the ends sorted,
+    /// and [`Layout::form_intervals`]. At most [`LAYOUT_CHORDS`] members.
     fn build(
         &mut self,
         particles: &[Particle],
         ranks: &[u32],
-        members: &[u32],
+        (members, ends): (&[u32], &[f64]),
         work: &mut LayoutWork,
     ) {
         self.valid = true;
         self.scene = (particles.as_ptr() as usize, particles.len());
         self.members.clear();
         self.members.extend_from_slice(members);
-        self.order.clear();
-        self.new_group.clear();
-        self.intervals.clear();
+        work.by_key.clear();
+        work.by_key
+            .extend(members.iter().enumerate().map(|(m, &index)| {
+                (
+                    (u64::from(ranks[index as usize]) << 32) | u64::from(index),
+                    m as u32,
+                )
+            }));
+        work.by_key.sort_unstable();
         self.bit.clear();
+        self.bit.resize(members.len(), 0);
         self.terms.clear();
+        for (b, &(_, m)) in work.by_key.iter().enumerate() {
+            self.bit[m as usize] = 1 << b;
+            let p = &particles[members[m as usize] as usize];
+            self.terms.push((p.sigma, p.sigma * p.color));
+        }
+        work.sorted.clear();
+        work.sorted
+            .extend(ends.iter().enumerate().map(|(e, &t)| (t, e as u32)));
+        work.sorted
+            .sort_unstable_by(|&a, &b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+        self.order.clear();
+        self.order.extend(work.sorted.iter().map(|&(_, e)| e));
+        self.intervals.clear();
+        self.form_intervals(ends, &[]);
+    }
+
+    /// The layout of the same members for ends that came in another order (two ends crossed
+    /// between the nodes of a quadrature segment: 17 % of the shadow rays on 1UUN lit 128²),
+    /// in place: the order re-sorted by insertion from the old one, which it nearly is, and
+    /// the intervals formed again, where an interval with the same open set as one of the
+    /// old intervals about its place takes its sums (the same terms added in the same order:
+    /// the same bits). The same layout as [`Layout::build`] would make.
+    fn reorder(&mut self, ends: &[f64], work: &mut LayoutWork) {
+        let key = |e: u32| (ends[e as usize], e);
+        // Where a single end moved back by one place: two neighbours crossed.
+        let (mut moves, mut swapped) = (0, None);
+        for i in 1..self.order.len() {
+            let x = self.order[i];
+            let mut j = i;
+            while j > 0 && end_before(key(x), key(self.order[j - 1])) {
+                self.order[j] = self.order[j - 1];
+                j -= 1;
+            }
+            self.order[j] = x;
+            if j < i {
+                moves += 1;
+                swapped = (i == j + 1).then_some(j);
+            }
+        }
+        if let (1, Some(p)) = (moves, swapped) {
+            if self.swap_neighbours(ends, p) {
+                #[cfg(test)]
+                {
+                    work.swaps += 1;
+                }
+                return;
+            }
+        }
+        std::mem::swap(&mut self.intervals, &mut work.before);
+        self.intervals.clear();
+        self.form_intervals(ends, &work.before);
+    }
+
+    /// [`Layout::reorder`] where the ends at places p and p + 1 of `order` have just been
+    /// swapped, both alone in their groups, and no group changed elsewhere: three intervals
+    /// change at most. The one that ended at p now ends at the other end; the one from p
+    /// (open set m₀ with the end now at p toggled, m₀ the open set before p) is formed anew,
+    /// or appears or goes; the one from p + 1 keeps its open set and sums and starts at the
+    /// other end. The same intervals as [`Layout::form_intervals`] would form (a test
+    /// compares them). False, with the intervals untouched, where the case is another one.
+    fn swap_neighbours(&mut self, ends: &[f64], p: usize) -> bool {
+        let (q, n) = (p + 1, self.order.len());
+        if self.general {
+            return false;
+        }
+        let value = |k: usize| ends[self.order[k] as usize];
+        for k in 1..n {
+            if (value(k) != value(k - 1)) != self.new_group[k] {
+                return false;
+            }
+        }
+        let alone = |k: usize| k == 0 || k >= n || self.new_group[k];
+        if !(alone(p) && alone(q) && alone(q + 1)) {
+            return false;
+        }
+        let (now_p, now_q) = (self.order[p], self.order[q]);
+        let toggle = |e: u32| self.bit[(e / 2) as usize];
+        // The interval that ended at p, and the open set before p.
+        let i = self.intervals.partition_point(|iv| (iv.at as usize) < p);
+        let before = match i.checked_sub(1).map(|h| &mut self.intervals[h]) {
+            Some(iv) if iv.to == now_q => {
+                iv.to = now_p;
+                iv.mask
+            }
+            _ => 0,
+        };
+        let had_middle = self.intervals.get(i).is_some_and(|iv| iv.at as usize == p);
+        if let Some(iv) = self.intervals.get_mut(i + usize::from(had_middle)) {
+            if iv.at as usize == q {
+                iv.from = now_q;
+            }
+        }
+        let open = before ^ toggle(now_p);
+        if open == 0 {
+            if had_middle {
+                self.intervals.remove(i);
+            }
+            return true;
+        }
+        let mut sigma = 0.0;
+        let mut weighted = DVec3::ZERO;
+        let mut rest = open;
+        while rest != 0 {
+            let (s, w) = self.terms[rest.trailing_zeros() as usize];
+            sigma += s;
+            weighted += w;
+            rest &= rest - 1;
+        }
+        self.general = !sigma.is_finite();
+        let middle = LayoutInterval {
+            from: now_p,
+            to: now_q,
+            sigma,
+            emission: weighted * (1.0 / sigma),
+            mask: open,
+            at: p as u32,
+        };
+        if had_middle {
+            self.intervals[i] = middle;
+        } else {
+            self.intervals.insert(i, middle);
+        }
+        true
+    }
+
+    /// The intervals of `order` (empty before): the sweep of [`sweep_open`] over groups of
+    /// equal ends (a chord cannot start and end in one group, since t1 > t0), with the open
+    /// set as a bit mask whose bits are the members in canonical order, so that its sums run
+    /// in that order; the sums of an interval are taken from one of `before` with the same
+    /// open set within [`BEFORE_REACH`] of its place, where there is one. A sum that is not
+    /// finite: the general sweep.
+    fn form_intervals(&mut self, ends: &[f64], before: &[LayoutInterval]) {
+        self.new_group.clear();
         self.general = false;
-        if members.is_empty() {
-            return;
-        }
-        if !work.canonical {
-            work.canonical_order(particles, ranks, members);
-        }
-        self.bit.clone_from(&work.bit);
-        self.terms.clone_from(&work.terms);
-        let sorted = &work.sorted;
-        self.order.extend(sorted.iter().map(|&(_, e)| e));
+        let n = self.order.len();
         let mut open = 0u64;
         let mut k = 0;
-        while k < sorted.len() {
-            let t = sorted[k].0;
+        while k < n {
+            let from = self.order[k];
+            let t = ends[from as usize];
             let mut next = k;
-            while next < sorted.len() && sorted[next].0 == t {
+            while next < n && ends[self.order[next] as usize] == t {
                 self.new_group.push(next == k && k > 0);
-                let e = sorted[next].1;
-                let bit = work.bit[(e / 2) as usize];
+                let e = self.order[next];
+                let bit = self.bit[(e / 2) as usize];
                 if e % 2 == 1 {
                     open &= !bit;
                 } else {
@@ -613,24 +704,37 @@ impl Layout {
                 }
                 next += 1;
             }
-            if next < sorted.len() && open != 0 {
-                let mut sigma = 0.0;
-                let mut weighted = DVec3::ZERO;
-                let mut rest = open;
-                while rest != 0 {
-                    let (s, w) = work.terms[rest.trailing_zeros() as usize];
-                    sigma += s;
-                    weighted += w;
-                    rest &= rest - 1;
-                }
+            if next < n && open != 0 {
+                let j = self.intervals.len();
+                let near = j.saturating_sub(BEFORE_REACH)..before.len().min(j + BEFORE_REACH + 1);
+                let kept = before
+                    .get(near)
+                    .and_then(|near| near.iter().find(|iv| iv.mask == open));
+                let (sigma, emission) = match kept {
+                    Some(iv) => (iv.sigma, iv.emission),
+                    None => {
+                        let mut sigma = 0.0;
+                        let mut weighted = DVec3::ZERO;
+                        let mut rest = open;
+                        while rest != 0 {
+                            let (s, w) = self.terms[rest.trailing_zeros() as usize];
+                            sigma += s;
+                            weighted += w;
+                            rest &= rest - 1;
+                        }
+                        (sigma, weighted * (1.0 / sigma))
+                    }
+                };
                 if !sigma.is_finite() {
                     self.general = true;
                 }
                 self.intervals.push(LayoutInterval {
-                    from: sorted[k].1,
-                    to: sorted[next].1,
+                    from,
+                    to: self.order[next],
                     sigma,
-                    emission: weighted * (1.0 / sigma),
+                    emission,
+                    mask: open,
+                    at: k as u32,
                 });
             }
             k = next;
@@ -1273,6 +1377,15 @@ mod tests {
                 let got = cutter.composite(&hits, range, skip, background, cut, &mut kept);
                 if members.len() <= LAYOUT_CHORDS {
                     general += usize::from(kept.layouts[0].general);
+                    // A kept, reordered or patched layout is the one a new build makes.
+                    let mut fresh = Layout::default();
+                    let mut work = LayoutWork::default();
+                    fresh.build(&ps, &cutter.ranks, (&members, &ends), &mut work);
+                    assert_eq!(
+                        layout_bits(&kept.layouts[0]),
+                        layout_bits(&fresh),
+                        "trial {trial}, node {node}"
+                    );
                 }
                 let mut fresh = IntervalScratch::default();
                 let acc = composite_by_sweep(
@@ -1297,6 +1410,33 @@ mod tests {
             reused > 1000 && seeded > 100 && built > 300 && general > 200,
             "reused {reused}, seeded {seeded}, built {built}, general {general}"
         );
+        let swaps = kept.layout_work.swaps;
+        assert!(
+            swaps > 50 && swaps < seeded,
+            "{swaps} of {seeded} reorders were one swap"
+        );
+    }
+
+    /// Everything of a layout that its composites read, as bits.
+    #[allow(clippy::type_complexity)]
+    fn layout_bits(
+        l: &Layout,
+    ) -> (
+        Vec<u32>,
+        Vec<bool>,
+        bool,
+        Vec<(u32, u32, u32, u64, [u64; 4])>,
+    ) {
+        let intervals = l
+            .intervals
+            .iter()
+            .map(|iv| {
+                let e = iv.emission;
+                let bits = [iv.sigma, e.x, e.y, e.z].map(f64::to_bits);
+                (iv.from, iv.to, iv.at, iv.mask, bits)
+            })
+            .collect();
+        (l.order.clone(), l.new_group.clone(), l.general, intervals)
     }
 
     #[test]

@@ -268,12 +268,19 @@ impl NestedSegment {
         } else {
             &[0, 2, 4, 6]
         };
+        // From one end of the segment to the other: consecutive shadow rays then differ least,
+        // and the interval cutter's most recent layout of chord ends (`optics::intervals`) is
+        // the one that holds, where the order ±x₁, ±x₃, … jumped across the segment and found
+        // it second (1UUN lit 128²: the first layout held for 70 % of the shadow rays, against
+        // 44 %). The values do not depend on the order.
         for &j in js {
             self.fv[2 * j] = self.node(-XGK[j], f);
-            self.fv[2 * j + 1] = self.node(XGK[j], f);
         }
         if level == 1 {
             self.fv[14] = self.node(0.0, f);
+        }
+        for &j in js.iter().rev() {
+            self.fv[2 * j + 1] = self.node(XGK[j], f);
         }
         let fc = self.fv[14];
         let pair = |j: usize| self.fv[2 * j] + self.fv[2 * j + 1];
