@@ -652,21 +652,13 @@ impl Layout {
             }
             return true;
         }
-        let mut sigma = 0.0;
-        let mut weighted = DVec3::ZERO;
-        let mut rest = open;
-        while rest != 0 {
-            let (s, w) = self.terms[rest.trailing_zeros() as usize];
-            sigma += s;
-            weighted += w;
-            rest &= rest - 1;
-        }
+        let (sigma, emission) = self.sums(open);
         self.general = !sigma.is_finite();
         let middle = LayoutInterval {
             from: now_p,
             to: now_q,
             sigma,
-            emission: weighted * (1.0 / sigma),
+            emission,
             mask: open,
             at: p as u32,
         };
@@ -676,6 +668,21 @@ impl Layout {
             self.intervals.insert(i, middle);
         }
         true
+    }
+
+    /// σ = Σσᵢ and E = S·(1/σ), S = Σσᵢ·Cᵢ, of the open set `open`, added in the order of its
+    /// bits (canonical order).
+    fn sums(&self, open: u64) -> (f64, DVec3) {
+        let mut sigma = 0.0;
+        let mut weighted = DVec3::ZERO;
+        let mut rest = open;
+        while rest != 0 {
+            let (s, w) = self.terms[rest.trailing_zeros() as usize];
+            sigma += s;
+            weighted += w;
+            rest &= rest - 1;
+        }
+        (sigma, weighted * (1.0 / sigma))
     }
 
     /// The intervals of `order` (empty before): the sweep of [`sweep_open`] over groups of
@@ -713,18 +720,7 @@ impl Layout {
                     .and_then(|near| near.iter().find(|iv| iv.mask == open));
                 let (sigma, emission) = match kept {
                     Some(iv) => (iv.sigma, iv.emission),
-                    None => {
-                        let mut sigma = 0.0;
-                        let mut weighted = DVec3::ZERO;
-                        let mut rest = open;
-                        while rest != 0 {
-                            let (s, w) = self.terms[rest.trailing_zeros() as usize];
-                            sigma += s;
-                            weighted += w;
-                            rest &= rest - 1;
-                        }
-                        (sigma, weighted * (1.0 / sigma))
-                    }
+                    None => self.sums(open),
                 };
                 if !sigma.is_finite() {
                     self.general = true;
