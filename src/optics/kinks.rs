@@ -47,25 +47,34 @@ pub fn shadow_tangencies(
     for_each_swept_leaf(bvh, &poly, |leaf| {
         for &i in leaf {
             let p = &particles[i as usize];
-            if !(p.sigma > 0.0) {
-                continue;
+            if p.sigma > 0.0 {
+                push_tangencies(ray, (t_lo, t_hi), light, (p.center, p.radius), out);
             }
-            let roots = match *light {
-                Light::Directional { direction, .. } => {
-                    cylinder_roots(ray, -direction, p.center, p.radius)
-                }
-                Light::Point { position, .. } => cone_roots(ray, position, p.center, p.radius),
-            };
-            out.extend(
-                roots
-                    .into_iter()
-                    .flatten()
-                    .filter(|&t| t > t_lo && t < t_hi),
-            );
         }
     });
     out.sort_unstable_by(f64::total_cmp);
     out.dedup();
+}
+
+/// Appends to `out` the t in (t_lo, t_hi) where the shadow ray from `ray.at(t)` towards `light`
+/// is tangent to the sphere (c, r): one sphere's part of [`shadow_tangencies`].
+pub(crate) fn push_tangencies(
+    ray: &Ray,
+    (t_lo, t_hi): (f64, f64),
+    light: &Light,
+    (c, r): (DVec3, f64),
+    out: &mut Vec<f64>,
+) {
+    let roots = match *light {
+        Light::Directional { direction, .. } => cylinder_roots(ray, -direction, c, r),
+        Light::Point { position, .. } => cone_roots(ray, position, c, r),
+    };
+    out.extend(
+        roots
+            .into_iter()
+            .flatten()
+            .filter(|&t| t > t_lo && t < t_hi),
+    );
 }
 
 /// The planar convex polygon that holds every shadow ray from a point of the segment [y0, y1]

@@ -38,7 +38,8 @@
 
 use crate::geometry::{intersect_sphere, Bvh, Hit, Ray};
 use crate::optics::kinks::{
-    axis_approach, for_each_swept_leaf, solve_quadratic, swept_polygon, AxisApproach,
+    axis_approach, for_each_swept_leaf, push_tangencies, solve_quadratic, swept_polygon,
+    AxisApproach,
 };
 use crate::optics::light::Light;
 use crate::optics::particle::Particle;
@@ -160,6 +161,35 @@ impl Occluders {
                     .then(a.index.cmp(&b.index))
             });
         }
+    }
+
+    /// The kinks of `light` along `camera_ray` in (t_lo, t_hi), as
+    /// [`shadow_tangencies`](crate::optics::kinks::shadow_tangencies) finds them with a query of
+    /// the BVH, from this list instead (gathered for a stretch of the same ray that contains
+    /// (t_lo, t_hi), towards the same light), into `out`, sorted: saves the renderer a second
+    /// traversal with the same polygon. The same values: a sphere with a tangency in the
+    /// stretch is in the list (its padded reach range holds the tangency, and it is not wholly
+    /// behind the stretch, where the tangent point lies ahead), and each sphere's roots come
+    /// from the same function; a test compares the two, bit for bit.
+    pub fn tangencies(
+        &self,
+        camera_ray: &Ray,
+        (t_lo, t_hi): (f64, f64),
+        light: &Light,
+        out: &mut Vec<f64>,
+    ) {
+        debug_assert!(
+            self.ta <= t_lo && t_hi <= self.tb,
+            "a list for another stretch"
+        );
+        if !(t_hi > t_lo) || !t_lo.is_finite() || !t_hi.is_finite() {
+            return;
+        }
+        for c in &self.candidates {
+            push_tangencies(camera_ray, (t_lo, t_hi), light, (c.center, c.radius), out);
+        }
+        out.sort_unstable_by(f64::total_cmp);
+        out.dedup();
     }
 
     /// The candidates of `wide` (gathered for a stretch of the same camera ray that contains
@@ -500,6 +530,8 @@ mod tests {
         let (mut wide, mut narrowed) = (Occluders::default(), Occluders::default());
         let (mut a, mut b, mut c) = (Vec::new(), Vec::new(), Vec::new());
         let (mut compared, mut grazing, mut narrowed_compared) = (0, 0, [0, 0]);
+        let bits = |ts: &[f64]| ts.iter().map(|t| t.to_bits()).collect::<Vec<_>>();
+        let mut tangencies_compared = 0;
         for trial in 0..200 {
             let ray = Ray::new(v(8.0) - DVec3::Z * 10.0, (v(0.3) + DVec3::Z).normalize());
             let (ta, tb) = (5.0 + v(3.0).x, 12.0 + v(3.0).x);
@@ -517,6 +549,20 @@ mod tests {
                     .collect();
                 let mut kinks = Vec::new();
                 shadow_tangencies(&ray, (ta, tb), light, &bvh, &particles, &mut kinks);
+                // The lists give the kinks that the BVH query gives, bit for bit: for their
+                // own stretch, and the wide one for its longer stretch.
+                let mut listed = Vec::new();
+                occ.tangencies(&ray, (ta, tb), light, &mut listed);
+                assert_eq!(bits(&listed), bits(&kinks), "trial {trial}, light {l}");
+                let (mut over_stretch, mut queried) = (Vec::new(), Vec::new());
+                wide.tangencies(&ray, stretch, light, &mut over_stretch);
+                shadow_tangencies(&ray, stretch, light, &bvh, &particles, &mut queried);
+                assert_eq!(
+                    bits(&over_stretch),
+                    bits(&queried),
+                    "trial {trial}, light {l}"
+                );
+                tangencies_compared += kinks.len() + queried.len();
                 for k in kinks {
                     for ulps in -3i64..=3 {
                         ts.push(f64::from_bits((k.to_bits() as i64 + ulps) as u64));
@@ -556,6 +602,10 @@ mod tests {
         }
         assert!(compared > 1000, "the rays should hit something: {compared}");
         assert!(grazing > 100, "the kinks should be tested: {grazing}");
+        assert!(
+            tangencies_compared > 200,
+            "kinks compared: {tangencies_compared}"
+        );
         assert!(
             narrowed_compared.iter().all(|&n| n > 500),
             "narrowed lists: {narrowed_compared:?}"

@@ -94,7 +94,6 @@ use super::{Integrator, RadianceEstimator, Sample};
 use crate::geometry::{Bvh, Hit, Ray};
 use crate::optics::emission::{composite_by, opacity};
 use crate::optics::intervals::{Interval, IntervalCutter, IntervalScratch};
-use crate::optics::kinks::shadow_tangencies;
 use crate::optics::light::Light;
 use crate::optics::model::{LightNeed, Model};
 use crate::optics::source::{surface_limit_weight, LightSample, SourceParams};
@@ -380,7 +379,6 @@ impl<'a> VolumeRenderer<'a> {
             let Some(last) = intervals[..kept].last() else {
                 continue;
             };
-            self.breakpoints(ray, (first.t0, last.t1), light, &mut kinks);
             sh.wide.gather(
                 &self.bvh,
                 &self.scene.particles,
@@ -389,6 +387,7 @@ impl<'a> VolumeRenderer<'a> {
                 light,
                 (first.t0, last.t1),
             );
+            self.breakpoints(ray, (first.t0, last.t1), light, &sh.wide, &mut kinks);
             // Every kink is a breakpoint from the start: a shadow that falls between the nodes
             // of a segment would otherwise go unseen by both rules, and by the error estimate.
             split.clear();
@@ -456,7 +455,9 @@ impl<'a> VolumeRenderer<'a> {
     }
 
     /// The breakpoints of light `light`'s integral along `ray` in (t_lo, t_hi), sorted, into
-    /// `out` (cleared first): its kinks (`optics::kinks`), and for a point light the point
+    /// `out` (cleared first): its kinks (`optics::kinks`, found among `occluders`, a list
+    /// gathered towards that light for a stretch of `ray` that holds (t_lo, t_hi):
+    /// [`Occluders::tangencies`]), and for a point light the point
     /// where the ray passes closest to it, t*, with a graded mesh around it. There the
     /// irradiance I/d² = I/(h² + (t − t*)²) peaks, as sharply as the ray passes close (h); as a
     /// breakpoint the peak is an end of two segments (where the rules put nodes densely) rather
@@ -466,16 +467,16 @@ impl<'a> VolumeRenderer<'a> {
     /// too: each segment then spans at most a factor 3 in distance from t*, where the Lorentzian
     /// is smooth on the segment's scale. That costs 2·log₃(L/h) segments on a ray that passes
     /// the light at h across a stretch L, and nothing where h is not below L.
-    fn breakpoints(&self, ray: &Ray, (t_lo, t_hi): (f64, f64), light: &Light, out: &mut Vec<f64>) {
+    fn breakpoints(
+        &self,
+        ray: &Ray,
+        (t_lo, t_hi): (f64, f64),
+        light: &Light,
+        occluders: &Occluders,
+        out: &mut Vec<f64>,
+    ) {
         out.clear();
-        shadow_tangencies(
-            ray,
-            (t_lo, t_hi),
-            light,
-            &self.bvh,
-            &self.scene.particles,
-            out,
-        );
+        occluders.tangencies(ray, (t_lo, t_hi), light, out);
         if let Light::Point { position, .. } = *light {
             let t = (position - ray.origin).dot(ray.direction);
             let h = (position - ray.at(t)).length();
@@ -1034,7 +1035,10 @@ mod tests {
                 let origin = DVec3::new(0.1 + h, 0.05, -8.0);
                 let ray = Ray::new(origin, DVec3::Z);
                 let mut marks = Vec::new();
-                r.breakpoints(&ray, (6.0, 10.0), &light, &mut marks);
+                let mut wide = Occluders::default();
+                let particles = &coarse.particles;
+                wide.gather(&r.bvh, particles, &ray, (0, 0), &light, (6.0, 10.0));
+                r.breakpoints(&ray, (6.0, 10.0), &light, &wide, &mut marks);
                 let t_star = 8.2;
                 let near = |x: f64| marks.iter().any(|&m| (m - x).abs() <= 1e-9 * (1.0 + x));
                 assert!(near(t_star), "{model} h {h}: {marks:?}");
