@@ -17,8 +17,10 @@
 //! The candidate spheres are those that a shadow ray from some point of the camera segment can
 //! reach: the segment swept towards the light (a parallelogram for a directional light, a
 //! triangle for a point light). The BVH is traversed with a separating-axis test of that
-//! polygon against the node boxes. The roots are only breakpoints for the quadrature: an
-//! inexact root costs refinement, never correctness.
+//! polygon against the node boxes ([`shadow_tangencies`]); the renderer, which gathers the
+//! same spheres for its shadow rays anyway, takes the roots from that list instead
+//! (`reference::shadow::Occluders::tangencies`, the same values). The roots are only
+//! breakpoints for the quadrature: an inexact root costs refinement, never correctness.
 
 // `!(a > b)` is deliberate throughout: unlike `a <= b` it is also true when a value is NaN, so
 // degenerate input takes the safe branch.
