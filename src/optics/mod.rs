@@ -6,6 +6,7 @@
 //! Depends on `geometry` only; `scene` builds on it.
 
 pub mod emission;
+pub mod exponential;
 pub mod extinction;
 pub mod intervals;
 pub mod kinks;

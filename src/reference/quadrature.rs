@@ -196,7 +196,9 @@ fn pair_estimate(resk: DVec3, resg: DVec3, resabs: DVec3, resasc: DVec3, h: f64)
     let mut relative = 0.0f64;
     for c in 0..3 {
         if resasc[c] > 0.0 && diff[c] > 0.0 {
-            error[c] = diff[c].max(resasc[c] * (200.0 * diff[c] / resasc[c]).powf(1.5).min(1.0));
+            // q^{3/2} as q·√q: one square root instead of `powf` (1 % of a lit render).
+            let q = 200.0 * diff[c] / resasc[c];
+            error[c] = diff[c].max(resasc[c] * (q * q.sqrt()).min(1.0));
             relative = relative.max(error[c] / resasc[c]);
         }
     }
