@@ -6,7 +6,7 @@ pub mod projection;
 pub mod ray;
 pub mod sphere;
 
-pub use bvh::{Bvh, BvhNode, Hit};
+pub use bvh::{Bvh, BvhNode, Hit, Leaf};
 pub use camera::Camera;
 pub use ray::Ray;
 pub use sphere::{intersect_sphere, Chord};

@@ -28,7 +28,7 @@
 
 use super::light::Light;
 use super::particle::Particle;
-use crate::geometry::{Bvh, Ray};
+use crate::geometry::{Bvh, Leaf, Ray};
 use glam::DVec3;
 
 /// Appends to `out` the ray parameters t in (t_lo, t_hi) where the shadow ray from `ray.at(t)`
@@ -47,10 +47,9 @@ pub fn shadow_tangencies(
     }
     let poly = swept_polygon(bvh, light, ray.at(t_lo), ray.at(t_hi));
     for_each_swept_leaf(bvh, &poly, |leaf| {
-        for &i in leaf {
-            let p = &particles[i as usize];
-            if p.sigma > 0.0 {
-                push_tangencies(ray, (t_lo, t_hi), light, (p.center, p.radius), out);
+        for (i, center, radius) in leaf.spheres() {
+            if particles[i as usize].sigma > 0.0 {
+                push_tangencies(ray, (t_lo, t_hi), light, (center, radius), out);
             }
         }
     });
@@ -99,7 +98,7 @@ pub(crate) fn swept_polygon(bvh: &Bvh, light: &Light, y0: DVec3, y1: DVec3) -> S
 
 /// Calls `visit` with the sphere indices of every BVH leaf whose box the polygon `poly` (from
 /// [`swept_polygon`]) may overlap (a conservative separating-axis test).
-pub(crate) fn for_each_swept_leaf(bvh: &Bvh, poly: &SweptPolygon, mut visit: impl FnMut(&[u32])) {
+pub(crate) fn for_each_swept_leaf(bvh: &Bvh, poly: &SweptPolygon, mut visit: impl FnMut(Leaf)) {
     if bvh.is_empty() {
         return;
     }
@@ -114,8 +113,7 @@ pub(crate) fn for_each_swept_leaf(bvh: &Bvh, poly: &SweptPolygon, mut visit: imp
             stack.push(node.first + 1);
             continue;
         }
-        let first = node.first as usize;
-        visit(&bvh.indices[first..first + node.count as usize]);
+        visit(bvh.leaf(node));
     }
 }
 

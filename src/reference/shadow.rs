@@ -118,30 +118,25 @@ impl Occluders {
         let ahead = AheadOfSegment::new(light, ya, yb);
         let candidates = &mut self.candidates;
         for_each_swept_leaf(bvh, &poly, |leaf| {
-            for &i in leaf {
-                let p = &particles[i as usize];
-                if !(p.sigma > 0.0) {
+            // The leaf's centres and radii (the particles', in leaf order) lie together; a
+            // particle itself is read (for σ) only once its sphere is in reach.
+            for (i, center, radius) in leaf.spheres() {
+                let (t_lo, t_hi) = reach_range(camera_ray, light, center, radius, tb);
+                if !(t_lo <= tb && t_hi >= ta) || !(particles[i as usize].sigma > 0.0) {
                     continue;
                 }
-                let (t_lo, t_hi) = reach_range(camera_ray, light, p.center, p.radius, tb);
-                if !(t_lo <= tb && t_hi >= ta) {
-                    continue;
-                }
-                let pad = padded_radius(p.center, p.radius);
+                let pad = padded_radius(center, radius);
                 // A finite reach range is the cylinder test of a directional light; with the
                 // half-space test below it is as tight as the polygon's (which is the
                 // cylinder's inside, cut at the segment) and far cheaper than its axes.
                 let near = match &ahead {
-                    Some(ahead) if t_lo.is_finite() && t_hi.is_finite() => {
-                        ahead.keeps(p.center, pad)
-                    }
-                    _ => poly
-                        .overlaps_box(p.center - DVec3::splat(pad), p.center + DVec3::splat(pad)),
+                    Some(ahead) if t_lo.is_finite() && t_hi.is_finite() => ahead.keeps(center, pad),
+                    _ => poly.overlaps_box(center - DVec3::splat(pad), center + DVec3::splat(pad)),
                 };
                 if near {
                     candidates.push(Candidate {
-                        center: p.center,
-                        radius: p.radius,
+                        center,
+                        radius,
                         index: i,
                         t_lo,
                         t_hi,
