@@ -122,7 +122,7 @@ impl Occluders {
             // particle itself is read (for σ) only once its sphere is in reach.
             for (i, center, radius) in leaf.spheres() {
                 let (t_lo, t_hi) = reach_range(camera_ray, light, center, radius, tb);
-                if !(t_lo <= tb && t_hi >= ta) || !(particles[i as usize].sigma > 0.0) {
+                if !(t_lo <= tb && t_hi >= ta && particles[i as usize].sigma > 0.0) {
                     continue;
                 }
                 let pad = padded_radius(center, radius);
