@@ -113,6 +113,12 @@ impl Bvh {
     /// children are allocated as a pair when it is split, the left subtree is finished before
     /// the right one starts), so the tree is the same for any number of threads.
     pub fn build(centers: Vec<DVec3>, radii: Vec<f64>) -> Bvh {
+        Self::build_over(centers, radii, |_| true)
+    }
+
+    /// [`Bvh::build`] over the spheres i with `keep(i)` only; indices stay positions in
+    /// `centers` and `radii`.
+    pub fn build_over(centers: Vec<DVec3>, radii: Vec<f64>, keep: impl Fn(usize) -> bool) -> Bvh {
         assert_eq!(centers.len(), radii.len());
         let n = centers.len();
         let boxes: Vec<Aabb> = centers
@@ -120,8 +126,8 @@ impl Bvh {
             .zip(&radii)
             .map(|(&c, &r)| sphere_box(c, r))
             .collect();
-        let mut indices: Vec<u32> = (0..n as u32).collect();
-        let nodes = if n == 0 {
+        let mut indices: Vec<u32> = (0..n as u32).filter(|&i| keep(i as usize)).collect();
+        let nodes = if indices.is_empty() {
             // An empty box that no ray enters.
             vec![BvhNode {
                 min: DVec3::splat(f64::INFINITY),
@@ -154,7 +160,7 @@ impl Bvh {
         }
     }
 
-    /// Number of spheres.
+    /// Number of spheres in the hierarchy.
     pub fn len(&self) -> usize {
         self.centers.len()
     }
@@ -658,6 +664,13 @@ mod tests {
                 let others = expected.iter().any(|h| h.index != skip);
                 prop_assert_eq!(bvh.any_hit(&ray, t_min, t_max, |i| i == skip), others);
             }
+            // Over every other sphere: the hits of those, with their original indices.
+            let keep = |i: usize| i % 2 == 1;
+            let subset = Bvh::build_over(centers.clone(), radii.clone(), keep);
+            prop_assert_eq!(subset.len(), centers.len() / 2);
+            subset.all_hits(&ray, t_min, t_max, &mut got);
+            let kept: Vec<Hit> = expected.into_iter().filter(|h| keep(h.index as usize)).collect();
+            prop_assert_eq!(got, kept);
         }
     }
 

@@ -124,6 +124,8 @@ pub const MAX_SEGMENTS: usize = 4000;
 /// The volume renderer of one scene (DESIGN.md §2, §3).
 pub struct VolumeRenderer<'a> {
     scene: &'a Scene,
+    /// Over the particles with σ > 0 (`Scene::build_gas_bvh`): every query of the renderer
+    /// skips the others anyway, and the occluder lists rely on it (`Occluders::gather`).
     bvh: Bvh,
     cutter: IntervalCutter<'a>,
     integrator: Integrator,
@@ -187,7 +189,7 @@ impl<'a> VolumeRenderer<'a> {
     pub fn new(scene: &'a Scene, integrator: Integrator) -> Self {
         VolumeRenderer {
             scene,
-            bvh: scene.build_bvh(),
+            bvh: scene.build_gas_bvh(),
             cutter: IntervalCutter::new(&scene.particles),
             integrator,
             model: scene.render.model.model(),
@@ -379,14 +381,8 @@ impl<'a> VolumeRenderer<'a> {
             let Some(last) = intervals[..kept].last() else {
                 continue;
             };
-            sh.wide.gather(
-                &self.bvh,
-                &self.scene.particles,
-                ray,
-                (WHOLE_RAY, l),
-                light,
-                (first.t0, last.t1),
-            );
+            sh.wide
+                .gather(&self.bvh, ray, (WHOLE_RAY, l), light, (first.t0, last.t1));
             self.breakpoints(ray, (first.t0, last.t1), light, &sh.wide, &mut kinks);
             // Every kink is a breakpoint from the start: a shadow that falls between the nodes
             // of a segment would otherwise go unseen by both rules, and by the error estimate.
@@ -1036,8 +1032,7 @@ mod tests {
                 let ray = Ray::new(origin, DVec3::Z);
                 let mut marks = Vec::new();
                 let mut wide = Occluders::default();
-                let particles = &coarse.particles;
-                wide.gather(&r.bvh, particles, &ray, (0, 0), &light, (6.0, 10.0));
+                wide.gather(&r.bvh, &ray, (0, 0), &light, (6.0, 10.0));
                 r.breakpoints(&ray, (6.0, 10.0), &light, &wide, &mut marks);
                 let t_star = 8.2;
                 let near = |x: f64| marks.iter().any(|&m| (m - x).abs() <= 1e-9 * (1.0 + x));

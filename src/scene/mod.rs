@@ -136,4 +136,14 @@ impl Scene {
             self.particles.iter().map(|p| p.radius).collect(),
         )
     }
+
+    /// A BVH over the particles with σ > 0 (indices are positions in `particles`): all that
+    /// the volume reference sees, since a particle with σ = 0 neither absorbs nor emits.
+    pub fn build_gas_bvh(&self) -> crate::geometry::Bvh {
+        crate::geometry::Bvh::build_over(
+            self.particles.iter().map(|p| p.center).collect(),
+            self.particles.iter().map(|p| p.radius).collect(),
+            |i| self.particles[i].sigma > 0.0,
+        )
+    }
 }
