@@ -16,7 +16,9 @@
 //! ray grazes a sphere, see `optics::kinks`) are integrated with an endpoint-smoothing
 //! substitution ([`gauss_kronrod_15_smoothed`]) and their estimate is multiplied by
 //! [`KINK_SAFETY`]: near a kink both rules err alike and their difference can understate the
-//! error. (The volume renderer also makes every kink a breakpoint before the first pass, so that
+//! error. Where the caller knows on which side of a kink the square root lies (the volume
+//! renderer does, for tangency kinks), only the singular ends are flattened
+//! ([`integrate_adaptive_with_ends`]), and a segment with none is integrated as it is. (The volume renderer also makes every kink a breakpoint before the first pass, so that
 //! no shadow falls unseen between the nodes of a segment.)
 //!
 //! **Two levels per segment.** The 7 Gauss nodes are a subset of the 15 Kronrod nodes, so a
@@ -119,7 +121,8 @@ fn single_segment(
     hi: f64,
     smoothed: bool,
 ) -> RuleResult {
-    let mut s = NestedSegment::new(lo, hi, 1.0, 0, smoothed);
+    let ends = if smoothed { BOTH_ENDS } else { 0 };
+    let mut s = NestedSegment::new(lo, hi, 1.0, 0, ends);
     let f: &mut dyn FnMut(usize, f64) -> DVec3 = &mut |_, u| f(u);
     s.raise_to(1, f);
     s.raise_to(2, f);
@@ -218,7 +221,9 @@ struct NestedSegment {
     hi: f64,
     weight: f64,
     tag: usize,
-    smoothed: bool,
+    /// Which ends are square-root points ([`LOW_END`], [`HIGH_END`]): those the substitution
+    /// flattens; 0 for none (no substitution).
+    ends: u8,
     level: u8,
     fv: [DVec3; 15],
     value: DVec3,
@@ -228,13 +233,13 @@ struct NestedSegment {
 
 impl NestedSegment {
     /// A segment with no node evaluated yet (level 0).
-    fn new(lo: f64, hi: f64, weight: f64, tag: usize, smoothed: bool) -> Self {
+    fn new(lo: f64, hi: f64, weight: f64, tag: usize, ends: u8) -> Self {
         NestedSegment {
             lo,
             hi,
             weight,
             tag,
-            smoothed,
+            ends,
             level: 0,
             fv: [DVec3::ZERO; 15],
             value: DVec3::ZERO,
@@ -244,14 +249,21 @@ impl NestedSegment {
     }
 
     /// The integrand at abscissa x ∈ [−1, 1] of the segment (after the endpoint-smoothing
-    /// substitution of [`gauss_kronrod_15_smoothed`] when `smoothed`).
+    /// substitution of [`integrate_adaptive_with_ends`] that flattens its singular `ends`).
     fn node(&self, x: f64, f: &mut dyn FnMut(usize, f64) -> DVec3) -> DVec3 {
-        if self.smoothed {
-            // s ∈ [0, 1], the variable of `gauss_kronrod_15_smoothed` (half-width 1/2).
+        if self.ends != 0 {
+            // s ∈ [0, 1], the variable of `gauss_kronrod_15_smoothed` (half-width 1/2), and a
+            // map g with g′ = 0 at the singular ends only.
             let w = self.hi - self.lo;
             let s = 0.5 + 0.5 * x;
-            let g = s * s * (3.0 - 2.0 * s);
-            let dg = 6.0 * s * (1.0 - s);
+            let (g, dg) = match self.ends {
+                LOW_END => (s * s, 2.0 * s),
+                HIGH_END => {
+                    let r = 1.0 - s;
+                    (1.0 - r * r, 2.0 * r)
+                }
+                _ => (s * s * (3.0 - 2.0 * s), 6.0 * s * (1.0 - s)),
+            };
             f(self.tag, self.lo + w * g) * (w * dg)
         } else {
             let centre = 0.5 * (self.lo + self.hi);
@@ -314,7 +326,7 @@ impl NestedSegment {
             resabs += w * (a.abs() + b.abs());
             resasc += w * ((a - mean).abs() + (b - mean).abs());
         }
-        let h = if self.smoothed {
+        let h = if self.ends != 0 {
             0.5
         } else {
             0.5 * (self.hi - self.lo).abs()
@@ -333,18 +345,58 @@ impl NestedSegment {
 /// is false starts at K15: the caller's judgement of where the coarse estimate cannot be
 /// trusted. `kink_in(tag, lo, hi)` returns a known non-smooth point strictly inside (lo, hi)
 /// (the one nearest to the middle), or `None`; segments that contain or touch one use the
-/// endpoint-smoothing substitution and [`KINK_SAFETY`] at both levels.
+/// endpoint-smoothing substitution at both ends and [`KINK_SAFETY`] at both levels
+/// ([`integrate_adaptive_with_ends`] with both ends singular wherever a kink is near).
 pub fn integrate_adaptive(
     pieces: &[Piece],
     tol: f64,
     max_segments: usize,
-    mut f: impl FnMut(usize, f64) -> DVec3,
+    f: impl FnMut(usize, f64) -> DVec3,
     kink_in: impl Fn(usize, f64, f64) -> Option<f64>,
     coarse_ok: impl Fn(usize, f64, f64) -> bool,
 ) -> AdaptiveResult {
+    let ends = |tag: usize, lo: f64, hi: f64, hair: f64| {
+        if kink_in(tag, lo - hair, hi + hair).is_some() {
+            BOTH_ENDS
+        } else {
+            0
+        }
+    };
+    integrate_adaptive_with_ends(pieces, tol, max_segments, f, &kink_in, coarse_ok, ends)
+}
+
+/// A segment's low end is a square-root point of the integrand (a bit of [`NestedSegment`]'s
+/// `ends`, as `singular_ends` of [`integrate_adaptive_with_ends`] returns them).
+pub const LOW_END: u8 = 1;
+/// Its high end is one.
+pub const HIGH_END: u8 = 2;
+/// Both ends are, or a kink lies inside.
+pub const BOTH_ENDS: u8 = LOW_END | HIGH_END;
+
+/// [`integrate_adaptive`], where `singular_ends(tag, lo, hi, hair)` says which ends of a new
+/// segment [lo, hi] are square-root points ([`LOW_END`], [`HIGH_END`]; [`BOTH_ENDS`] also for a
+/// kink inside; `hair` is how far from an end a kink still counts as at it). A segment with a
+/// singular end takes the substitution that flattens that end only: u = lo + w·s² (low),
+/// u = hi − w·(1 − s)² (high), or the cubic s²(3 − 2s) of [`gauss_kronrod_15_smoothed`] (both),
+/// and [`KINK_SAFETY`]; a segment with none is integrated as it is. The substitution is needed
+/// only where the singularity is: at a tangency kink the integrand has its square root on the
+/// side where the shadow ray crosses the sphere and is smooth on the other
+/// (`optics::kinks::push_sided_tangencies`), and flattening a smooth end only crowds the nodes
+/// there. On 1UUN lit 512² this took 11 % of the shadow rays off, and the largest error
+/// against a tol 1e-9 render fell from 3.9e-7 to 3.6e-7.
+#[allow(clippy::too_many_arguments)]
+pub fn integrate_adaptive_with_ends(
+    pieces: &[Piece],
+    tol: f64,
+    max_segments: usize,
+    mut f: impl FnMut(usize, f64) -> DVec3,
+    kink_in: &impl Fn(usize, f64, f64) -> Option<f64>,
+    coarse_ok: impl Fn(usize, f64, f64) -> bool,
+    singular_ends: impl Fn(usize, f64, f64, f64) -> u8,
+) -> AdaptiveResult {
     let f: &mut dyn FnMut(usize, f64) -> DVec3 = &mut f;
     // Near a kink both rules of a pair err alike and their difference can understate the error.
-    let safety = |s: &NestedSegment| if s.smoothed { KINK_SAFETY } else { 1.0 };
+    let safety = |s: &NestedSegment| if s.ends != 0 { KINK_SAFETY } else { 1.0 };
     let mut segments: Vec<NestedSegment> = Vec::with_capacity(pieces.len() * 2);
     let mut heap = BinaryHeap::new();
     let mut evaluations = 0;
@@ -354,8 +406,8 @@ pub fn integrate_adaptive(
             // A kink inside, or at an end (a segment split at a kink keeps a square-root endpoint
             // singularity), calls for the substitution: widen the test by a hair to see ends.
             let hair = (hi - lo) * 1e-9;
-            let smoothed = kink_in(tag, lo - hair, hi + hair).is_some();
-            let mut s = NestedSegment::new(lo, hi, weight, tag, smoothed);
+            let ends = singular_ends(tag, lo, hi, hair);
+            let mut s = NestedSegment::new(lo, hi, weight, tag, ends);
             s.raise_to(1, f);
             let mut nodes = NESTED_NODES[0];
             if !coarse_ok(tag, lo, hi) {
@@ -483,6 +535,44 @@ mod tests {
                 r.error.x
             );
             assert!(r.error.x <= tol);
+        }
+    }
+
+    /// A square root at one end, announced as that end: the one-sided substitution reaches tol
+    /// with an honest estimate, and with fewer evaluations than flattening both ends.
+    #[test]
+    fn a_singular_end_alone_is_flattened_and_the_estimate_covers_the_error() {
+        // ∫_0.3^1 √(u − 0.3)·(1 + u) du and its mirror image ∫_0^0.7 √(0.7 − u)·(1 + u) du.
+        let v = 0.7f64;
+        let exact_low = (2.0 / 3.0) * v.powf(1.5) * 1.3 + (2.0 / 5.0) * v.powf(2.5);
+        let exact_high = (2.0 / 3.0) * v.powf(1.5) * 1.7 - (2.0 / 5.0) * v.powf(2.5);
+        let cases: [(f64, f64, u8, f64); 2] = [
+            (0.3, 1.0, LOW_END, exact_low),
+            (0.0, 0.7, HIGH_END, exact_high),
+        ];
+        for (lo, hi, end, exact) in cases {
+            let f = |_: usize, u: f64| {
+                let d = if end == LOW_END { u - 0.3 } else { 0.7 - u };
+                DVec3::splat(d.max(0.0).sqrt() * (1.0 + u))
+            };
+            let pieces = one_piece(lo, hi, 1.0);
+            let mut evaluations = [0; 2];
+            for (k, ends) in [end, BOTH_ENDS].into_iter().enumerate() {
+                let r = integrate_adaptive_with_ends(
+                    &pieces,
+                    1e-10,
+                    100,
+                    f,
+                    &|_, _, _| None,
+                    |_, _, _| true,
+                    |_, _, _, _| ends,
+                );
+                let actual = (r.value.x - exact).abs();
+                assert!(r.converged && r.error.x <= 1e-10, "ends {ends}: {r:?}");
+                assert!(actual <= r.error.x, "ends {ends}: {actual} > {}", r.error.x);
+                evaluations[k] = r.evaluations;
+            }
+            assert!(evaluations[0] < evaluations[1], "{evaluations:?}");
         }
     }
 

@@ -38,7 +38,7 @@
 
 use crate::geometry::{intersect_sphere, Bvh, Hit, Ray};
 use crate::optics::kinks::{
-    axis_approach, for_each_swept_leaf, push_tangencies, solve_quadratic, swept_polygon,
+    axis_approach, for_each_swept_leaf, push_sided_tangencies, solve_quadratic, swept_polygon,
     AxisApproach,
 };
 use crate::optics::light::Light;
@@ -173,6 +173,21 @@ impl Occluders {
         light: &Light,
         out: &mut Vec<f64>,
     ) {
+        let mut sided = Vec::new();
+        self.sided_tangencies(camera_ray, (t_lo, t_hi), light, &mut sided);
+        out.extend(sided.into_iter().map(|(t, _)| t));
+    }
+
+    /// [`Occluders::tangencies`] with the side of each on which the shadow rays cross the
+    /// sphere (`kinks::push_sided_tangencies`), sorted by value, equal values merged into one
+    /// with both their sides. `out` is not cleared.
+    pub fn sided_tangencies(
+        &self,
+        camera_ray: &Ray,
+        (t_lo, t_hi): (f64, f64),
+        light: &Light,
+        out: &mut Vec<(f64, u8)>,
+    ) {
         debug_assert!(
             self.ta <= t_lo && t_hi <= self.tb,
             "a list for another stretch"
@@ -181,10 +196,17 @@ impl Occluders {
             return;
         }
         for c in &self.candidates {
-            push_tangencies(camera_ray, (t_lo, t_hi), light, (c.center, c.radius), out);
+            push_sided_tangencies(camera_ray, (t_lo, t_hi), light, (c.center, c.radius), out);
         }
-        out.sort_unstable_by(f64::total_cmp);
-        out.dedup();
+        out.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+        out.dedup_by(|b, a| {
+            if a.0 == b.0 {
+                a.1 |= b.1;
+                true
+            } else {
+                false
+            }
+        });
     }
 
     /// The candidates of `wide` (gathered for a stretch of the same camera ray that contains

@@ -87,13 +87,14 @@
 //! (`reference::shadow`), with the same hits as a traversal of the whole BVH: one BVH query per
 //! camera ray and light, from which each interval's list is narrowed.
 
-use super::quadrature::{integrate_adaptive, Piece};
+use super::quadrature::{integrate_adaptive_with_ends, Piece, BOTH_ENDS, HIGH_END, LOW_END};
 use super::riemann::midpoint_sum;
 use super::shadow::Occluders;
 use super::{Integrator, RadianceEstimator, Sample};
 use crate::geometry::{Bvh, Hit, Ray};
 use crate::optics::emission::{composite_by, opacity};
 use crate::optics::intervals::{Interval, IntervalCutter, IntervalScratch};
+use crate::optics::kinks::{CROSSES_ABOVE, CROSSES_BELOW};
 use crate::optics::light::Light;
 use crate::optics::model::{LightNeed, Model};
 use crate::optics::source::{surface_limit_weight, LightSample, SourceParams};
@@ -368,7 +369,7 @@ impl<'a> VolumeRenderer<'a> {
         let m = self.scene.lights.len();
         // pieces[k] spans the whole of interval k in u: [0, U_k] (built so by the caller).
         let t_of = |k: usize, u: f64| t_at(&intervals[k], pieces[k].hi, u);
-        let mut kinks = Vec::new();
+        let (mut marks, mut kinks, mut sides) = (Vec::new(), Vec::new(), Vec::new());
         let mut split = Vec::with_capacity(pieces.len());
         let share = render.tol / m as f64;
         for (l, light) in self.scene.lights.iter().enumerate() {
@@ -383,7 +384,11 @@ impl<'a> VolumeRenderer<'a> {
             };
             sh.wide
                 .gather(&self.bvh, ray, (WHOLE_RAY, l), light, (first.t0, last.t1));
-            self.breakpoints(ray, (first.t0, last.t1), light, &sh.wide, &mut kinks);
+            self.breakpoints(ray, (first.t0, last.t1), light, &sh.wide, &mut marks);
+            kinks.clear();
+            sides.clear();
+            kinks.extend(marks.iter().map(|&(t, _)| t));
+            sides.extend(marks.iter().map(|&(_, side)| side));
             // Every kink is a breakpoint from the start: a shadow that falls between the nodes
             // of a segment would otherwise go unseen by both rules, and by the error estimate.
             split.clear();
@@ -429,14 +434,44 @@ impl<'a> VolumeRenderer<'a> {
             sh.shadow_cut = cut.map(|(epsilon, bound, _)| (epsilon, bound));
             sh.was_cut = false;
             let tol = share * (1.0 - 0.5 * TAIL_SHARE - CUT_SHARE);
-            let r = integrate_adaptive(
+            // Which ends of [lo, hi] are square-root points: a kink at the low end whose
+            // shadow rays cross its sphere above it, one at the high end crossed below it; a
+            // kink inside (one that could not be a breakpoint) counts as both.
+            let singular_ends = |k: usize, lo: f64, hi: f64, hair: f64| -> u8 {
+                let (a, b) = (t_of(k, lo - hair), t_of(k, hi + hair));
+                let from = kinks.partition_point(|&t| t <= a);
+                let to = kinks.partition_point(|&t| t < b);
+                let iv = &intervals[k];
+                let mut ends = 0;
+                for (&t, &side) in kinks[from..to].iter().zip(&sides[from..to]) {
+                    let u = opacity(iv.sigma * (t - iv.t0));
+                    ends |= if (u - lo).abs() <= hair {
+                        if side & CROSSES_ABOVE != 0 {
+                            LOW_END
+                        } else {
+                            0
+                        }
+                    } else if (u - hi).abs() <= hair {
+                        if side & CROSSES_BELOW != 0 {
+                            HIGH_END
+                        } else {
+                            0
+                        }
+                    } else {
+                        BOTH_ENDS
+                    };
+                }
+                ends
+            };
+            let r = integrate_adaptive_with_ends(
                 &split,
                 tol,
                 MAX_SEGMENTS,
                 |k, u| self.light_source(ray, t_of(k, u), (k, &intervals[k]), l, sh),
-                kink_in,
+                &kink_in,
                 // σ·Δt of the segment [lo, hi] in u: ln(1 − lo) − ln(1 − hi).
                 |_, lo, hi| (-lo).ln_1p() - (-hi).ln_1p() <= COARSE_DEPTH,
+                singular_ends,
             );
             value += r.value;
             error += r.error;
@@ -451,9 +486,10 @@ impl<'a> VolumeRenderer<'a> {
     }
 
     /// The breakpoints of light `light`'s integral along `ray` in (t_lo, t_hi), sorted, into
-    /// `out` (cleared first): its kinks (`optics::kinks`, found among `occluders`, a list
+    /// `out` (cleared first), each with the sides on which it is a square-root point
+    /// (`kinks::CROSSES_ABOVE`, `CROSSES_BELOW`): its kinks (`optics::kinks`, found among `occluders`, a list
     /// gathered towards that light for a stretch of `ray` that holds (t_lo, t_hi):
-    /// [`Occluders::tangencies`]), and for a point light the point
+    /// [`Occluders::sided_tangencies`]), and for a point light the point
     /// where the ray passes closest to it, t*, with a graded mesh around it. There the
     /// irradiance I/d² = I/(h² + (t − t*)²) peaks, as sharply as the ray passes close (h); as a
     /// breakpoint the peak is an end of two segments (where the rules put nodes densely) rather
@@ -469,26 +505,34 @@ impl<'a> VolumeRenderer<'a> {
         (t_lo, t_hi): (f64, f64),
         light: &Light,
         occluders: &Occluders,
-        out: &mut Vec<f64>,
+        out: &mut Vec<(f64, u8)>,
     ) {
         out.clear();
-        occluders.tangencies(ray, (t_lo, t_hi), light, out);
+        occluders.sided_tangencies(ray, (t_lo, t_hi), light, out);
         if let Light::Point { position, .. } = *light {
             let t = (position - ray.origin).dot(ray.direction);
             let h = (position - ray.at(t)).length();
             let inside = |x: f64| x > t_lo && x < t_hi;
             let before = out.len();
+            // The peak is smooth, but its marks keep the substitution at both ends and the
+            // kinks' safety factor, with which the dark-roof scene's err was found honest.
+            let both = CROSSES_ABOVE | CROSSES_BELOW;
             if inside(t) {
-                out.push(t);
+                out.push((t, both));
             }
             // Written so that h = 0 or NaN adds nothing more (and cannot loop).
             let mut d = h;
             while d > 0.0 && (inside(t - d) || inside(t + d)) {
-                out.extend([t - d, t + d].into_iter().filter(|&x| inside(x)));
+                out.extend(
+                    [t - d, t + d]
+                        .into_iter()
+                        .filter(|&x| inside(x))
+                        .map(|x| (x, both)),
+                );
                 d *= GRADE;
             }
             if out.len() > before {
-                out.sort_unstable_by(f64::total_cmp);
+                out.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
             }
         }
     }
@@ -1035,7 +1079,11 @@ mod tests {
                 wide.gather(&r.bvh, &ray, (0, 0), &light, (6.0, 10.0));
                 r.breakpoints(&ray, (6.0, 10.0), &light, &wide, &mut marks);
                 let t_star = 8.2;
-                let near = |x: f64| marks.iter().any(|&m| (m - x).abs() <= 1e-9 * (1.0 + x));
+                let near = |x: f64| {
+                    marks
+                        .iter()
+                        .any(|&(m, _)| (m - x).abs() <= 1e-9 * (1.0 + x))
+                };
                 assert!(near(t_star), "{model} h {h}: {marks:?}");
                 let mut graded = 0;
                 let mut d = h;
