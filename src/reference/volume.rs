@@ -30,10 +30,13 @@
 //! camera-ray parameters are computed in closed form (`optics::kinks`: ray–cylinder for
 //! directional lights, ray–cone for point lights) and every one is a breakpoint from the start
 //! (a shadow that falls between the nodes of a segment would otherwise be missed by both rules,
-//! and by the error estimate with them). The segments next to a kink are integrated with an
-//! endpoint-smoothing substitution that turns the square-root kink into a smooth integrand, and
-//! their error estimate carries a safety factor. Kinks the closed form might miss (round-off in
-//! the roots) are left to the adaptivity.
+//! and by the error estimate with them). The square root of a kink lies on one side of it, the
+//! side where the shadow rays cross the grazed sphere (`kinks::push_sided_tangencies`); the
+//! segment on that side is integrated with an endpoint substitution that flattens that end and
+//! turns the square root into a smooth integrand, and its error estimate carries a safety
+//! factor, while the segment on the other side sees a smooth integrand there and is integrated
+//! as it is (`quadrature::integrate_adaptive_with_ends`). Kinks the closed form might miss
+//! (round-off in the roots) are left to the adaptivity.
 //!
 //! **Θmax = 1.** An interval with σ = ∞ is the end of the ray: T = 0 from its start t0 on. Its
 //! contribution T(0,t0)·Q∞ is the σ → ∞ limit of the integral, which concentrates on x(t0⁺):
@@ -434,34 +437,9 @@ impl<'a> VolumeRenderer<'a> {
             sh.shadow_cut = cut.map(|(epsilon, bound, _)| (epsilon, bound));
             sh.was_cut = false;
             let tol = share * (1.0 - 0.5 * TAIL_SHARE - CUT_SHARE);
-            // Which ends of [lo, hi] are square-root points: a kink at the low end whose
-            // shadow rays cross its sphere above it, one at the high end crossed below it; a
-            // kink inside (one that could not be a breakpoint) counts as both.
-            let singular_ends = |k: usize, lo: f64, hi: f64, hair: f64| -> u8 {
-                let (a, b) = (t_of(k, lo - hair), t_of(k, hi + hair));
-                let from = kinks.partition_point(|&t| t <= a);
-                let to = kinks.partition_point(|&t| t < b);
-                let iv = &intervals[k];
-                let mut ends = 0;
-                for (&t, &side) in kinks[from..to].iter().zip(&sides[from..to]) {
-                    let u = opacity(iv.sigma * (t - iv.t0));
-                    ends |= if (u - lo).abs() <= hair {
-                        if side & CROSSES_ABOVE != 0 {
-                            LOW_END
-                        } else {
-                            0
-                        }
-                    } else if (u - hi).abs() <= hair {
-                        if side & CROSSES_BELOW != 0 {
-                            HIGH_END
-                        } else {
-                            0
-                        }
-                    } else {
-                        BOTH_ENDS
-                    };
-                }
-                ends
+            let singular_ends = |k: usize, lo: f64, hi: f64, hair: f64| {
+                let near = (t_of(k, lo - hair), t_of(k, hi + hair));
+                singular_ends(&kinks, &sides, &intervals[k], near, (lo, hi, hair))
             };
             let r = integrate_adaptive_with_ends(
                 &split,
@@ -761,6 +739,42 @@ const RESOLUTION_LIMIT: f64 = 1e-6;
 /// a thinner one adds an optical depth below 1e-3·RESOLUTION_LIMIT over the positions the
 /// limit stands for.
 const LIMIT_MEMBER_FRACTION: f64 = 1e-3;
+/// Which ends of the segment [lo, hi] (in u) of interval `iv` are square-root points of a
+/// light's integrand ([`integrate_adaptive_with_ends`]), from its `kinks` (sorted) and their
+/// `sides`: a kink at the low end whose shadow rays cross its sphere above it, one at the high
+/// end crossed below it; a kink inside (one that could not be a breakpoint) counts as both.
+/// `(a, b)` is the segment in t, widened by `hair` in u, within which a kink is at an end.
+fn singular_ends(
+    kinks: &[f64],
+    sides: &[u8],
+    iv: &Interval,
+    (a, b): (f64, f64),
+    (lo, hi, hair): (f64, f64, f64),
+) -> u8 {
+    let from = kinks.partition_point(|&t| t <= a);
+    let to = kinks.partition_point(|&t| t < b);
+    let mut ends = 0;
+    for (&t, &side) in kinks[from..to].iter().zip(&sides[from..to]) {
+        let u = opacity(iv.sigma * (t - iv.t0));
+        ends |= if (u - lo).abs() <= hair {
+            if side & CROSSES_ABOVE != 0 {
+                LOW_END
+            } else {
+                0
+            }
+        } else if (u - hi).abs() <= hair {
+            if side & CROSSES_BELOW != 0 {
+                HIGH_END
+            } else {
+                0
+            }
+        } else {
+            BOTH_ENDS
+        };
+    }
+    ends
+}
+
 /// Coefficient of the first-order remainder of the σ → ∞ limit, err = F·Qmax/τ (see
 /// `VolumeRenderer::limit_remainder`).
 const LIMIT_REMAINDER_FACTOR: f64 = 1e3;
