@@ -752,7 +752,9 @@ fn singular_ends(
     (lo, hi, hair): (f64, f64, f64),
 ) -> u8 {
     let from = kinks.partition_point(|&t| t <= a);
-    let to = kinks.partition_point(|&t| t < b);
+    // Also where clamping t(u) to the interval collapses (a, b) to a point, or reverses it
+    // (a ray through a point light): no kink, as in `kink_in`.
+    let to = kinks.partition_point(|&t| t < b).max(from);
     let mut ends = 0;
     for (&t, &side) in kinks[from..to].iter().zip(&sides[from..to]) {
         let u = opacity(iv.sigma * (t - iv.t0));
