@@ -17,14 +17,14 @@ pub fn opacity(tau: f64) -> f64 {
 }
 
 /// Opacity a = 1 − e^{−τ} and transmittance e^{−τ} of a piece of optical depth τ ≥ 0 from one
-/// exponential. Below τ = [`EXPM1_BELOW`], a comes from its Taylor series ([`small_opacity`])
+/// exponential. Below τ = [`SMALL_DEPTH`], a comes from its Taylor series ([`small_opacity`])
 /// with its digits, and e = 1 − a is exact to an ulp (e ≥ 0.95); above it `exp` gives e, and
 /// a = 1 − e loses at most log2(1/0.05) ≈ 4.3 bits to cancellation, a relative error below
 /// 20ε, under the round-off floor (50ε of ∫|f|) that the quadrature's estimate already carries.
 /// τ = +∞ gives (1, 0).
 #[inline]
 pub fn opacity_and_transmittance(tau: f64) -> (f64, f64) {
-    if tau < EXPM1_BELOW {
+    if tau < SMALL_DEPTH {
         let a = small_opacity(tau);
         (a, 1.0 - a)
     } else {
@@ -32,9 +32,6 @@ pub fn opacity_and_transmittance(tau: f64) -> (f64, f64) {
         (1.0 - e, e)
     }
 }
-
-/// Optical depth below which [`opacity_and_transmittance`] takes [`small_opacity`].
-pub const EXPM1_BELOW: f64 = SMALL_DEPTH;
 
 /// Radiance and transmittance of a ray through `intervals` (in ray order) towards a background
 /// of radiance `background`.

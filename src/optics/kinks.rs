@@ -66,10 +66,7 @@ pub(crate) fn push_tangencies(
     (c, r): (DVec3, f64),
     out: &mut Vec<f64>,
 ) {
-    let roots = match *light {
-        Light::Directional { direction, .. } => cylinder_roots(ray, -direction, c, r),
-        Light::Point { position, .. } => cone_roots(ray, position, c, r),
-    };
+    let (roots, _) = sided_roots(ray, light, (c, r));
     out.extend(
         roots
             .into_iter()
@@ -97,18 +94,24 @@ pub(crate) fn push_sided_tangencies(
     (c, r): (DVec3, f64),
     out: &mut Vec<(f64, u8)>,
 ) {
+    let (roots, sides) = sided_roots(ray, light, (c, r));
+    for (t, side) in roots.into_iter().zip(sides) {
+        if let Some(t) = t.filter(|&t| t > t_lo && t < t_hi) {
+            out.push((t, side));
+        }
+    }
+}
+
+/// The two tangency roots of the sphere (c, r) for `light` along `ray`, each with its side
+/// ([`push_sided_tangencies`]).
+fn sided_roots(ray: &Ray, light: &Light, (c, r): (DVec3, f64)) -> ([Option<f64>; 2], [u8; 2]) {
     const BOTH: u8 = CROSSES_ABOVE | CROSSES_BELOW;
-    let (roots, sides) = match *light {
+    match *light {
         Light::Directional { direction, .. } => (
             cylinder_roots(ray, -direction, c, r),
             [CROSSES_ABOVE, CROSSES_BELOW],
         ),
         Light::Point { position, .. } => (cone_roots(ray, position, c, r), [BOTH, BOTH]),
-    };
-    for (t, side) in roots.into_iter().zip(sides) {
-        if let Some(t) = t.filter(|&t| t > t_lo && t < t_hi) {
-            out.push((t, side));
-        }
     }
 }
 

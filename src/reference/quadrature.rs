@@ -18,8 +18,9 @@
 //! [`KINK_SAFETY`]: near a kink both rules err alike and their difference can understate the
 //! error. Where the caller knows on which side of a kink the square root lies (the volume
 //! renderer does, for tangency kinks), only the singular ends are flattened
-//! ([`integrate_adaptive_with_ends`]), and a segment with none is integrated as it is. (The volume renderer also makes every kink a breakpoint before the first pass, so that
-//! no shadow falls unseen between the nodes of a segment.)
+//! ([`integrate_adaptive_with_ends`]), and a segment with none is integrated as it is. (The
+//! volume renderer also makes every kink a breakpoint before the first pass, so that no shadow
+//! falls unseen between the nodes of a segment.)
 //!
 //! **Two levels per segment.** The 7 Gauss nodes are a subset of the 15 Kronrod nodes, so a
 //! segment is first integrated by G7 alone, whose estimate is its difference from the

@@ -165,7 +165,9 @@ impl Occluders {
     /// traversal with the same polygon. The same values: a sphere with a tangency in the
     /// stretch is in the list (its padded reach range holds the tangency, and it is not wholly
     /// behind the stretch, where the tangent point lies ahead), and each sphere's roots come
-    /// from the same function; a test compares the two, bit for bit.
+    /// from the same function; a test compares the two, bit for bit. (The renderer takes
+    /// [`Occluders::sided_tangencies`]; this is its values, for that test.)
+    #[cfg(test)]
     pub fn tangencies(
         &self,
         camera_ray: &Ray,
