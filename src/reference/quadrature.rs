@@ -124,7 +124,11 @@ fn single_segment(
 ) -> RuleResult {
     let ends = if smoothed { BOTH_ENDS } else { 0 };
     let mut s = NestedSegment::new(lo, hi, 1.0, 0, ends);
-    let f: &mut dyn FnMut(usize, f64) -> DVec3 = &mut |_, u| f(u);
+    let f: &mut Nodes = &mut |_, us, out| {
+        for (u, v) in us.iter().zip(out) {
+            *v = f(*u);
+        }
+    };
     s.raise_to(1, f);
     s.raise_to(2, f);
     RuleResult {
@@ -185,6 +189,14 @@ const WG7_SUB5: [f64; 3] = [
     0.052_860_187_099_682_856_771,
     0.519_608_904_792_132_905_67,
 ];
+
+/// The integrand of a batch of nodes of one segment: `f(tag, us, values)` sets `values[i]`
+/// to the integrand at `us[i]` of piece `tag` (the nodes a segment's level adds, in the order
+/// of [`NestedSegment::raise_to`], so that the caller may share work between them).
+pub type Nodes<'a> = dyn FnMut(usize, &[f64], &mut [DVec3]) + 'a;
+
+/// The most nodes one call of [`Nodes`] asks for (the eight that K15 adds to G7).
+pub const MAX_NODES: usize = 8;
 
 /// Integrand evaluations of a segment at its first level (G7) and at its second (K15, reusing
 /// the first level's seven).
@@ -249,9 +261,11 @@ impl NestedSegment {
         }
     }
 
-    /// The integrand at abscissa x ∈ [−1, 1] of the segment (after the endpoint-smoothing
-    /// substitution of [`integrate_adaptive_with_ends`] that flattens its singular `ends`).
-    fn node(&self, x: f64, f: &mut dyn FnMut(usize, f64) -> DVec3) -> DVec3 {
+    /// Where the integrand is taken for abscissa x ∈ [−1, 1] of the segment, and the factor
+    /// its value is multiplied by: after the endpoint-smoothing substitution of
+    /// [`integrate_adaptive_with_ends`] that flattens its singular `ends`, the map's
+    /// derivative; `None` without one.
+    fn node(&self, x: f64) -> (f64, Option<f64>) {
         if self.ends != 0 {
             // s ∈ [0, 1], the variable of `gauss_kronrod_15_smoothed` (half-width 1/2), and a
             // map g with g′ = 0 at the singular ends only.
@@ -265,37 +279,60 @@ impl NestedSegment {
                 }
                 _ => (s * s * (3.0 - 2.0 * s), 6.0 * s * (1.0 - s)),
             };
-            f(self.tag, self.lo + w * g) * (w * dg)
+            (self.lo + w * g, Some(w * dg))
         } else {
             let centre = 0.5 * (self.lo + self.hi);
             let half = 0.5 * (self.hi - self.lo);
-            f(self.tag, centre + half * x)
+            (centre + half * x, None)
         }
     }
 
     /// Evaluates the nodes that `level` adds (G7's at level 1, the other eight of K15's at
     /// level 2), and the segment's value and error estimate at that level: G7 against the
     /// 5-node rule on its own nodes ([`WG7_SUB5`]), or K15 against G7 (QUADPACK's `qk15`).
-    fn raise_to(&mut self, level: u8, f: &mut dyn FnMut(usize, f64) -> DVec3) {
+    fn raise_to(&mut self, level: u8, f: &mut Nodes) {
         self.level = level;
-        let js: &[usize] = if level == 1 {
-            &[1, 3, 5]
+        // The nodes the level adds, as (abscissa, slot in `fv`), from one end of the segment to
+        // the other: consecutive shadow rays then differ least, and the interval cutter's most
+        // recent layout of chord ends (`optics::intervals`) is the one that holds, where the
+        // order ±x₁, ±x₃, … jumped across the segment and found it second (1UUN lit 128²: the
+        // first layout held for 70 % of the shadow rays, against 44 %). The values do not
+        // depend on the order.
+        let nodes: &[(f64, usize)] = if level == 1 {
+            &[
+                (-XGK[1], 2),
+                (-XGK[3], 6),
+                (-XGK[5], 10),
+                (0.0, 14),
+                (XGK[5], 11),
+                (XGK[3], 7),
+                (XGK[1], 3),
+            ]
         } else {
-            &[0, 2, 4, 6]
+            &[
+                (-XGK[0], 0),
+                (-XGK[2], 4),
+                (-XGK[4], 8),
+                (-XGK[6], 12),
+                (XGK[6], 13),
+                (XGK[4], 9),
+                (XGK[2], 5),
+                (XGK[0], 1),
+            ]
         };
-        // From one end of the segment to the other: consecutive shadow rays then differ least,
-        // and the interval cutter's most recent layout of chord ends (`optics::intervals`) is
-        // the one that holds, where the order ±x₁, ±x₃, … jumped across the segment and found
-        // it second (1UUN lit 128²: the first layout held for 70 % of the shadow rays, against
-        // 44 %). The values do not depend on the order.
-        for &j in js {
-            self.fv[2 * j] = self.node(-XGK[j], f);
+        let mut us = [0.0; MAX_NODES];
+        let mut factors = [None; MAX_NODES];
+        for (i, &(x, _)) in nodes.iter().enumerate() {
+            (us[i], factors[i]) = self.node(x);
         }
-        if level == 1 {
-            self.fv[14] = self.node(0.0, f);
-        }
-        for &j in js.iter().rev() {
-            self.fv[2 * j + 1] = self.node(XGK[j], f);
+        let n = nodes.len();
+        let mut values = [DVec3::ZERO; MAX_NODES];
+        f(self.tag, &us[..n], &mut values[..n]);
+        for ((&(_, slot), v), factor) in nodes.iter().zip(values).zip(factors) {
+            self.fv[slot] = match factor {
+                Some(factor) => v * factor,
+                None => v,
+            };
         }
         let fc = self.fv[14];
         let pair = |j: usize| self.fv[2 * j] + self.fv[2 * j + 1];
@@ -385,7 +422,6 @@ pub const BOTH_ENDS: u8 = LOW_END | HIGH_END;
 /// (`optics::kinks::push_sided_tangencies`), and flattening a smooth end only crowds the nodes
 /// there. On 1UUN lit 512² this took 11 % of the shadow rays off, and the largest error
 /// against a tol 1e-9 render fell from 3.9e-7 to 3.6e-7.
-#[allow(clippy::too_many_arguments)]
 pub fn integrate_adaptive_with_ends(
     pieces: &[Piece],
     tol: f64,
@@ -395,29 +431,52 @@ pub fn integrate_adaptive_with_ends(
     coarse_ok: impl Fn(usize, f64, f64) -> bool,
     singular_ends: impl Fn(usize, f64, f64, f64) -> u8,
 ) -> AdaptiveResult {
-    let f: &mut dyn FnMut(usize, f64) -> DVec3 = &mut f;
+    let nodes = |tag: usize, us: &[f64], values: &mut [DVec3]| {
+        for (u, v) in us.iter().zip(values) {
+            *v = f(tag, *u);
+        }
+    };
+    let tests = (kink_in, coarse_ok, singular_ends);
+    integrate_adaptive_batched(pieces, tol, max_segments, nodes, tests)
+}
+
+/// [`integrate_adaptive_with_ends`] with the integrand taken a segment's level at a time
+/// ([`Nodes`]): the same nodes in the same order, and the same result, bit for bit. The volume
+/// renderer's shadow rays from one segment share their occluder list, which is then read once
+/// for all of them.
+pub fn integrate_adaptive_batched(
+    pieces: &[Piece],
+    tol: f64,
+    max_segments: usize,
+    mut f: impl FnMut(usize, &[f64], &mut [DVec3]),
+    (kink_in, coarse_ok, singular_ends): (
+        &impl Fn(usize, f64, f64) -> Option<f64>,
+        impl Fn(usize, f64, f64) -> bool,
+        impl Fn(usize, f64, f64, f64) -> u8,
+    ),
+) -> AdaptiveResult {
+    let f: &mut Nodes = &mut f;
     // Near a kink both rules of a pair err alike and their difference can understate the error.
     let safety = |s: &NestedSegment| if s.ends != 0 { KINK_SAFETY } else { 1.0 };
     let mut segments: Vec<NestedSegment> = Vec::with_capacity(pieces.len() * 2);
     let mut heap = BinaryHeap::new();
     let mut evaluations = 0;
     let mut total_error = DVec3::ZERO;
-    let new_segment =
-        |lo: f64, hi: f64, weight: f64, tag: usize, f: &mut dyn FnMut(usize, f64) -> DVec3| {
-            // A kink inside, or at an end (a segment split at a kink keeps a square-root endpoint
-            // singularity), calls for the substitution: widen the test by a hair to see ends.
-            let hair = (hi - lo) * 1e-9;
-            let ends = singular_ends(tag, lo, hi, hair);
-            let mut s = NestedSegment::new(lo, hi, weight, tag, ends);
-            s.raise_to(1, f);
-            let mut nodes = NESTED_NODES[0];
-            if !coarse_ok(tag, lo, hi) {
-                s.raise_to(2, f);
-                nodes = NESTED_NODES[1];
-            }
-            s.error *= safety(&s);
-            (s, nodes)
-        };
+    let new_segment = |lo: f64, hi: f64, weight: f64, tag: usize, f: &mut Nodes| {
+        // A kink inside, or at an end (a segment split at a kink keeps a square-root endpoint
+        // singularity), calls for the substitution: widen the test by a hair to see ends.
+        let hair = (hi - lo) * 1e-9;
+        let ends = singular_ends(tag, lo, hi, hair);
+        let mut s = NestedSegment::new(lo, hi, weight, tag, ends);
+        s.raise_to(1, f);
+        let mut nodes = NESTED_NODES[0];
+        if !coarse_ok(tag, lo, hi) {
+            s.raise_to(2, f);
+            nodes = NESTED_NODES[1];
+        }
+        s.error *= safety(&s);
+        (s, nodes)
+    };
     for p in pieces {
         if !(p.hi > p.lo) || !(p.weight > 0.0) {
             continue;
@@ -509,6 +568,66 @@ mod tests {
             |_, _, _| None,
             |_, _, _| true,
         )
+    }
+
+    /// The batched integrand gets each segment's level as one batch: G7's seven nodes or the
+    /// eight K15 adds, from one end of the segment to the other, all in the piece, as many in
+    /// all as `evaluations`; and the result is the per-node one's, bit for bit.
+    #[test]
+    fn nodes_come_a_level_at_a_time_in_order() {
+        let pieces = [
+            Piece {
+                lo: 0.0,
+                hi: 0.6,
+                weight: 0.8,
+                tag: 0,
+            },
+            Piece {
+                lo: 0.2,
+                hi: 0.9,
+                weight: 0.5,
+                tag: 1,
+            },
+        ];
+        let g =
+            |tag: usize, u: f64| DVec3::new((u - 0.3).abs().sqrt(), (9.0 * u).sin(), tag as f64);
+        let kink_in =
+            |tag: usize, lo: f64, hi: f64| (tag == 0 && lo < 0.3 && hi > 0.3).then_some(0.3);
+        let ends = |tag: usize, lo: f64, hi: f64, hair: f64| {
+            if kink_in(tag, lo - hair, hi + hair).is_some() {
+                BOTH_ENDS
+            } else {
+                0
+            }
+        };
+        let coarse_ok = |tag: usize, _: f64, _: f64| tag == 0;
+        let mut batches = Vec::new();
+        let batched = integrate_adaptive_batched(
+            &pieces,
+            1e-10,
+            1000,
+            |tag, us: &[f64], out: &mut [DVec3]| {
+                batches.push((tag, us.to_vec()));
+                for (u, v) in us.iter().zip(out) {
+                    *v = g(tag, *u);
+                }
+            },
+            (&kink_in, coarse_ok, ends),
+        );
+        let one_by_one =
+            integrate_adaptive_with_ends(&pieces, 1e-10, 1000, g, &kink_in, coarse_ok, ends);
+        assert_eq!(batched, one_by_one);
+        assert!(batched.converged && batched.segments > 10);
+        let mut count = 0;
+        for (tag, us) in &batches {
+            let p = &pieces[*tag];
+            assert!(us.len() == 7 || us.len() == 8, "{us:?}");
+            assert!(us.windows(2).all(|w| w[0] < w[1]), "{us:?}");
+            assert!(us.iter().all(|&u| u > p.lo && u < p.hi), "{us:?}");
+            count += us.len();
+        }
+        assert_eq!(count, batched.evaluations);
+        assert!(batches.iter().any(|(tag, us)| *tag == 1 && us.len() == 8));
     }
 
     #[test]

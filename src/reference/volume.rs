@@ -88,11 +88,16 @@
 //!
 //! **Shadow rays** test only the candidate occluders of their camera-ray interval
 //! (`reference::shadow`), with the same hits as a traversal of the whole BVH: one BVH query per
-//! camera ray and light, from which each interval's list is narrowed.
+//! camera ray and light, from which each interval's list is narrowed. The quadrature asks for
+//! the nodes of a segment's level together (`quadrature::integrate_adaptive_batched`), and
+//! their shadow rays read that list once, each candidate tested against all of them in SIMD
+//! lanes (`Occluders::hits_batch`); the composites follow one by one, in node order.
 
-use super::quadrature::{integrate_adaptive_with_ends, Piece, BOTH_ENDS, HIGH_END, LOW_END};
+use super::quadrature::{
+    integrate_adaptive_batched, Piece, BOTH_ENDS, HIGH_END, LOW_END, MAX_NODES,
+};
 use super::riemann::midpoint_sum;
-use super::shadow::Occluders;
+use super::shadow::{Occluders, ShadowRay};
 use super::{Integrator, RadianceEstimator, Sample};
 use crate::geometry::{Bvh, Hit, Ray};
 use crate::optics::emission::{composite_by, opacity};
@@ -120,6 +125,9 @@ const WHOLE_RAY: usize = usize::MAX;
 /// Ratio of the distances from a point light's closest approach of successive breakpoints of
 /// its graded mesh (`VolumeRenderer::breakpoints`).
 const GRADE: f64 = 3.0;
+
+/// The most nodes the quadrature asks for at once (`quadrature::Nodes`).
+const MAX_BATCH: usize = MAX_NODES;
 
 /// Segments per pixel and light at most; beyond it the remaining error estimate is reported as
 /// it stands (the pixel then may miss `tol`, and says so in its `err` value).
@@ -166,6 +174,8 @@ struct ShadowScratch {
     shadow_cut: Option<(f64, DVec3)>,
     /// Whether a shadow ray was cut since this was last cleared.
     was_cut: bool,
+    /// The hits of each shadow ray of a batch (`VolumeRenderer::light_sources`).
+    batch: Vec<Vec<Hit>>,
 }
 
 impl ShadowScratch {
@@ -301,47 +311,74 @@ impl<'a> VolumeRenderer<'a> {
     }
 
     /// The part of Q(x) that light `l` contributes at x = ray.at(t) in interval `k` (Q is
-    /// linear in the lights, DESIGN.md §2): lit w·L_l(x); single-scatter α(x)·E_l(x)·T_l(x)/4π.
-    /// The shadow ray tests only the candidate occluders of interval `k` (`reference::shadow`),
-    /// narrowed on first use from the list of the whole camera ray (`ShadowScratch::wide`).
-    fn light_source(
+    /// linear in the lights, DESIGN.md §2): lit w·L_l(x); single-scatter α(x)·E_l(x)·T_l(x)/4π,
+    /// into `out[i]` for each t = `ts[i]`, the nodes of one quadrature segment. The shadow rays
+    /// test only the candidate occluders of interval `k` (`reference::shadow`), narrowed on
+    /// first use from the list of the whole camera ray (`ShadowScratch::wide`), and read that
+    /// list once for all of them (`Occluders::hits_batch`); they are then composited one by
+    /// one, in node order, as the kept layouts of `optics::intervals` expect.
+    fn light_sources(
         &self,
         ray: &Ray,
-        t: f64,
+        ts: &[f64],
         (k, iv): (usize, &Interval),
         l: usize,
         sh: &mut ShadowScratch,
-    ) -> DVec3 {
-        let x = ray.at(t);
+        out: &mut [DVec3],
+    ) {
         let light = &self.scene.lights[l];
-        let Some(inc) = light.incident_at(x) else {
-            return DVec3::ZERO;
-        };
-        if !inc.irradiance.is_finite() {
-            return DVec3::ZERO;
-        }
         if sh.occluders.len() <= k {
             sh.occluders.resize_with(k + 1, Occluders::default);
         }
-        if !sh.occluders[k].covers(k, l, t) {
-            // `integrate_per_light` gathers the whole ray's list for light l before its
-            // quadrature, and every node lies in one of the ray's intervals.
-            debug_assert!(sh.wide.covers(WHOLE_RAY, l, t));
-            sh.occluders[k].narrow(&sh.wide, ray, (k, l), light, (iv.t0, iv.t1));
+        let mut shadow = [ShadowRay {
+            t: 0.0,
+            ray: *ray,
+            t_max: 0.0,
+        }; MAX_BATCH];
+        let mut lit = [(0, DVec3::ZERO); MAX_BATCH];
+        let mut n = 0;
+        for (i, &t) in ts.iter().enumerate() {
+            out[i] = DVec3::ZERO;
+            let x = ray.at(t);
+            let Some(inc) = light.incident_at(x) else {
+                continue;
+            };
+            if !inc.irradiance.is_finite() {
+                continue;
+            }
+            if !sh.occluders[k].covers(k, l, t) {
+                // `integrate_per_light` gathers the whole ray's list for light l before its
+                // quadrature, and every node lies in one of the ray's intervals.
+                debug_assert!(sh.wide.covers(WHOLE_RAY, l, t));
+                sh.occluders[k].narrow(&sh.wide, ray, (k, l), light, (iv.t0, iv.t1));
+            }
+            shadow[n] = ShadowRay {
+                t,
+                ray: Ray {
+                    origin: x,
+                    direction: inc.toward,
+                },
+                t_max: inc.distance,
+            };
+            lit[n] = (i, inc.irradiance);
+            n += 1;
         }
-        let shadow_ray = Ray {
-            origin: x,
-            direction: inc.toward,
-        };
-        sh.rays += 1;
-        sh.occluders[k].hits(t, &shadow_ray, inc.distance, &mut sh.hits);
+        sh.rays += n as u64;
+        let mut batch = std::mem::take(&mut sh.batch);
+        batch.resize_with(MAX_BATCH, Vec::new);
+        sh.occluders[k].hits_batch(&shadow[..n], &mut batch[..n]);
         let cut = sh.shadow_cut;
-        let s = if self.transmittance_only {
-            self.shadow_transmittance(inc.distance, inc.irradiance, |_| false, sh)
-        } else {
-            self.shadow_composite(inc.distance, inc.irradiance, |_| false, cut, sh)
-        };
-        self.model.light_source(&self.params, iv, &s)
+        for ((s, &(i, irradiance)), hits) in shadow[..n].iter().zip(&lit[..n]).zip(&mut batch) {
+            std::mem::swap(&mut sh.hits, hits);
+            let sample = if self.transmittance_only {
+                self.shadow_transmittance(s.t_max, irradiance, |_| false, sh)
+            } else {
+                self.shadow_composite(s.t_max, irradiance, |_| false, cut, sh)
+            };
+            std::mem::swap(&mut sh.hits, hits);
+            out[i] = self.model.light_source(&self.params, iv, &sample);
+        }
+        sh.batch = batch;
     }
 
     /// Σ_k T(0,t0_k)·∫₀^{U_k} Q du over the finite intervals, adaptively. Q is linear in the
@@ -392,23 +429,7 @@ impl<'a> VolumeRenderer<'a> {
             sides.clear();
             kinks.extend(marks.iter().map(|&(t, _)| t));
             sides.extend(marks.iter().map(|&(_, side)| side));
-            // Every kink is a breakpoint from the start: a shadow that falls between the nodes
-            // of a segment would otherwise go unseen by both rules, and by the error estimate.
-            split.clear();
-            for p in pieces {
-                let iv = &intervals[p.tag];
-                let from = kinks.partition_point(|&t| t <= iv.t0);
-                let to = kinks.partition_point(|&t| t < iv.t1);
-                let mut lo = p.lo;
-                for &t in &kinks[from..to] {
-                    let u = opacity(iv.sigma * (t - iv.t0));
-                    if u > lo && u < p.hi {
-                        split.push(Piece { lo, hi: u, ..*p });
-                        lo = u;
-                    }
-                }
-                split.push(Piece { lo, ..*p });
-            }
+            split_at_kinks(pieces, intervals, &kinks, &mut split);
             let kink_in = |k: usize, lo: f64, hi: f64| {
                 let (a, b) = (t_of(k, lo), t_of(k, hi));
                 let from = kinks.partition_point(|&t| t <= a);
@@ -441,15 +462,24 @@ impl<'a> VolumeRenderer<'a> {
                 let near = (t_of(k, lo - hair), t_of(k, hi + hair));
                 singular_ends(&kinks, &sides, &intervals[k], near, (lo, hi, hair))
             };
-            let r = integrate_adaptive_with_ends(
+            let nodes = |k: usize, us: &[f64], out: &mut [DVec3]| {
+                let mut ts = [0.0; MAX_BATCH];
+                for (t, &u) in ts.iter_mut().zip(us) {
+                    *t = t_of(k, u);
+                }
+                self.light_sources(ray, &ts[..us.len()], (k, &intervals[k]), l, sh, out);
+            };
+            let r = integrate_adaptive_batched(
                 &split,
                 tol,
                 MAX_SEGMENTS,
-                |k, u| self.light_source(ray, t_of(k, u), (k, &intervals[k]), l, sh),
-                &kink_in,
-                // σ·Δt of the segment [lo, hi] in u: ln(1 − lo) − ln(1 − hi).
-                |_, lo, hi| (-lo).ln_1p() - (-hi).ln_1p() <= COARSE_DEPTH,
-                singular_ends,
+                nodes,
+                (
+                    &kink_in,
+                    // σ·Δt of the segment [lo, hi] in u: ln(1 − lo) − ln(1 − hi).
+                    |_, lo, hi| (-lo).ln_1p() - (-hi).ln_1p() <= COARSE_DEPTH,
+                    singular_ends,
+                ),
             );
             value += r.value;
             error += r.error;
@@ -775,6 +805,28 @@ fn singular_ends(
         };
     }
     ends
+}
+
+/// `pieces` (of `intervals`, in u) cut at every one of the sorted `kinks` (in t) inside them,
+/// into `split` (cleared first). Every kink is a breakpoint from the start: a shadow that falls
+/// between the nodes of a segment would otherwise go unseen by both rules, and by the error
+/// estimate.
+fn split_at_kinks(pieces: &[Piece], intervals: &[Interval], kinks: &[f64], split: &mut Vec<Piece>) {
+    split.clear();
+    for p in pieces {
+        let iv = &intervals[p.tag];
+        let from = kinks.partition_point(|&t| t <= iv.t0);
+        let to = kinks.partition_point(|&t| t < iv.t1);
+        let mut lo = p.lo;
+        for &t in &kinks[from..to] {
+            let u = opacity(iv.sigma * (t - iv.t0));
+            if u > lo && u < p.hi {
+                split.push(Piece { lo, hi: u, ..*p });
+                lo = u;
+            }
+        }
+        split.push(Piece { lo, ..*p });
+    }
 }
 
 /// Coefficient of the first-order remainder of the σ → ∞ limit, err = F·Qmax/τ (see
