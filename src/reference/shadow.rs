@@ -308,11 +308,22 @@ fn hits_in_lanes(candidates: &[Candidate], shadow: &[ShadowRay], out: &mut [Vec<
     let n = shadow.len().min(LANES);
     let (mut ox, mut oy, mut oz) = ([0.0; LANES], [0.0; LANES], [0.0; LANES]);
     let (mut dx, mut dy, mut dz) = ([0.0; LANES], [0.0; LANES], [0.0; LANES]);
+    // The span of the rays' t: a candidate whose reach range misses all of it is skipped
+    // whole (any NaN t makes it (−∞, ∞), so that every candidate is tested).
+    let (mut t_first, mut t_last) = (f64::INFINITY, f64::NEG_INFINITY);
     for (i, s) in shadow[..n].iter().enumerate() {
         (ox[i], oy[i], oz[i]) = s.ray.origin.into();
         (dx[i], dy[i], dz[i]) = s.ray.direction.into();
+        if s.t.is_nan() {
+            (t_first, t_last) = (f64::NEG_INFINITY, f64::INFINITY);
+        } else {
+            (t_first, t_last) = (t_first.min(s.t), t_last.max(s.t));
+        }
     }
     for c in candidates {
+        if c.t_hi < t_first || c.t_lo > t_last {
+            continue;
+        }
         let (cx, cy, cz, r) = (c.center.x, c.center.y, c.center.z, c.radius);
         let (mut t_c, mut dist, mut half) = ([0.0; LANES], [0.0; LANES], [0.0; LANES]);
         for i in 0..LANES {
