@@ -124,11 +124,7 @@ fn single_segment(
 ) -> RuleResult {
     let ends = if smoothed { BOTH_ENDS } else { 0 };
     let mut s = NestedSegment::new(lo, hi, 1.0, 0, ends);
-    let f: &mut Nodes = &mut |_, us, out| {
-        for (u, v) in us.iter().zip(out) {
-            *v = f(*u);
-        }
-    };
+    let f: &mut Nodes = &mut each_node(|_, u| f(u));
     s.raise_to(1, f);
     s.raise_to(2, f);
     RuleResult {
@@ -426,18 +422,22 @@ pub fn integrate_adaptive_with_ends(
     pieces: &[Piece],
     tol: f64,
     max_segments: usize,
-    mut f: impl FnMut(usize, f64) -> DVec3,
+    f: impl FnMut(usize, f64) -> DVec3,
     kink_in: &impl Fn(usize, f64, f64) -> Option<f64>,
     coarse_ok: impl Fn(usize, f64, f64) -> bool,
     singular_ends: impl Fn(usize, f64, f64, f64) -> u8,
 ) -> AdaptiveResult {
-    let nodes = |tag: usize, us: &[f64], values: &mut [DVec3]| {
+    let tests = (kink_in, coarse_ok, singular_ends);
+    integrate_adaptive_batched(pieces, tol, max_segments, each_node(f), tests)
+}
+
+/// A per-node integrand `f(tag, u)` as a [`Nodes`] one: each node of a batch in turn.
+fn each_node(mut f: impl FnMut(usize, f64) -> DVec3) -> impl FnMut(usize, &[f64], &mut [DVec3]) {
+    move |tag, us, values| {
         for (u, v) in us.iter().zip(values) {
             *v = f(tag, *u);
         }
-    };
-    let tests = (kink_in, coarse_ok, singular_ends);
-    integrate_adaptive_batched(pieces, tol, max_segments, nodes, tests)
+    }
 }
 
 /// [`integrate_adaptive_with_ends`] with the integrand taken a segment's level at a time

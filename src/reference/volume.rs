@@ -126,9 +126,6 @@ const WHOLE_RAY: usize = usize::MAX;
 /// its graded mesh (`VolumeRenderer::breakpoints`).
 const GRADE: f64 = 3.0;
 
-/// The most nodes the quadrature asks for at once (`quadrature::Nodes`).
-const MAX_BATCH: usize = MAX_NODES;
-
 /// Segments per pixel and light at most; beyond it the remaining error estimate is reported as
 /// it stands (the pixel then may miss `tol`, and says so in its `err` value).
 pub const MAX_SEGMENTS: usize = 4000;
@@ -334,8 +331,8 @@ impl<'a> VolumeRenderer<'a> {
             t: 0.0,
             ray: *ray,
             t_max: 0.0,
-        }; MAX_BATCH];
-        let mut lit = [(0, DVec3::ZERO); MAX_BATCH];
+        }; MAX_NODES];
+        let mut lit = [(0, DVec3::ZERO); MAX_NODES];
         let mut n = 0;
         for (i, &t) in ts.iter().enumerate() {
             out[i] = DVec3::ZERO;
@@ -365,7 +362,7 @@ impl<'a> VolumeRenderer<'a> {
         }
         sh.rays += n as u64;
         let mut batch = std::mem::take(&mut sh.batch);
-        batch.resize_with(MAX_BATCH, Vec::new);
+        batch.resize_with(MAX_NODES, Vec::new);
         sh.occluders[k].hits_batch(&shadow[..n], &mut batch[..n]);
         let cut = sh.shadow_cut;
         for ((s, &(i, irradiance)), hits) in shadow[..n].iter().zip(&lit[..n]).zip(&mut batch) {
@@ -463,7 +460,7 @@ impl<'a> VolumeRenderer<'a> {
                 singular_ends(&kinks, &sides, &intervals[k], near, (lo, hi, hair))
             };
             let nodes = |k: usize, us: &[f64], out: &mut [DVec3]| {
-                let mut ts = [0.0; MAX_BATCH];
+                let mut ts = [0.0; MAX_NODES];
                 for (t, &u) in ts.iter_mut().zip(us) {
                     *t = t_of(k, u);
                 }
