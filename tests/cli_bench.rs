@@ -61,3 +61,55 @@ fn bench_prints_the_single_scatter_workload_with_its_baselines() {
         "adaptive off the truth by {adaptive_vs_truth}: {stdout}"
     );
 }
+
+/// `--repeat 2` renders each renderer twice in turn and prints one row per renderer (the
+/// fastest run), saying so on stderr; `--repeat 0` is refused with exit code 2 and no table.
+#[test]
+fn bench_repeat_takes_the_fastest_run_and_refuses_zero() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let bench = |repeat: &str| {
+        Command::new(env!("CARGO_BIN_EXE_pgt"))
+            .args([
+                "bench",
+                "--size",
+                "4",
+                "--workloads",
+                "1uun",
+                "--threads",
+                "1",
+            ])
+            .args(["--repeat", repeat, "--data"])
+            .arg(dir.path().join("no-data"))
+            .output()
+            .expect("the pgt binary runs")
+    };
+    let out = bench("2");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{stdout}\n{stderr}");
+    assert!(stderr.contains("each renderer 2 times in turn"), "{stderr}");
+    let renderers: Vec<String> = stdout
+        .lines()
+        .filter(|l| l.starts_with("protein-like"))
+        .map(|l| {
+            let words: Vec<&str> = l.split_whitespace().collect();
+            let size = words.iter().position(|w| *w == "4").expect("size column");
+            words[1..size].join(" ")
+        })
+        .collect();
+    assert_eq!(
+        renderers,
+        ["adaptive tol 1e-4", "riemann-100", "emission"],
+        "{stdout}"
+    );
+
+    let out = bench("0");
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("--repeat"), "{stderr}");
+    assert!(
+        out.stdout.is_empty(),
+        "{}",
+        String::from_utf8_lossy(&out.stdout)
+    );
+}
