@@ -22,7 +22,7 @@
 //! volume renderer also makes every kink a breakpoint before the first pass, so that no shadow
 //! falls unseen between the nodes of a segment.)
 //!
-//! **Two levels per segment.** The 7 Gauss nodes are a subset of the 15 Kronrod nodes, so a
+//! **Two levels per segment** (and a third below them, see below). The 7 Gauss nodes are a subset of the 15 Kronrod nodes, so a
 //! segment is first integrated by G7 alone, whose estimate is its difference from the
 //! interpolatory 5-node rule on five of its nodes (degree 5 against G7's 13, so for smooth
 //! integrands the estimate is far above G7's error), and raised to K15 by eight more nodes only
@@ -45,6 +45,14 @@
 //! err covered the actual error everywhere in all three. They were rejected because the
 //! adaptive error at tol 1e-4 must stay ≥ 100× below Riemann-100's (7.7e-5 on that scene, issue
 //! 10), and it is the pessimism of this estimate that keeps it there.
+//!
+//! **A third, lower level where the caller allows it.** The second of those schemes is kept
+//! for segments the caller chooses ([`Level::R5`], [`integrate_adaptive_batched`]'s
+//! `first_level`): R5 on G7's nodes 0, ±XGK[1], ±XGK[3] ([`WG7_SUB5`]), estimated against the
+//! 3-node rule on 0, ±XGK[3] ([`R3`]), raised to G7 by the two nodes ±XGK[5] and then to K15.
+//! The volume renderer starts a piece there only where its whole contribution is bounded by a
+//! few tol (`volume::R5_SHARE`); on 1UUN lit 128² that takes 9.6 % of the shadow rays off and
+//! leaves the largest error at 4.9e-7 (157× below Riemann-100's), all of it covered by err.
 //!
 //! **Global adaptivity.** All segments of one pixel (every interval of the camera ray) share
 //! one error budget: the segment with the largest estimate is raised or split until the summed
@@ -125,8 +133,7 @@ fn single_segment(
     let ends = if smoothed { BOTH_ENDS } else { 0 };
     let mut s = NestedSegment::new(lo, hi, 1.0, 0, ends);
     let f: &mut Nodes = &mut each_node(|_, u| f(u));
-    s.raise_to(1, f);
-    s.raise_to(2, f);
+    s.raise_to(Level::K15, f);
     RuleResult {
         value: s.value,
         error: s.error,
@@ -198,6 +205,39 @@ pub const MAX_NODES: usize = 8;
 /// the first level's seven).
 pub const NESTED_NODES: [usize; 2] = [7, 15];
 
+/// The rule a segment is at. Each level's nodes hold the last one's, so raising a segment
+/// costs only the nodes it adds: R5 (5 nodes) → G7 (2 more) → K15 (8 more).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Level {
+    /// The interpolatory rule on G7's nodes 0, ±XGK[1], ±XGK[3] ([`WG7_SUB5`]), estimated
+    /// against the interpolatory rule on 0, ±XGK[3] ([`R3`]): for pieces whose whole
+    /// contribution is small (the caller's judgement, `first_level`).
+    R5,
+    /// G7, estimated against R5.
+    G7,
+    /// K15, estimated against G7 (QUADPACK's `qk15`).
+    K15,
+}
+
+impl Level {
+    /// The level above, if any.
+    fn next(self) -> Option<Level> {
+        match self {
+            Level::R5 => Some(Level::G7),
+            Level::G7 => Some(Level::K15),
+            Level::K15 => None,
+        }
+    }
+}
+
+/// Weights of the 3-node interpolatory rule on 0, ±XGK[3] (exact to degree 3; both positive):
+/// w₃ = 1/(3·x₃²) from 2w₃·x₃² = 2/3, and w₀ = 2 − 2w₃ (order: centre, ±XGK[3]; a unit test
+/// checks them). The coarse rule that R5 is compared with.
+const R3: [f64; 2] = [
+    2.0 - 2.0 / (3.0 * XGK[3] * XGK[3]),
+    1.0 / (3.0 * XGK[3] * XGK[3]),
+];
+
 /// The error estimate of a pair of rules on one segment (module documentation): `resk` the
 /// better rule, `resg` the coarser, `resabs` = ∫|f| and `resasc` = ∫|f − mean| by the better
 /// rule's weights, all on [−1, 1]; `h` the half-width.
@@ -223,7 +263,7 @@ fn pair_estimate(resk: DVec3, resg: DVec3, resabs: DVec3, resasc: DVec3, h: f64)
 
 /// One segment of [`integrate_adaptive`]: the integrand at the Kronrod nodes evaluated so
 /// far (`fv[2j]` at centre − half·XGK[j], `fv[2j+1]` at centre + half·XGK[j], `fv[14]` at the
-/// centre), and its level (1: G7, 2: K15).
+/// centre), and its level (`None` before the first).
 #[derive(Debug, Clone, Copy)]
 struct NestedSegment {
     lo: f64,
@@ -233,7 +273,7 @@ struct NestedSegment {
     /// Which ends are square-root points ([`LOW_END`], [`HIGH_END`]): those the substitution
     /// flattens; 0 for none (no substitution).
     ends: u8,
-    level: u8,
+    level: Option<Level>,
     fv: [DVec3; 15],
     value: DVec3,
     error: DVec3,
@@ -241,7 +281,7 @@ struct NestedSegment {
 }
 
 impl NestedSegment {
-    /// A segment with no node evaluated yet (level 0).
+    /// A segment with no node evaluated yet.
     fn new(lo: f64, hi: f64, weight: f64, tag: usize, ends: u8) -> Self {
         NestedSegment {
             lo,
@@ -249,7 +289,7 @@ impl NestedSegment {
             weight,
             tag,
             ends,
-            level: 0,
+            level: None,
             fv: [DVec3::ZERO; 15],
             value: DVec3::ZERO,
             error: DVec3::ZERO,
@@ -283,19 +323,27 @@ impl NestedSegment {
         }
     }
 
-    /// Evaluates the nodes that `level` adds (G7's at level 1, the other eight of K15's at
-    /// level 2), and the segment's value and error estimate at that level: G7 against the
-    /// 5-node rule on its own nodes ([`WG7_SUB5`]), or K15 against G7 (QUADPACK's `qk15`).
-    fn raise_to(&mut self, level: u8, f: &mut Nodes) {
-        self.level = level;
+    /// Evaluates the nodes that `level` adds to the segment's present level (all of its own
+    /// on a new segment; a new segment is raised to K15 through G7), and the segment's value
+    /// and error estimate at that level: R5 against R3 ([`R3`]), G7 against R5 ([`WG7_SUB5`]),
+    /// or K15 against G7 (QUADPACK's `qk15`). Returns the number of nodes evaluated.
+    fn raise_to(&mut self, level: Level, f: &mut Nodes) -> usize {
         // The nodes the level adds, as (abscissa, slot in `fv`), from one end of the segment to
         // the other: consecutive shadow rays then differ least, and the interval cutter's most
         // recent layout of chord ends (`optics::intervals`) is the one that holds, where the
         // order ±x₁, ±x₃, … jumped across the segment and found it second (1UUN lit 128²: the
         // first layout held for 70 % of the shadow rays, against 44 %). The values do not
         // depend on the order.
-        let nodes: &[(f64, usize)] = if level == 1 {
-            &[
+        let nodes: &[(f64, usize)] = match (self.level, level) {
+            (None, Level::R5) => &[
+                (-XGK[1], 2),
+                (-XGK[3], 6),
+                (0.0, 14),
+                (XGK[3], 7),
+                (XGK[1], 3),
+            ],
+            (Some(Level::R5), Level::G7) => &[(-XGK[5], 10), (XGK[5], 11)],
+            (None, Level::G7) => &[
                 (-XGK[1], 2),
                 (-XGK[3], 6),
                 (-XGK[5], 10),
@@ -303,9 +351,8 @@ impl NestedSegment {
                 (XGK[5], 11),
                 (XGK[3], 7),
                 (XGK[1], 3),
-            ]
-        } else {
-            &[
+            ],
+            (Some(Level::G7), Level::K15) => &[
                 (-XGK[0], 0),
                 (-XGK[2], 4),
                 (-XGK[4], 8),
@@ -314,8 +361,13 @@ impl NestedSegment {
                 (XGK[4], 9),
                 (XGK[2], 5),
                 (XGK[0], 1),
-            ]
+            ],
+            (None, Level::K15) => {
+                return self.raise_to(Level::G7, f) + self.raise_to(Level::K15, f);
+            }
+            (from, to) => unreachable!("a segment at {from:?} is not raised to {to:?}"),
         };
+        self.level = Some(level);
         let mut us = [0.0; MAX_NODES];
         let mut factors = [None; MAX_NODES];
         for (i, &(x, _)) in nodes.iter().enumerate() {
@@ -333,24 +385,29 @@ impl NestedSegment {
         let fc = self.fv[14];
         let pair = |j: usize| self.fv[2 * j] + self.fv[2 * j + 1];
         let g7 = WG[3] * fc + WG[0] * pair(1) + WG[1] * pair(3) + WG[2] * pair(5);
-        let (resk, resg, wc, used): (DVec3, DVec3, f64, &[(usize, f64)]) = if level == 1 {
-            let sub5 = WG7_SUB5[0] * fc + WG7_SUB5[1] * pair(1) + WG7_SUB5[2] * pair(3);
-            (g7, sub5, WG[3], &[(1, WG[0]), (3, WG[1]), (5, WG[2])])
-        } else {
-            let mut k15 = WGK[7] * fc;
-            for (j, w) in WGK[..7].iter().enumerate() {
-                k15 += *w * pair(j);
+        let r5 = WG7_SUB5[0] * fc + WG7_SUB5[1] * pair(1) + WG7_SUB5[2] * pair(3);
+        let (resk, resg, wc, used): (DVec3, DVec3, f64, &[(usize, f64)]) = match level {
+            Level::R5 => {
+                let r3 = R3[0] * fc + R3[1] * pair(3);
+                (r5, r3, WG7_SUB5[0], &[(1, WG7_SUB5[1]), (3, WG7_SUB5[2])])
             }
-            let used = &[
-                (0, WGK[0]),
-                (1, WGK[1]),
-                (2, WGK[2]),
-                (3, WGK[3]),
-                (4, WGK[4]),
-                (5, WGK[5]),
-                (6, WGK[6]),
-            ];
-            (k15, g7, WGK[7], used)
+            Level::G7 => (g7, r5, WG[3], &[(1, WG[0]), (3, WG[1]), (5, WG[2])]),
+            Level::K15 => {
+                let mut k15 = WGK[7] * fc;
+                for (j, w) in WGK[..7].iter().enumerate() {
+                    k15 += *w * pair(j);
+                }
+                let used = &[
+                    (0, WGK[0]),
+                    (1, WGK[1]),
+                    (2, WGK[2]),
+                    (3, WGK[3]),
+                    (4, WGK[4]),
+                    (5, WGK[5]),
+                    (6, WGK[6]),
+                ];
+                (k15, g7, WGK[7], used)
+            }
         };
         let mean = 0.5 * resk;
         let mut resabs = wc * fc.abs();
@@ -367,6 +424,7 @@ impl NestedSegment {
         };
         self.value = self.weight * (resk * h);
         self.error = self.weight * pair_estimate(resk, resg, resabs, resasc, h);
+        n
     }
 }
 
@@ -427,7 +485,14 @@ pub fn integrate_adaptive_with_ends(
     coarse_ok: impl Fn(usize, f64, f64) -> bool,
     singular_ends: impl Fn(usize, f64, f64, f64) -> u8,
 ) -> AdaptiveResult {
-    let tests = (kink_in, coarse_ok, singular_ends);
+    let first_level = |tag, lo, hi| {
+        if coarse_ok(tag, lo, hi) {
+            Level::G7
+        } else {
+            Level::K15
+        }
+    };
+    let tests = (kink_in, first_level, singular_ends);
     integrate_adaptive_batched(pieces, tol, max_segments, each_node(f), tests)
 }
 
@@ -441,17 +506,21 @@ fn each_node(mut f: impl FnMut(usize, f64) -> DVec3) -> impl FnMut(usize, &[f64]
 }
 
 /// [`integrate_adaptive_with_ends`] with the integrand taken a segment's level at a time
-/// ([`Nodes`]): the same nodes in the same order, and the same result, bit for bit. The volume
-/// renderer's shadow rays from one segment share their occluder list, which is then read once
-/// for all of them.
+/// ([`Nodes`]): the same nodes in the same order, and the same result, bit for bit, where
+/// `first_level(tag, lo, hi)` is G7 where `coarse_ok` is true and K15 where it is false. The
+/// volume renderer's shadow rays from one segment share their occluder list, which is then read
+/// once for all of them. `first_level` may also start a piece at [`Level::R5`], whose
+/// estimate then raises it to G7 where needed, before K15 and any split (the halves of a split
+/// start at G7 or K15 as `first_level` says, never at R5: they are what a coarse start did
+/// not resolve).
 pub fn integrate_adaptive_batched(
     pieces: &[Piece],
     tol: f64,
     max_segments: usize,
     mut f: impl FnMut(usize, &[f64], &mut [DVec3]),
-    (kink_in, coarse_ok, singular_ends): (
+    (kink_in, first_level, singular_ends): (
         &impl Fn(usize, f64, f64) -> Option<f64>,
-        impl Fn(usize, f64, f64) -> bool,
+        impl Fn(usize, f64, f64) -> Level,
         impl Fn(usize, f64, f64, f64) -> u8,
     ),
 ) -> AdaptiveResult {
@@ -462,18 +531,13 @@ pub fn integrate_adaptive_batched(
     let mut heap = BinaryHeap::new();
     let mut evaluations = 0;
     let mut total_error = DVec3::ZERO;
-    let new_segment = |lo: f64, hi: f64, weight: f64, tag: usize, f: &mut Nodes| {
+    let new_segment = |lo: f64, hi: f64, weight: f64, tag: usize, lowest: Level, f: &mut Nodes| {
         // A kink inside, or at an end (a segment split at a kink keeps a square-root endpoint
         // singularity), calls for the substitution: widen the test by a hair to see ends.
         let hair = (hi - lo) * 1e-9;
         let ends = singular_ends(tag, lo, hi, hair);
         let mut s = NestedSegment::new(lo, hi, weight, tag, ends);
-        s.raise_to(1, f);
-        let mut nodes = NESTED_NODES[0];
-        if !coarse_ok(tag, lo, hi) {
-            s.raise_to(2, f);
-            nodes = NESTED_NODES[1];
-        }
+        let nodes = s.raise_to(first_level(tag, lo, hi).max(lowest), f);
         s.error *= safety(&s);
         (s, nodes)
     };
@@ -481,7 +545,7 @@ pub fn integrate_adaptive_batched(
         if !(p.hi > p.lo) || !(p.weight > 0.0) {
             continue;
         }
-        let (s, n) = new_segment(p.lo, p.hi, p.weight, p.tag, f);
+        let (s, n) = new_segment(p.lo, p.hi, p.weight, p.tag, Level::R5, f);
         total_error += s.error;
         evaluations += n;
         heap.push(Priority(s.error.max_element(), segments.len()));
@@ -502,12 +566,11 @@ pub fn integrate_adaptive_batched(
         let Some(Priority(_, i)) = heap.pop() else {
             break;
         };
-        if segments[i].level == 1 {
+        if let Some(next) = segments[i].level.and_then(Level::next) {
             let s = &mut segments[i];
             total_error -= s.error;
-            s.raise_to(2, f);
+            evaluations += s.raise_to(next, f);
             s.error *= safety(s);
-            evaluations += NESTED_NODES[1] - NESTED_NODES[0];
             total_error += s.error;
             heap.push(Priority(s.error.max_element(), i));
             continue;
@@ -524,7 +587,7 @@ pub fn integrate_adaptive_batched(
         segments[i].alive = false;
         total_error -= s.error;
         for (lo, hi) in [(s.lo, mid), (mid, s.hi)] {
-            let (child, n) = new_segment(lo, hi, s.weight, s.tag, f);
+            let (child, n) = new_segment(lo, hi, s.weight, s.tag, Level::G7, f);
             total_error += child.error;
             evaluations += n;
             heap.push(Priority(child.error.max_element(), segments.len()));
@@ -601,6 +664,13 @@ mod tests {
             }
         };
         let coarse_ok = |tag: usize, _: f64, _: f64| tag == 0;
+        let first_level = |tag: usize, lo: f64, hi: f64| {
+            if coarse_ok(tag, lo, hi) {
+                Level::G7
+            } else {
+                Level::K15
+            }
+        };
         let mut batches = Vec::new();
         let batched = integrate_adaptive_batched(
             &pieces,
@@ -612,7 +682,7 @@ mod tests {
                     *v = g(tag, *u);
                 }
             },
-            (&kink_in, coarse_ok, ends),
+            (&kink_in, first_level, ends),
         );
         let one_by_one =
             integrate_adaptive_with_ends(&pieces, 1e-10, 1000, g, &kink_in, coarse_ok, ends);
@@ -734,6 +804,73 @@ mod tests {
     }
 
     #[test]
+    fn the_three_node_rule_is_exact_to_degree_3_and_not_4() {
+        let x3 = XGK[3];
+        let rule = |p: i32| R3[0] * 0f64.powi(p) + 2.0 * R3[1] * x3.powi(p);
+        for p in [0, 2] {
+            let exact = 2.0 / (p + 1) as f64;
+            assert!((rule(p) - exact).abs() < 1e-15, "x^{p}: {}", rule(p));
+        }
+        assert!((rule(4) - 2.0 / 5.0).abs() > 1e-2);
+        assert!(R3.iter().all(|&w| w > 0.0));
+    }
+
+    /// [`integrate_adaptive_batched`] with every piece started at `first`, one piece [lo, hi]
+    /// of weight 1; the sizes of the batches asked for, in order.
+    fn integrate_from(
+        first: Level,
+        (lo, hi): (f64, f64),
+        tol: f64,
+        g: impl Fn(f64) -> f64,
+    ) -> (AdaptiveResult, Vec<usize>) {
+        let mut batches = Vec::new();
+        let r = integrate_adaptive_batched(
+            &one_piece(lo, hi, 1.0),
+            tol,
+            10_000,
+            |_, us: &[f64], out: &mut [DVec3]| {
+                batches.push(us.len());
+                for (u, v) in us.iter().zip(out) {
+                    *v = DVec3::splat(g(*u));
+                }
+            },
+            (&|_, _, _| None, |_, _, _| first, |_, _, _, _| 0),
+        );
+        (r, batches)
+    }
+
+    #[test]
+    fn an_r5_start_stops_at_five_nodes_or_is_raised_to_g7_by_two_and_to_k15_by_eight() {
+        // e^x on [0, 0.5]: R5 is off by ~1e-9, its estimate against R3 is ~1e-4; G7's against
+        // R5 ~1e-8.
+        let exact = 0.5f64.exp() - 1.0;
+        let (loose, batches) = integrate_from(Level::R5, (0.0, 0.5), 1e-3, f64::exp);
+        assert_eq!((loose.evaluations, batches), (5, vec![5]));
+        assert!((loose.value.x - exact).abs() <= loose.error.x && loose.error.x <= 1e-3);
+        // Where R5's estimate does not meet tol, two more nodes make it G7: the same value and
+        // estimate, bit for bit, as a start at G7.
+        let (raised, batches) = integrate_from(Level::R5, (0.0, 0.5), 1e-6, f64::exp);
+        let (g7, g7_batches) = integrate_from(Level::G7, (0.0, 0.5), 1e-6, f64::exp);
+        assert_eq!((raised.evaluations, batches), (7, vec![5, 2]));
+        assert_eq!(g7_batches, vec![7]);
+        assert_eq!((raised.value, raised.error), (g7.value, g7.error));
+        // And eight more make it K15, before any split.
+        let (fine, batches) = integrate_from(Level::R5, (0.0, 0.5), 1e-13, f64::exp);
+        assert_eq!((fine.evaluations, fine.segments), (15, 1));
+        assert_eq!(batches, vec![5, 2, 8]);
+        assert!((fine.value.x - exact).abs() <= fine.error.x.max(1e-16));
+        // The halves of a split start at G7, not at R5.
+        let (split, batches) =
+            integrate_from(Level::R5, (0.0, 1.0), 1e-9, |x| (x - 0.37).abs().powf(1.5));
+        assert!(split.segments > 1);
+        assert_eq!(batches[..3], [5, 2, 8]);
+        assert!(
+            batches[3..].iter().all(|&n| n == 7 || n == 8),
+            "{batches:?}"
+        );
+    }
+
+    #[test]
     fn smooth_segments_stop_at_seven_nodes_and_a_coarse_refusal_starts_at_fifteen() {
         // e^x on [0, 0.5]: G7 is exact to ~1e-20, its estimate against the 5-node rule ~1e-8.
         let pieces = one_piece(0.0, 0.5, 1.0);
@@ -772,14 +909,18 @@ mod tests {
         ];
         for (i, (g, exact)) in cases.iter().enumerate() {
             for tol in [1e-3, 1e-6, 1e-9] {
-                let r = integrate_plain(0.0, 1.0, tol, g);
-                assert!(r.converged, "case {i} tol {tol}");
-                let actual = (r.value.x - exact).abs();
-                assert!(
-                    actual <= r.error.x,
-                    "case {i} tol {tol}: actual {actual:e} > estimate {:e}",
-                    r.error.x
-                );
+                let plain = integrate_plain(0.0, 1.0, tol, g);
+                // Started at R5 (as the volume renderer starts pieces of small weight).
+                let (from_r5, _) = integrate_from(Level::R5, (0.0, 1.0), tol, g);
+                for (r, start) in [(plain, "G7"), (from_r5, "R5")] {
+                    assert!(r.converged, "case {i} tol {tol} from {start}");
+                    let actual = (r.value.x - exact).abs();
+                    assert!(
+                        actual <= r.error.x,
+                        "case {i} tol {tol} from {start}: actual {actual:e} > estimate {:e}",
+                        r.error.x
+                    );
+                }
             }
         }
     }
