@@ -128,7 +128,9 @@ pub const COARSE_DEPTH: f64 = 0.25;
 /// the actual error exceeded err at one pixel channel (4.3e-6 against 1.1e-6). Limits of 1,
 /// 10, 100 and 1000 gave 5.8, 9.6, 12.7 and 13.3 % fewer shadow rays, and largest errors of
 /// 3.3e-7, 4.9e-7, 4.9e-7 and 2.0e-6 against a tol 1e-9 render (the last above the 7.7e-7
-/// that keeps adaptive ≥ 100× more accurate than Riemann-100, issue 10), all covered by err.
+/// that keeps adaptive ≥ 100× more accurate than Riemann-100, issue 10), all covered by err
+/// (measured with QUADPACK's factor 200 at every level, before `quadrature`'s
+/// `LOWER_AMPLIFICATION`).
 pub const R5_SHARE: f64 = 10.0;
 
 /// The interval tag of the whole camera ray's occluder list (`ShadowScratch::wide`): no
