@@ -1074,6 +1074,19 @@ mod tests {
         }
     }
 
+    /// A camera ray's sample at tol 1e-4 against its truth (a much tighter render): both
+    /// converged, err covers the difference (with the truth's own err), and err meets tol.
+    fn assert_honest(model: OpticalModel, (x, y): (f64, f64), got: &Sample, want: &Sample) {
+        assert!(!got.unconverged && !want.unconverged);
+        let actual = (got.radiance - want.radiance).abs();
+        assert!(
+            actual.cmple(got.error + want.error).all(),
+            "{model} ({x}, {y}): off by {actual}, err {}",
+            got.error
+        );
+        assert!(got.error.max_element() <= 1e-4 * (1.0 + 1e-9));
+    }
+
     /// The lit model's shadow rays under a dark roof are cut, and err covers the cut;
     /// single-scatter's are not (it traces the transmittance alone, exactly,
     /// `VolumeRenderer::shadow_transmittance`), and its err covers the rest.
@@ -1096,14 +1109,7 @@ mod tests {
                     "{model} ({x}, {y}): whether a shadow ray was cut"
                 );
                 let want = truth.radiance(&ray);
-                assert!(!got.unconverged && !want.unconverged);
-                let actual = (got.radiance - want.radiance).abs();
-                assert!(
-                    actual.cmple(got.error + want.error).all(),
-                    "{model} ({x}, {y}): off by {actual}, err {}",
-                    got.error
-                );
-                assert!(got.error.max_element() <= 1e-4 * (1.0 + 1e-9));
+                assert_honest(model, (x, y), &got, &want);
             }
         }
     }
@@ -1127,14 +1133,7 @@ mod tests {
                 let (got, want) = (r.radiance(&ray), truth.radiance(&ray));
                 rays += got.shadow_rays;
                 rays_no_r5 += no_r5.radiance(&ray).shadow_rays;
-                assert!(!got.unconverged && !want.unconverged);
-                let actual = (got.radiance - want.radiance).abs();
-                assert!(
-                    actual.cmple(got.error + want.error).all(),
-                    "{model} ({x}, {y}): off by {actual}, err {}",
-                    got.error
-                );
-                assert!(got.error.max_element() <= 1e-4 * (1.0 + 1e-9));
+                assert_honest(model, (x, y), &got, &want);
             }
             assert!(rays < rays_no_r5, "{model}: {rays} against {rays_no_r5}");
             eprintln!("{model}: {rays} shadow rays, {rays_no_r5} with every segment at G7");
