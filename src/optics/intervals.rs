@@ -292,10 +292,11 @@ fn clipped_spans(
 /// in (t_min, t_max), with no intervals built. Per interval it needs only σ = Σσᵢ and
 /// E = S·(1/σ), S = Σσᵢ·Cᵢ (summed in canonical order, as [`medium_of`]), and adds
 /// T·(1 − e^{−σΔ})·E as [`composite`](super::emission::composite) does without forming the
-/// albedo (consecutive intervals of the same E as one, `Accumulator::add_emission`). The order of the chord ends, and with it every interval's particles, σ and E, is
-/// kept between calls as a [`Layout`]; a shadow ray whose ends come in the same order (mostly
-/// the next node of the same quadrature segment: 71 % of the shadow rays on 1UUN lit) only
-/// checks that order and takes each interval's length from its own ends. More than 64 chords,
+/// albedo (consecutive intervals of the same E as one, `Accumulator::add_emission`). The
+/// order of the chord ends, and with it every interval's particles, σ and E, is kept between
+/// calls as a [`Layout`]; a shadow ray whose ends come in the same order (mostly the next node
+/// of the same quadrature segment: 71 % of the shadow rays on 1UUN lit) only checks that order
+/// and takes each interval's length from its own ends. More than 64 chords,
 /// or a set with a Θmax = 1 particle or an overflowing Σσᵢ, take [`composite_by_sweep`].
 fn composite_spans(
     hits: &[Hit],

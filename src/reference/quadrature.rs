@@ -23,8 +23,8 @@
 //! volume renderer also makes every kink a breakpoint before the first pass, so that no shadow
 //! falls unseen between the nodes of a segment.)
 //!
-//! **Two levels per segment** (and a third below them, see below). The 7 Gauss nodes are a subset of the 15 Kronrod nodes, so a
-//! segment is first integrated by G7 alone, whose estimate is its difference from the
+//! **Two levels per segment** (and a third below them, see below). The 7 Gauss nodes are a
+//! subset of the 15 Kronrod nodes, so a segment is first integrated by G7 alone, whose estimate is its difference from the
 //! interpolatory 5-node rule on five of its nodes (degree 5 against G7's 13, so for smooth
 //! integrands the estimate is far above G7's error), and raised to K15 by eight more nodes only
 //! where that does not meet the budget.
@@ -409,14 +409,15 @@ impl NestedSegment {
         }
         let fc = self.fv[14];
         let pair = |j: usize| self.fv[2 * j] + self.fv[2 * j + 1];
-        let g7 = WG[3] * fc + WG[0] * pair(1) + WG[1] * pair(3) + WG[2] * pair(5);
-        let r5 = WG7_SUB5[0] * fc + WG7_SUB5[1] * pair(1) + WG7_SUB5[2] * pair(3);
+        // Each rule only where its nodes have been evaluated.
+        let g7 = || WG[3] * fc + WG[0] * pair(1) + WG[1] * pair(3) + WG[2] * pair(5);
+        let r5 = || WG7_SUB5[0] * fc + WG7_SUB5[1] * pair(1) + WG7_SUB5[2] * pair(3);
         let (resk, resg, wc, used): (DVec3, DVec3, f64, &[(usize, f64)]) = match level {
             Level::R5 => {
                 let r3 = R3[0] * fc + R3[1] * pair(3);
-                (r5, r3, WG7_SUB5[0], &[(1, WG7_SUB5[1]), (3, WG7_SUB5[2])])
+                (r5(), r3, WG7_SUB5[0], &[(1, WG7_SUB5[1]), (3, WG7_SUB5[2])])
             }
-            Level::G7 => (g7, r5, WG[3], &[(1, WG[0]), (3, WG[1]), (5, WG[2])]),
+            Level::G7 => (g7(), r5(), WG[3], &[(1, WG[0]), (3, WG[1]), (5, WG[2])]),
             Level::K15 => {
                 let mut k15 = WGK[7] * fc;
                 for (j, w) in WGK[..7].iter().enumerate() {
@@ -431,7 +432,7 @@ impl NestedSegment {
                     (5, WGK[5]),
                     (6, WGK[6]),
                 ];
-                (k15, g7, WGK[7], used)
+                (k15, g7(), WGK[7], used)
             }
         };
         let mean = 0.5 * resk;
