@@ -93,6 +93,23 @@
 //! the nodes of a segment's level together (`quadrature::integrate_adaptive_batched`), and
 //! their shadow rays read that list once, each candidate tested against all of them in SIMD
 //! lanes (`Occluders::hits_batch`); the composites follow one by one, in node order.
+//!
+//! **Where the time goes** (1UUN chains A+B lit, the thesis's two lights, tol 1e-4, 128²;
+//! counted with a throwaway instrumented build, issue 10). About 1,970 of the 16,384 camera
+//! rays reach gas. Each light's integral over such a ray has 16 pieces (camera-ray
+//! intervals), which the 53 kinks inside them (of 87 in the ray's range) split into 69
+//! segments: the kinks make three quarters of the segments. 86 % of the 2.04 M shadow rays are
+//! the segments' first levels (6.4 nodes each), 9 % raise a segment to K15 and 5 % start the
+//! halves of a split. So the error estimate's pessimism costs little now: doubling each
+//! light's tol takes 4.7 % of the shadow rays off, quadrupling it 8.1 %. Nor are the kinks
+//! negligible ones: the transmittance from the kink's point to the sphere it grazes is above
+//! 0.1 at 60 % of them and above 0.01 at 85 %, and that times the camera ray's own
+//! transmittance is below 1e-5 at 9 %. With every segment at five nodes and none refined the
+//! count would fall by a third at most (starting every segment at R5 was measured and is not
+//! honest, [`R5_SHARE`]). So the cost is the number of kinks times about six shadow rays,
+//! times what one shadow ray costs: about 4,000 instructions. Of the render's instructions
+//! (callgrind, 64²), the ray–sphere tests take 15 %, keeping the layouts of chord ends 22 %
+//! and the exponentials 9 %; the rest is spread thin.
 
 use super::quadrature::{
     integrate_adaptive_batched, Level, Piece, BOTH_ENDS, HIGH_END, LOW_END, MAX_NODES,
@@ -125,13 +142,15 @@ pub const COARSE_DEPTH: f64 = 0.25;
 /// rather than at G7. Most segments of small weight or short extent converge there (96 % on
 /// 1UUN lit), and where R5's estimate were to miss a feature, the piece cannot hold more than
 /// a few tol. A start at R5 for every segment was measured and rejected: on 1UUN lit 128²
-/// the actual error exceeded err at one pixel channel (4.3e-6 against 1.1e-6). Limits of 1,
-/// 10, 100 and 1000 gave 5.8, 9.6, 12.7 and 13.3 % fewer shadow rays, and largest errors of
-/// 3.3e-7, 4.9e-7, 4.9e-7 and 2.0e-6 against a tol 1e-9 render (the last above the 7.7e-7
-/// that keeps adaptive ≥ 100× more accurate than Riemann-100, issue 10), all covered by err
-/// (measured with QUADPACK's factor 200 at every level, before `quadrature`'s
-/// `LOWER_AMPLIFICATION`, and with the halves of a split also started at R5; at 10 that made
-/// no difference: 2,131,315 shadow rays against 2,131,405).
+/// the actual error exceeded err at one pixel channel (4.3e-6 against 1.1e-6; taking the
+/// largest of three estimates against the three degree-3 rules on R5's nodes, instead of one,
+/// still left a pixel channel above its err, and the largest error at 1.1e-5). With the present code, 1UUN 128² lit (and with two
+/// point lights, one inside the gas), limits of 30, 100, 300 and 1000 take 2.4, 4.4, 5.3 and
+/// 5.5 % (2.1, 4.1, 5.3, 5.8 %) of the shadow rays off against 10, and give largest errors
+/// against a tol 1e-9 render of 5.2e-7, 5.1e-7, 9.1e-7 and 2.2e-6 (4.8e-7, 5.4e-7, 1.8e-6,
+/// 1.8e-6; at 10: 5.2e-7 and 4.8e-7), all covered by err; from 300 on the first is above the
+/// 7.7e-7 that keeps adaptive ≥ 100× more accurate than Riemann-100 (issue 10). 100 would
+/// save 4 % for a ten times weaker bound on what a missed feature could cost; 10 is kept.
 pub const R5_SHARE: f64 = 10.0;
 
 /// The interval tag of the whole camera ray's occluder list (`ShadowScratch::wide`): no
