@@ -909,7 +909,7 @@ impl Layout {
             Some(iv) if lo < n && iv.to == self.order[lo] => iv.mask,
             _ => 0,
         };
-        self.form_groups((lo, walk_end), open);
+        self.form_groups((lo, walk_end), open, &[]);
         let after = old.partition_point(|iv| (iv.at as usize) < tail_old);
         self.intervals
             .extend(old[after..].iter().map(|iv| moved(iv, shift)));
@@ -999,7 +999,7 @@ impl Layout {
             Some(iv) if lo < n && iv.to == self.order[lo] => iv.mask,
             _ => 0,
         };
-        self.form_groups((lo, end), open);
+        self.form_groups((lo, end), open, &[]);
         let tail = before.partition_point(|iv| (iv.at as usize) < end);
         self.intervals.extend_from_slice(&before[tail..]);
         true
@@ -1007,9 +1007,10 @@ impl Layout {
 
     /// The intervals from the groups that start at places `lo` (a group's start) up to `end`
     /// (the next group's start after them, or the order's length) of `order`, grouped by
-    /// `new_group`, where the open set before `lo` is `open`: pushed onto `intervals` as
-    /// [`Layout::form_intervals`] forms them, with their sums.
-    fn form_groups(&mut self, (lo, end): (usize, usize), mut open: u64) {
+    /// `new_group`, where the open set before `lo` is `open`: pushed onto `intervals`, with
+    /// their sums, each taken from one of `before` with the same open set within
+    /// [`BEFORE_REACH`] of its place where there is one (the same terms in the same order).
+    fn form_groups(&mut self, (lo, end): (usize, usize), mut open: u64, before: &[LayoutInterval]) {
         let n = self.order.len();
         let mut k = lo;
         while k < end.min(n) {
@@ -1029,7 +1030,15 @@ impl Layout {
                 }
             }
             if next < n && open != 0 {
-                let (sigma, emission) = self.sums(open);
+                let j = self.intervals.len();
+                let near = j.saturating_sub(BEFORE_REACH)..before.len().min(j + BEFORE_REACH + 1);
+                let kept = before
+                    .get(near)
+                    .and_then(|near| near.iter().find(|iv| iv.mask == open));
+                let (sigma, emission) = match kept {
+                    Some(iv) => (iv.sigma, iv.emission),
+                    None => self.sums(open),
+                };
                 if !sigma.is_finite() {
                     self.general = true;
                 }
@@ -1139,50 +1148,14 @@ impl Layout {
     /// open set within [`BEFORE_REACH`] of its place, where there is one. A sum that is not
     /// finite: the general sweep.
     fn form_intervals(&mut self, ends: &[f64], before: &[LayoutInterval]) {
-        self.new_group.clear();
         self.general = false;
-        let n = self.order.len();
-        let mut open = 0u64;
-        let mut k = 0;
-        while k < n {
-            let from = self.order[k];
-            let t = ends[from as usize];
-            let mut next = k;
-            while next < n && ends[self.order[next] as usize] == t {
-                self.new_group.push(next == k && k > 0);
-                let e = self.order[next];
-                let bit = self.bit[(e / 2) as usize];
-                if e % 2 == 1 {
-                    open &= !bit;
-                } else {
-                    open |= bit;
-                }
-                next += 1;
-            }
-            if next < n && open != 0 {
-                let j = self.intervals.len();
-                let near = j.saturating_sub(BEFORE_REACH)..before.len().min(j + BEFORE_REACH + 1);
-                let kept = before
-                    .get(near)
-                    .and_then(|near| near.iter().find(|iv| iv.mask == open));
-                let (sigma, emission) = match kept {
-                    Some(iv) => (iv.sigma, iv.emission),
-                    None => self.sums(open),
-                };
-                if !sigma.is_finite() {
-                    self.general = true;
-                }
-                self.intervals.push(LayoutInterval {
-                    from,
-                    to: self.order[next],
-                    sigma,
-                    emission,
-                    mask: open,
-                    at: k as u32,
-                });
-            }
-            k = next;
-        }
+        let order = &self.order;
+        self.new_group.clear();
+        self.new_group.extend(
+            (0..order.len())
+                .map(|k| k > 0 && ends[order[k] as usize] != ends[order[k - 1] as usize]),
+        );
+        self.form_groups((0, order.len()), 0, before);
     }
 }
 
