@@ -715,9 +715,9 @@ impl Layout {
         if to_place {
             self.push_term(at, &particles[members[at] as usize]);
         }
-        // The ends in the neighbour's order, renumbered, the new member's last.
-        // (An end position e is member e / 2's: the renumbering moves e by two from the
-        // changed member's ends on.)
+        // The ends in the neighbour's order, renumbered, the new member's last. An end
+        // position e is member e / 2's, so `renumber` moves e by two from the changed
+        // member's ends on (written on e itself: no division in this loop).
         let ends_from = 2 * at as u32;
         let renumber_end = |e: u32| match (inserted, e.cmp(&ends_from)) {
             (_, Ordering::Less) => Some(e),
@@ -726,17 +726,8 @@ impl Layout {
             (false, _) => Some(e - 2),
         };
         self.order.clear();
-        if inserted {
-            self.order.extend(
-                neighbour
-                    .order
-                    .iter()
-                    .map(|&e| e + 2 * u32::from(e >= ends_from)),
-            );
-        } else {
-            self.order
-                .extend(neighbour.order.iter().filter_map(|&e| renumber_end(e)));
-        }
+        self.order
+            .extend(neighbour.order.iter().filter_map(|&e| renumber_end(e)));
         // The changed member's bit: in this layout's canonical order where it was put in,
         // in the neighbour's where it was taken out.
         let changed = if inserted {

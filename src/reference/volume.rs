@@ -157,12 +157,13 @@ pub const COARSE_DEPTH: f64 = 0.25;
 /// the actual error exceeded err at one pixel channel (4.3e-6 against 1.1e-6; taking the
 /// largest of three estimates against the three degree-3 rules on R5's nodes, instead of one,
 /// still left a pixel channel above its err, and the largest error at 1.1e-5). With the
-/// present code, 1UUN 128² lit (and with two point lights, one inside the gas), limits of 30, 100, 300 and 1000 take 2.4, 4.4, 5.3 and
-/// 5.5 % (2.1, 4.1, 5.3, 5.8 %) of the shadow rays off against 10, and give largest errors
-/// against a tol 1e-9 render of 5.2e-7, 5.1e-7, 9.1e-7 and 2.2e-6 (4.8e-7, 5.4e-7, 1.8e-6,
-/// 1.8e-6; at 10: 5.2e-7 and 4.8e-7), all covered by err; from 300 on the first is above the
-/// 7.7e-7 that keeps adaptive ≥ 100× more accurate than Riemann-100 (issue 10). 100 would
-/// save 4 % for a ten times weaker bound on what a missed feature could cost; 10 is kept.
+/// present code, 1UUN 128² lit (and with two point lights, one inside the gas), limits of
+/// 30, 100, 300 and 1000 take 2.4, 4.4, 5.3 and 5.5 % (2.1, 4.1, 5.3, 5.8 %) of the shadow
+/// rays off against 10, and give largest errors against a tol 1e-9 render of 5.2e-7,
+/// 5.1e-7, 9.1e-7 and 2.2e-6 (4.8e-7, 5.4e-7, 1.8e-6, 1.8e-6; at 10: 5.2e-7 and 4.8e-7), all
+/// covered by err; from 300 on the first is above the 7.7e-7 that keeps adaptive ≥ 100× more
+/// accurate than Riemann-100 (issue 10). 100 would save 4 % for a ten times weaker bound on
+/// what a missed feature could cost; 10 is kept.
 pub const R5_SHARE: f64 = 10.0;
 
 /// The interval tag of the whole camera ray's occluder list (`ShadowScratch::wide`): no
