@@ -1,5 +1,5 @@
 //! `cargo bench --bench opaque`: primary + shadow rays per second of the opaque reference
-//! (DESIGN.md §2 opaque mode) for the thesis's particle counts, 512×512, two directional lights;
+//! (docs/design.md §2 opaque mode) for the thesis's particle counts, 512×512, two directional lights;
 //! and the BVH build for a million spheres. Plain timing (no harness): run it on a quiet machine
 //! and compare ratios within one run.
 

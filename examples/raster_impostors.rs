@@ -12,7 +12,7 @@
 //!
 //! The method is the classic one: each particle is a camera-facing quad that covers its
 //! silhouette; the fragment shader casts the pixel's ray (through the pixel centre, as pgt
-//! does), intersects it with the sphere, and applies DESIGN.md §2's emission model to the chord
+//! does), intersects it with the sphere, and applies docs/design.md §2's emission model to the chord
 //! alone, α = 1 − e^{−σ·chord}, colour C·α (premultiplied); particles are sorted by the depth of
 //! their centres and blended back to front over the background (`over`, premultiplied). Where
 //! spheres overlap this is not what the reference computes (it integrates the summed σ); that

@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Test vectors for pgt's comparison metrics (DESIGN.md §5), computed by independent oracles.
+"""Test vectors for pgt's comparison metrics (docs/design.md §5), computed by independent oracles.
 
 SSIM, MSE and PSNR come from scikit-image (the contract's oracle):
 

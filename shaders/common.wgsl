@@ -1,4 +1,4 @@
-// pgt prelude (DESIGN.md §4): the scene buffers, the camera of DESIGN.md §1, ray–sphere
+// pgt prelude (docs/design.md §4): the scene buffers, the camera of docs/design.md §1, ray–sphere
 // intersection, one BVH traversal (all hits, first hit, any hit) and per-particle emission
 // compositing. Every method file, pgt's own and users' (docs/user-shaders.md), is appended to
 // this prelude and defines
@@ -49,7 +49,7 @@ fn ray_at(ray: Ray, t: f32) -> vec3<f32> {
     return ray.origin + t * ray.direction;
 }
 
-// DESIGN.md §1: pixel (px, py), py down, through its centre:
+// docs/design.md §1: pixel (px, py), py down, through its centre:
 // a = (2(px+0.5)/W − 1)·(W/H)·tan(fov_y/2), b = (1 − 2(py+0.5)/H)·tan(fov_y/2).
 fn camera_ray(pixel: vec2<u32>) -> Ray {
     let w = f32(frame.width);
@@ -97,7 +97,7 @@ fn particle_transmittance(sigma: f32, length: f32) -> f32 {
     return exp(-sigma * max(length, 0.0));
 }
 
-// DESIGN.md §2, emission model for one particle alone: L = L_behind·T + C·(1 − T).
+// docs/design.md §2, emission model for one particle alone: L = L_behind·T + C·(1 − T).
 fn composite_emission(p: Particle, length: f32, behind: vec3<f32>) -> vec3<f32> {
     let t = particle_transmittance(p.sigma, length);
     return behind * t + p.color * (1.0 - t);
@@ -265,7 +265,7 @@ fn any_hit(ray: Ray, t_min: f32, t_max: f32, skip: u32) -> bool {
 }
 
 // The emission model along (t_min, t_max) of a ray with `background` behind t_max, one particle
-// at a time, back to front (DESIGN.md §4: overlaps ignored; exact where particles are disjoint).
+// at a time, back to front (docs/design.md §4: overlaps ignored; exact where particles are disjoint).
 fn emission_along(ray: Ray, t_min: f32, t_max: f32, background: vec3<f32>) -> vec3<f32> {
     return emission_along_skipping(ray, t_min, t_max, background, NO_PARTICLE);
 }
@@ -288,7 +288,7 @@ fn emission_along_skipping(ray: Ray, t_min: f32, t_max: f32, background: vec3<f3
     return radiance;
 }
 
-// What arrives at x from one light before any occlusion (DESIGN.md §1): the unit vector towards
+// What arrives at x from one light before any occlusion (docs/design.md §1): the unit vector towards
 // the light, the distance to it (T_FAR for directional lights) and E, or I/d² (I with
 // falloff = "none"). `valid` is false at a point light's own position.
 struct Incident {
@@ -314,7 +314,7 @@ fn light_incident(light: Light, x: vec3<f32>) -> Incident {
     return Incident(v / d, d, e, true);
 }
 
-// DESIGN.md §2 "lit": Q(x) = w·Σ_l L_l(x), L_l the emission model along the shadow ray from x
+// docs/design.md §2 "lit": Q(x) = w·Σ_l L_l(x), L_l the emission model along the shadow ray from x
 // towards light l with the light's E (or I/d²) as background; it includes the particle that
 // contains x. One shadow ray per light.
 fn lit_source(x: vec3<f32>) -> vec3<f32> {

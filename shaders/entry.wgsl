@@ -1,6 +1,6 @@
 // pgt entry point, appended after the method file: one invocation per pixel of the band
 // [row_begin, row_begin + row_count) of the image, one ray through the pixel centre
-// (DESIGN.md §1), the method's `shade`, the result into `output` (which holds the band only;
+// (docs/design.md §1), the method's `shade`, the result into `output` (which holds the band only;
 // pass 0 writes, later passes of a multi-pass method add), and the counters of `stats`.
 @compute @workgroup_size(WORKGROUP_SIDE, WORKGROUP_SIDE, 1)
 fn pgt_main(@builtin(global_invocation_id) gid: vec3<u32>) {

@@ -1,4 +1,4 @@
-// Method `opaque` (DESIGN.md §2 "Opaque mode", as src/reference/opaque.rs defines it): the first
+// Method `opaque` (docs/design.md §2 "Opaque mode", as src/reference/opaque.rs defines it): the first
 // sphere hit, Lambertian C/π plus normalised Blinn–Phong ks·(s+8)/(8π)·max(0, n·h)^s·cos, hard
 // shadows by one shadow ray per light through the BVH, plus ambient·C.
 

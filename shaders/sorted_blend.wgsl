@@ -1,4 +1,4 @@
-// Method `sorted-blend` (DESIGN.md §4): what rasterising renderers do with transparent particles
+// Method `sorted-blend` (docs/design.md §4): what rasterising renderers do with transparent particles
 // (3D Gaussian splatting, Mol* and MegaMol transparency). The particles a camera ray crosses are
 // sorted by the view-space depth of their centres, dot(centre − eye, forward) (the eye is the
 // origin of the camera-relative coordinates), and each is composited whole, back to front, with

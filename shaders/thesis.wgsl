@@ -1,6 +1,6 @@
-// Method `thesis` (DESIGN.md §4, thesis chapter 5): the particles a camera ray crosses, sorted by
+// Method `thesis` (docs/design.md §4, thesis chapter 5): the particles a camera ray crosses, sorted by
 // entry and composited one particle at a time (overlaps ignored). The first `n_exact` particles
-// from the eye use the lit model (DESIGN.md §2, thesis eq. 4.17) with `samples` midpoint-rule
+// from the eye use the lit model (docs/design.md §2, thesis eq. 4.17) with `samples` midpoint-rule
 // samples along their chord and one shadow ray per sample per light (`lit_source`: the emission
 // model along the shadow ray, the light as background); the rest, and every particle of an
 // emission-model scene, use the emission model's closed form.
@@ -11,7 +11,7 @@
 // see src/approx/dispatch.rs) and each pass adds its share.
 
 // Σ over samples j in [j_begin, j_end) of Q(x_j)·σ·e^{−σ(t_j − t0)}·Δt, t_j = t0 + (j + ½)Δt,
-// Δt = (t1 − t0)/samples: the midpoint rule for ∫ Q·σ·T dt (the σ factor of DESIGN.md §8).
+// Δt = (t1 − t0)/samples: the midpoint rule for ∫ Q·σ·T dt (the σ factor of docs/design.md §8).
 fn lit_samples(ray: Ray, p: Particle, t0: f32, t1: f32, j_begin: u32, j_end: u32) -> vec3<f32> {
     let n = max(method_param(PARAM_SAMPLES), 1u);
     let dt = (t1 - t0) / f32(n);

@@ -1,5 +1,5 @@
 //! Library error type. Every error that reaches the user names the file, the line (or byte offset)
-//! and the problem (DESIGN.md §6, §7); the CLI maps all of them to exit code 2.
+//! and the problem (docs/design.md §6, §7); the CLI maps all of them to exit code 2.
 
 use std::path::{Path, PathBuf};
 
@@ -107,7 +107,7 @@ pub fn line_of(text: &str, offset: usize) -> usize {
 }
 
 /// A TOML syntax or type error in the file `path` (whose contents are `text`) as an error that
-/// names the file and line (DESIGN.md §6 "Bad input"), quoting the offending line, since serde's
+/// names the file and line (docs/design.md §6 "Bad input"), quoting the offending line, since serde's
 /// message alone ("invalid length 2") does not name the field. Errors without a position (rare
 /// in toml 0.8) name the file only.
 pub fn toml_error(path: &Path, text: &str, e: &toml::de::Error) -> PgtError {

@@ -1,6 +1,6 @@
 //! pgt — particle ground truth.
 //!
-//! Data flows one way (DESIGN.md, STYLE.md): scene → geometry → optics → reference | approx →
+//! Data flows one way (docs/design.md, STYLE.md): scene → geometry → optics → reference | approx →
 //! metrics → report, with the command line on top. This file holds only module lines and
 //! re-exports.
 

@@ -1,4 +1,4 @@
-//! The `pgt` binary: parse, run, map the outcome to an exit code (DESIGN.md §7: 0 success,
+//! The `pgt` binary: parse, run, map the outcome to an exit code (docs/design.md §7: 0 success,
 //! 1 gate failed, 2 error).
 
 use clap::Parser;

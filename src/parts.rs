@@ -1,4 +1,4 @@
-//! A reference render cut into parts for a cluster (DESIGN.md §7: `pgt render SCENE --tile I/N
+//! A reference render cut into parts for a cluster (docs/design.md §7: `pgt render SCENE --tile I/N
 //! -o PART.exr` and `pgt merge PART... -o OUT`; issue 12), and their bit-identical merge.
 //!
 //! **Which pixels a part holds.** Part I of N (I 0-based, as Slurm's `$SLURM_ARRAY_TASK_ID` and
@@ -21,7 +21,7 @@
 //! | `pgtRows` | `y mod N = I` (the layout, for a human reading the header) |
 //! | `pgtRenderHash` | 128-bit FNV-1a of the loaded scene (camera, render settings with the command-line overrides, lights, particles, bit for bit), the options that change pixels (`--spp`, `--integrator`, `--samples`) and pgt's version |
 //!
-//! Every pixel is a pure function of the scene and those options (DESIGN.md §3), and a part goes
+//! Every pixel is a pure function of the scene and those options (docs/design.md §3), and a part goes
 //! through the same per-pixel code as a whole render ([`crate::reference::render_pixel`]), so
 //! the merge is bit-identical to a one-machine render, err layer included.
 

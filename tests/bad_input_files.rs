@@ -1,5 +1,5 @@
 //! Bad gate files, experiment files and user WGSL files get the treatment bad scenes get
-//! (DESIGN.md §6, issue 13 item 6): exit 2, a message naming the file and line (the file alone
+//! (docs/design.md §6, issue 13 item 6): exit 2, a message naming the file and line (the file alone
 //! where no line is meaningful: bytes that are not text) and the problem, and no output (no
 //! JSON summary, no report folder, no image).
 

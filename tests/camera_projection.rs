@@ -1,4 +1,4 @@
-//! `pgt camera --json` against the reference's camera (DESIGN.md §1 "Camera convention"): for
+//! `pgt camera --json` against the reference's camera (docs/design.md §1 "Camera convention"): for
 //! several scenes, square and not, points along the ray the reference sends through a pixel
 //! centre must project, through each API's view and projection matrices as the JSON gives them,
 //! to that pixel centre (px + 0.5, py + 0.5), and points anywhere in the view must project to

@@ -1,4 +1,4 @@
-//! End-to-end test of `pgt bench` (DESIGN.md §7): one small workload through the binary, the
+//! End-to-end test of `pgt bench` (docs/design.md §7): one small workload through the binary, the
 //! table it prints read back.
 
 use std::process::Command;

@@ -1,4 +1,4 @@
-//! End-to-end tests of `pgt render`: real files in, real files out, exit codes (DESIGN.md §7).
+//! End-to-end tests of `pgt render`: real files in, real files out, exit codes (docs/design.md §7).
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

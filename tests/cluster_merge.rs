@@ -1,4 +1,4 @@
-//! `pgt render --tile I/N` and `pgt merge` (issue 12, DESIGN.md §7): the merge of the parts is
+//! `pgt render --tile I/N` and `pgt merge` (issue 12, docs/design.md §7): the merge of the parts is
 //! bit-identical to the one-machine render, in every layer; bad merges exit 2, name the file and
 //! the problem, and write nothing.
 

@@ -1,4 +1,4 @@
-//! End-to-end tests of `pgt compare` (DESIGN.md §5, §7): the real binary, exit codes 0 / 1 / 2,
+//! End-to-end tests of `pgt compare` (docs/design.md §5, §7): the real binary, exit codes 0 / 1 / 2,
 //! the verdict, the JSON summary, gate files and the report folder.
 
 use pgt::image_io::{write_image, RgbImage};

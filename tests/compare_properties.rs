@@ -1,4 +1,4 @@
-//! Properties of the metrics that hold for any input (DESIGN.md §5), on random images:
+//! Properties of the metrics that hold for any input (docs/design.md §5), on random images:
 //! SSIM is symmetric and ≤ 1, identical images give exactly 1 and 0, a constant offset c gives
 //! RMSE |c| and max abs |c|, and the results do not depend on the thread count.
 

@@ -1,4 +1,4 @@
-//! The HTML report in a real headless browser (DESIGN.md §5 "Reports"): Debian's `chromium`
+//! The HTML report in a real headless browser (docs/design.md §5 "Reports"): Debian's `chromium`
 //! loads the page written by `pgt compare --report`, the page's inline script marks
 //! `<body data-pgt-images="ok">` once every `img` has decoded (naturalWidth > 0), `--dump-dom`
 //! shows the mark, and a screenshot is taken.
@@ -328,7 +328,7 @@ fn pixel_centre(
     (px, py)
 }
 
-/// DESIGN.md §5 "Interactive where a browser runs it": in headless chromium driven through
+/// docs/design.md §5 "Interactive where a browser runs it": in headless chromium driven through
 /// chromedriver, the report zooms (buttons and wheel, all panes together, nearest-neighbour
 /// pixels), pans, flips A/B by key and button, changes the exposure, and the pixel probe under
 /// a hovered pixel shows the reference, approximation, |a − r| and error estimate that the

@@ -1,6 +1,6 @@
 //! SSIM, MSE, PSNR and the error statistics against scikit-image / numpy vectors
 //! (tests/data/compare/ssim_vectors.json, written by scripts/ssim_vectors.py). The budget is
-//! 1e-6 absolute per channel and mean (DESIGN.md §5); f64 reordering costs ~1e-15, a real
+//! 1e-6 absolute per channel and mean (docs/design.md §5); f64 reordering costs ~1e-15, a real
 //! mismatch (wrong window, border mode, crop or constants) is ≥ 1e-4.
 
 use pgt::image_io::{read_image, RgbImage};

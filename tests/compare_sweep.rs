@@ -1,4 +1,4 @@
-//! End-to-end test of `pgt sweep` (DESIGN.md §5, §7): reference once (then from the cache), one
+//! End-to-end test of `pgt sweep` (docs/design.md §5, §7): reference once (then from the cache), one
 //! approximation per parameter combination, a report with a table and SVG plots, the GPU
 //! `thesis` method converging as its samples grow, and bad experiments refused with exit 2.
 
@@ -183,7 +183,7 @@ fn thesis_sweep_on_the_gpu_converges_with_samples() {
     }
     let dir = tempfile::tempdir().unwrap();
     // Disjoint spheres, lit model: the thesis's per-particle scheme converges to the reference
-    // as samples grow when n_exact covers every particle (DESIGN.md §4).
+    // as samples grow when n_exact covers every particle (docs/design.md §4).
     disjoint_scene(dir.path());
     let exp = dir.path().join("exp.toml");
     std::fs::write(
@@ -387,7 +387,7 @@ fn thesis_on_the_gpu_differs_from_thesis_cpu_by_float32_rounding_only() {
     assert!(causes[1]["rmse"].as_f64().unwrap() > 100.0 * float32, "{a}");
 }
 
-/// DESIGN.md §3: a reference pixel that does not converge is reported, not hidden, in a sweep
+/// docs/design.md §3: a reference pixel that does not converge is reported, not hidden, in a sweep
 /// too: the centre pixel's ray runs exactly through a point light inside gas. The count and the
 /// worst pixel are in `summary.json` and on stderr, also when the reference comes from the cache.
 #[test]

@@ -1,4 +1,4 @@
-//! `pgt approx` end to end (DESIGN.md §4, §7): the shipped example shaders run through
+//! `pgt approx` end to end (docs/design.md §4, §7): the shipped example shaders run through
 //! `--shader`, a broken shader gives exit 2 and the user's line, no adapter gives exit 2 and the
 //! message saying what to install.
 

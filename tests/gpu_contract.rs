@@ -1,4 +1,4 @@
-//! One definition of the CPU–GPU contract (DESIGN.md §4, STYLE.md "one side generates the
+//! One definition of the CPU–GPU contract (docs/design.md §4, STYLE.md "one side generates the
 //! other"): the constants, structs and bindings are generated from `src/approx/contract.rs` and
 //! `src/approx/layout.rs`; no file under `shaders/` may declare them again or write their
 //! numbers. No GPU needed.

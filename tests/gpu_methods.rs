@@ -1,4 +1,4 @@
-//! The GPU methods against exact answers (DESIGN.md §4), on whatever adapter wgpu finds
+//! The GPU methods against exact answers (docs/design.md §4), on whatever adapter wgpu finds
 //! (lavapipe in CI). Images are 48×48: lavapipe on two cores is slow.
 
 mod gpu_common;
@@ -56,7 +56,7 @@ fn emission_matches_the_exact_answer_on_disjoint_particles() {
         .filter(|p| (p[0] - bg[0]).abs() > 0.05)
         .count();
     assert!(covered > 300, "{covered}");
-    // And against the reference renderer (exact interval cutting, DESIGN.md §3).
+    // And against the reference renderer (exact interval cutting, docs/design.md §3).
     let r = reference::render(&s, &RenderOptions::default()).unwrap();
     let e = rmse(&gpu.image, &r.image);
     eprintln!("emission vs reference: RMSE {e:.3e}");

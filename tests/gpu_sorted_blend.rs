@@ -1,4 +1,4 @@
-//! The `sorted-blend` method (DESIGN.md §4) against the exact emission reference
+//! The `sorted-blend` method (docs/design.md §4) against the exact emission reference
 //! (`pgt::reference`, emission model) and an f64 oracle of what it claims to compute, on
 //! whatever adapter wgpu finds (lavapipe in CI).
 

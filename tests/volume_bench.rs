@@ -5,7 +5,7 @@
 //!
 //! 2,758 spheres (the particle count of the thesis's 1UUN protein), radii uniform in
 //! [1.2, 1.9] Å, centres uniform in a cube of 2758·20 Å³ (one atom per 20 Å³, about a protein's
-//! density), Θmax = 0.3, random colours; the camera frames the bounding sphere (DESIGN.md §1
+//! density), Θmax = 0.3, random colours; the camera frames the bounding sphere (docs/design.md §1
 //! default). Errors are against an adaptive render at tol 1e-8.
 
 mod volume_support;

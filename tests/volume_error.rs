@@ -1,4 +1,4 @@
-//! The quadrature's error estimate is honest (DESIGN.md §3): against a tol = 1e-10 render the
+//! The quadrature's error estimate is honest (docs/design.md §3): against a tol = 1e-10 render the
 //! actual error is within the estimate at ≥ 99.9 % of pixel channels, at tol = 1e-4 and 1e-6,
 //! and the summed estimate itself meets tol.
 
@@ -68,7 +68,7 @@ fn check_honest(name: &str, mut s: Scene, truth_tol: f64) {
         for (pix, (g, t)) in got.iter().zip(&truth).enumerate() {
             let reported = g.unconverged || t.unconverged;
             if reported {
-                // Reported (DESIGN.md §3); its err still has to cover the error, below.
+                // Reported (docs/design.md §3); its err still has to cover the error, below.
                 unconverged += 1;
             } else {
                 assert!(

@@ -1,4 +1,4 @@
-//! Closed-form oracles, limits and bad input for the volume renderer (DESIGN.md §2, §3).
+//! Closed-form oracles, limits and bad input for the volume renderer (docs/design.md §2, §3).
 
 mod volume_support;
 
@@ -13,7 +13,7 @@ use proptest::prelude::*;
 use volume_support::Rng;
 use volume_support::*;
 
-/// DESIGN.md §2: one particle alone gives exactly L = L_bg·T + C·(1 − T), T = e^{−σ·chord},
+/// docs/design.md §2: one particle alone gives exactly L = L_bg·T + C·(1 − T), T = e^{−σ·chord},
 /// along every ray; the chord comes from the distance b of the centre to the ray, 2√(r² − b²).
 #[test]
 fn one_sphere_emission_is_the_closed_form_along_every_ray() {
@@ -51,7 +51,7 @@ fn one_sphere_emission_is_the_closed_form_along_every_ray() {
     assert!(inside > 200);
 }
 
-/// Through the centre the transmittance is 1 − Θmax (DESIGN.md §1): black particle, white
+/// Through the centre the transmittance is 1 − Θmax (docs/design.md §1): black particle, white
 /// background, so L = T.
 #[test]
 fn through_the_centre_transmittance_is_one_minus_opacity() {
@@ -298,7 +298,7 @@ fn riemann_sums_converge_to_the_adaptive_reference() {
     }
 }
 
-/// DESIGN.md §3: the image (and its error layer) is bit-identical for any thread count.
+/// docs/design.md §3: the image (and its error layer) is bit-identical for any thread count.
 #[test]
 fn image_is_identical_for_any_thread_count() {
     let mut rng = Rng::new(9);

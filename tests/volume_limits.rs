@@ -1,4 +1,4 @@
-//! Huge σ (DESIGN.md §3, issue 10): where the skin depth 1/σ falls below the f64 resolution of
+//! Huge σ (docs/design.md §3, issue 10): where the skin depth 1/σ falls below the f64 resolution of
 //! the ray parameter, the reference converges to the Θmax = 1 limit (with its O(1/σ) remainder
 //! in err), never to a collapsed quadrature; also where two huge σ add up to ∞ in an overlap.
 
@@ -110,7 +110,7 @@ fn one_sphere(model: OpticalModel, sigma: f64) -> pgt::scene::Scene {
     s
 }
 
-/// DESIGN.md §3: a pixel that does not converge is reported, not hidden. The centre pixel's ray
+/// docs/design.md §3: a pixel that does not converge is reported, not hidden. The centre pixel's ray
 /// runs exactly through a point light inside gas (∫ dt/t² diverges there): the render counts it
 /// and names it as the worst, and the CLI's warning says so.
 #[test]

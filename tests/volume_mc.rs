@@ -1,4 +1,4 @@
-//! An independent Monte Carlo estimator of the volume integrals of DESIGN.md §2 (delta tracking
+//! An independent Monte Carlo estimator of the volume integrals of docs/design.md §2 (delta tracking
 //! for the free paths, ratio tracking for transmittances), with its own brute-force geometry: it
 //! shares nothing with the renderer but the scene types and `Light::incident_at`. The exact
 //! reference must agree with it within 4 standard errors on random overlapping scenes.

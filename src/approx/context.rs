@@ -1,14 +1,14 @@
-//! The GPU context (DESIGN.md §4): adapter selection, device and queue, and wgpu's errors turned
+//! The GPU context (docs/design.md §4): adapter selection, device and queue, and wgpu's errors turned
 //! into `PgtError::Gpu` instead of panics.
 //!
 //! wgpu's default handler for errors outside an error scope panics; pgt installs its own, which
 //! records the message, and wraps every fallible step in an error scope that is popped and
-//! reported. No adapter at all is a clear message and exit code 2 (DESIGN.md §4).
+//! reported. No adapter at all is a clear message and exit code 2 (docs/design.md §4).
 
 use crate::error::{PgtError, Result};
 use std::sync::{Arc, Mutex};
 
-/// The message DESIGN.md §4 asks for when no adapter exists.
+/// The message docs/design.md §4 asks for when no adapter exists.
 pub const NO_ADAPTER: &str =
     "no GPU adapter found: install mesa-vulkan-drivers (lavapipe) or a GPU driver";
 

@@ -1,4 +1,4 @@
-//! The one definition of the CPU–GPU contract (DESIGN.md §4): every number, binding index and
+//! The one definition of the CPU–GPU contract (docs/design.md §4): every number, binding index and
 //! struct that Rust and WGSL share is defined here or in [`super::layout`], and
 //! [`wgsl_declarations`] writes the WGSL for it, which [`super::shader`] prepends to every
 //! program. `shaders/` uses the names only; `tests/gpu_contract.rs` checks that no file there
@@ -32,7 +32,7 @@ pub const NO_PARTICLE: u32 = u32::MAX;
 /// Light kinds in `GpuLight::kind`.
 pub const LIGHT_DIRECTIONAL: u32 = 0;
 pub const LIGHT_POINT: u32 = 1;
-/// Point-light falloffs in `GpuLight::falloff` (DESIGN.md §1).
+/// Point-light falloffs in `GpuLight::falloff` (docs/design.md §1).
 pub const FALLOFF_INVERSE_SQUARE: u32 = 0;
 pub const FALLOFF_NONE: u32 = 1;
 

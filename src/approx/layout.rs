@@ -1,4 +1,4 @@
-//! The scene as the GPU sees it (DESIGN.md §4): one Rust definition of every struct that the
+//! The scene as the GPU sees it (docs/design.md §4): one Rust definition of every struct that the
 //! WGSL prelude uses, with explicit padding, so that `bytemuck` can upload them byte for byte.
 //! The WGSL declarations are *generated* from these definitions ([`gpu_struct!`] records each
 //! field's WGSL type, [`super::contract::wgsl_declarations`] writes them); `tests/gpu_layout.rs`
@@ -108,7 +108,7 @@ gpu_struct! {
 }
 
 gpu_struct! {
-    /// WGSL `struct Light`, 32 bytes (DESIGN.md §1).
+    /// WGSL `struct Light`, 32 bytes (docs/design.md §1).
     plain "Light" pub struct GpuLight {
         /// Directional: the unit direction the light travels. Point: camera-relative position.
         pub vector: [f32; 3],
@@ -125,7 +125,7 @@ gpu_struct! {
     /// WGSL `struct Frame` (the uniform buffer), 144 bytes: camera, background, render settings
     /// and the method's parameters.
     plain "Frame" pub struct GpuFrame {
-        /// Camera frame f, r, u of DESIGN.md §1 (the camera is at the origin).
+        /// Camera frame f, r, u of docs/design.md §1 (the camera is at the origin).
         pub forward: [f32; 3],
         /// tan(fov_y / 2).
         pub tan_half_fov: f32,
@@ -137,7 +137,7 @@ gpu_struct! {
         pub background: [f32; 3],
         pub light_count: u32,
         pub particle_count: u32,
-        /// Lit model light weight w (DESIGN.md §2: 1/m or 1), from
+        /// Lit model light weight w (docs/design.md §2: 1/m or 1), from
         /// [`crate::optics::source::light_weight`].
         pub light_weight: f32,
         /// Opaque-mode ambient factor.
@@ -314,7 +314,7 @@ pub fn bvh_depth(bvh: &Bvh) -> u32 {
 }
 
 impl GpuFrame {
-    /// The frame uniform of a scene: camera of DESIGN.md §1, the render settings and the
+    /// The frame uniform of a scene: camera of docs/design.md §1, the render settings and the
     /// method's parameter values by slot (at most [`PARAM_SLOTS`]; the caller validates).
     pub fn new(scene: &Scene, params: &[u32]) -> GpuFrame {
         let cam = &scene.camera;

@@ -1,4 +1,4 @@
-//! The GPU approximation renderer (DESIGN.md §4): wgpu compute shaders over the same scene,
+//! The GPU approximation renderer (docs/design.md §4): wgpu compute shaders over the same scene,
 //! camera and pixel sampling as the reference, in f32. pgt exists to measure approximations;
 //! this module runs them.
 //!

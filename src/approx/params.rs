@@ -1,4 +1,4 @@
-//! Method parameters (DESIGN.md §4: "methods, chosen by name, each a documented set of
+//! Method parameters (docs/design.md §4: "methods, chosen by name, each a documented set of
 //! parameters"): what a parameter is ([`ParamSpec`]), which method runs ([`Method`]) and the
 //! values chosen for it by name ([`ApproxParams`]), validated against the method's specs. The
 //! values travel to the GPU in `GpuFrame::params`, slot k for the k-th parameter, so a new

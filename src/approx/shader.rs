@@ -1,7 +1,7 @@
 //! WGSL programs: the declarations generated from the CPU–GPU contract
 //! ([`super::contract::wgsl_declarations`]), the method's parameter slot names, the prelude
 //! `shaders/common.wgsl`, one method file and the entry point `shaders/entry.wgsl`,
-//! concatenated, then parsed and validated with naga before any pipeline exists (DESIGN.md §4). Errors name the file the offending line came from and its line in
+//! concatenated, then parsed and validated with naga before any pipeline exists (docs/design.md §4). Errors name the file the offending line came from and its line in
 //! *that* file, so a user's mistake points at the user's line, not at the concatenation.
 
 use crate::error::{PgtError, Result};

@@ -1,4 +1,4 @@
-//! Users' own methods (DESIGN.md §4, docs/user-shaders.md): a WGSL file that defines
+//! Users' own methods (docs/design.md §4, docs/user-shaders.md): a WGSL file that defines
 //! `fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32>` and may use everything the prelude
 //! `shaders/common.wgsl` declares. Errors point at the user's file and line
 //! ([`super::shader::ShaderProgram::position`] maps the concatenated source back).

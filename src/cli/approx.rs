@@ -1,4 +1,4 @@
-//! `pgt approx SCENE --method thesis --samples 100 --n-exact 5 -o OUT` (DESIGN.md §4, §7): the
+//! `pgt approx SCENE --method thesis --samples 100 --n-exact 5 -o OUT` (docs/design.md §4, §7): the
 //! GPU approximation, or a user's method with `--shader FILE.wgsl`. The methods and their
 //! parameters come from the registry (`crate::approx::methods`); `--list-methods` prints it.
 
@@ -10,7 +10,7 @@ use clap::builder::PossibleValuesParser;
 use clap::Args;
 use std::path::PathBuf;
 
-/// `pgt approx` (DESIGN.md §7).
+/// `pgt approx` (docs/design.md §7).
 #[derive(Debug, Args)]
 pub struct ApproxArgs {
     /// Scene file (.toml) or a bare particle file.
@@ -114,7 +114,7 @@ fn describe_params(method: &Method, values: &[(String, u32)]) -> String {
 
 /// A spinner with the elapsed time while the GPU works (a long approximation, e.g. `thesis`
 /// with many samples on lavapipe, runs for minutes in passes the CLI cannot see into); shown only
-/// when stderr is a terminal (DESIGN.md §7), cleared before the summary line.
+/// when stderr is a terminal (docs/design.md §7), cleared before the summary line.
 fn approx_spinner(params: &ApproxParams) -> indicatif::ProgressBar {
     let method = match &params.method {
         Some(m) => m.name(),
@@ -149,8 +149,8 @@ fn pass_message(current: &str, p: approx::dispatch::PassProgress) -> String {
     }
 }
 
-/// Loads the scene, runs the approximation (DESIGN.md §4), writes the image and prints the
-/// one-line summary with the adapter and the GPU time (DESIGN.md §7).
+/// Loads the scene, runs the approximation (docs/design.md §4), writes the image and prints the
+/// one-line summary with the adapter and the GPU time (docs/design.md §7).
 pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
     if args.list_methods {
         print!("{}", methods::markdown_table());

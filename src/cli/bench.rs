@@ -1,5 +1,5 @@
 //! `pgt bench`: the speed of the exact reference on standard workloads, as one table of ratios
-//! (DESIGN.md §7), so that one run on a noisy machine shows what changed.
+//! (docs/design.md §7), so that one run on a noisy machine shows what changed.
 //!
 //! | workload | scene |
 //! |---|---|
@@ -9,7 +9,7 @@
 //! | `million-lit` | the same, lit (not in the default list: minutes on two cores) |
 //! | `1uun-scatter` | 1UUN as `1uun`, single-scatter model, two point lights: one at the centre of the particles' bounding sphere (inside the gas) and one above it (not in the default list) |
 //!
-//! Every scene is the bare-file default (DESIGN.md §1): the camera frames the bounding sphere,
+//! Every scene is the bare-file default (docs/design.md §1): the camera frames the bounding sphere,
 //! the thesis's two directional lights (green down, blue up), black background, Θmax = 0.5, lit
 //! model, `tol` 1e-4. Each lit workload is rendered three times: adaptive (the reference), the
 //! thesis's Riemann sums with 100 samples per interval, and the emission model, and the table
@@ -298,7 +298,7 @@ fn inside_and_above(particles: &[Particle]) -> Vec<Light> {
     ]
 }
 
-/// 1UUN chains A and B with the bare-file defaults (DESIGN.md §1), through the scene loader.
+/// 1UUN chains A and B with the bare-file defaults (docs/design.md §1), through the scene loader.
 fn protein_scene(pdb: &Path, size: u32) -> anyhow::Result<Scene> {
     let text = format!(
         "[render]\ntol = {TOL:e}\n\n[defaults]\nopacity = {OPACITY}\n\n\
@@ -315,7 +315,7 @@ fn protein_scene(pdb: &Path, size: u32) -> anyhow::Result<Scene> {
         .with_context(|| format!("loading {}", pdb.display()))
 }
 
-/// The default scene of a bare particle file (DESIGN.md §1) around `particles`, lit, tol 1e-4.
+/// The default scene of a bare particle file (docs/design.md §1) around `particles`, lit, tol 1e-4.
 fn bare_scene(particles: Vec<Particle>, size: u32) -> Scene {
     Scene {
         source: PathBuf::from("bench"),

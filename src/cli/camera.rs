@@ -1,4 +1,4 @@
-//! `pgt camera SCENE [--json]` (DESIGN.md §7): the scene's camera (after default framing) as a
+//! `pgt camera SCENE [--json]` (docs/design.md §7): the scene's camera (after default framing) as a
 //! rasterising engine wants it: eye, basis, fov, size, the pixel-centre convention, the view
 //! matrix and a projection matrix per graphics API with near/far from the scene's bounds
 //! ([`crate::geometry::projection`]).

@@ -1,4 +1,4 @@
-//! `pgt compare REF APPROX`: metrics, maps, report and gates (DESIGN.md §5, §7).
+//! `pgt compare REF APPROX`: metrics, maps, report and gates (docs/design.md §5, §7).
 //!
 //! Prints a one-line verdict on stdout; `--json F` writes the summary (`-` = stdout, then the
 //! verdict goes to stderr); `--report DIR` writes the HTML page and maps. Exit 0 when every gate
@@ -166,7 +166,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
     })
 }
 
-/// The reference's per-pixel error estimate: the `err` layer of a reference EXR (DESIGN.md §3,
+/// The reference's per-pixel error estimate: the `err` layer of a reference EXR (docs/design.md §3,
 /// §7), when the whole image is compared (no `--layer`) and the file has one.
 fn reference_estimate(reference: &Path, layer: Option<&str>) -> Option<RgbImage> {
     let is_exr = reference
@@ -193,7 +193,7 @@ fn parse_exposures(s: &str) -> Result<(f32, f32), String> {
 }
 
 /// An image file, or a scene file (`.toml`) rendered on the fly by the exact reference with its
-/// default options (DESIGN.md §5 "Inputs: … or scenes rendered on the fly").
+/// default options (docs/design.md §5 "Inputs: … or scenes rendered on the fly").
 /// Whether a path names a scene (`.toml`) rather than an image.
 fn is_scene(path: &Path) -> bool {
     path.extension()

@@ -1,4 +1,4 @@
-//! `pgt export SCENE -o particles.csv|.ply` (DESIGN.md §7): the resolved particles — centre,
+//! `pgt export SCENE -o particles.csv|.ply` (docs/design.md §7): the resolved particles — centre,
 //! radius, linear colour, extinction σ and opacity Θmax — exactly as pgt renders them (after
 //! includes, defaults, `radius_scale`, filters and σ = λκ or −ln(1−Θmax)/(2r)), so that an
 //! outside renderer draws the same data.
@@ -12,7 +12,7 @@
 //! * **PLY**: `binary_little_endian 1.0`, one `vertex` element per particle with `double`
 //!   properties `x y z radius red green blue opacity sigma`; σ = ∞ is the IEEE 754 +∞ double.
 //!
-//! Θmax = 1 − e^{−2rσ} (DESIGN.md §1 inverted; for a particle given by κ it is the opacity that
+//! Θmax = 1 − e^{−2rσ} (docs/design.md §1 inverted; for a particle given by κ it is the opacity that
 //! the resolved σ has along a diameter).
 
 use super::Outcome;
@@ -64,7 +64,7 @@ pub const COLUMNS: [&str; 9] = [
     "x", "y", "z", "radius", "red", "green", "blue", "opacity", "sigma",
 ];
 
-/// Θmax = 1 − e^{−2rσ}, the opacity along a diameter (DESIGN.md §1); 1 for σ = ∞. `expm1` keeps
+/// Θmax = 1 − e^{−2rσ}, the opacity along a diameter (docs/design.md §1); 1 for σ = ∞. `expm1` keeps
 /// small opacities exact.
 pub fn opacity_of(p: &Particle) -> f64 {
     if p.sigma == f64::INFINITY {

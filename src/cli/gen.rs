@@ -1,4 +1,4 @@
-//! `pgt gen random --count N --seed S [--box …] [--radius a..b] -o FILE` (DESIGN.md §7): the
+//! `pgt gen random --count N --seed S [--box …] [--radius a..b] -o FILE` (docs/design.md §7): the
 //! synthetic random set of [`crate::formats::random`], written as CSV, atomically.
 
 use super::Outcome;

@@ -1,4 +1,4 @@
-//! `pgt info FILE [--json]` (DESIGN.md §7): particle count, bounds, radius range, colours and
+//! `pgt info FILE [--json]` (docs/design.md §7): particle count, bounds, radius range, colours and
 //! warnings of a particle file (any format pgt reads) or of a scene file (`.toml`, loaded and
 //! validated with [`Scene::load`], so its includes count too).
 

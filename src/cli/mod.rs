@@ -1,4 +1,4 @@
-//! The `pgt` command line (DESIGN.md §7): one file per subcommand. Every subcommand returns an
+//! The `pgt` command line (docs/design.md §7): one file per subcommand. Every subcommand returns an
 //! [`Outcome`]; `main` maps it and errors to exit codes 0 / 1 / 2.
 
 pub mod approx;

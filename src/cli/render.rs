@@ -1,4 +1,4 @@
-//! `pgt render SCENE -o OUT`: the exact reference (DESIGN.md §3, §7).
+//! `pgt render SCENE -o OUT`: the exact reference (docs/design.md §3, §7).
 
 use super::Outcome;
 use crate::image_io::write_image;
@@ -108,7 +108,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
     Ok(Outcome::Success)
 }
 
-/// DESIGN.md §3: a pixel that does not converge is reported, not hidden. The count and the pixel
+/// docs/design.md §3: a pixel that does not converge is reported, not hidden. The count and the pixel
 /// with the largest error estimate, or `None` when every pixel reached `tol`.
 pub fn unconverged_warning(stats: &reference::RenderStats, tol: f64) -> Option<String> {
     let (x, y, e) = stats.worst_unconverged?;

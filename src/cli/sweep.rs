@@ -1,4 +1,4 @@
-//! `pgt sweep EXPERIMENT.toml --report DIR` (DESIGN.md §5, §7): argument handling only. The
+//! `pgt sweep EXPERIMENT.toml --report DIR` (docs/design.md §5, §7): argument handling only. The
 //! experiment format and the running are in [`crate::sweep`], the page, plots and JSON in
 //! [`crate::report::sweep_page`].
 
@@ -26,7 +26,7 @@ pub struct SweepArgs {
 
 /// Runs the experiment and writes the report. On stderr: a line for the reference and one per
 /// finished run, counted (`[2/6] thesis samples=4: …`); where stderr is a terminal, also a bar
-/// of runs done out of the total with the run in progress (DESIGN.md §7 "Long work shows a
+/// of runs done out of the total with the run in progress (docs/design.md §7 "Long work shows a
 /// progress bar on stderr when it is a terminal").
 pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
     let mut experiment = Experiment::load(&args.experiment)?;
@@ -88,7 +88,7 @@ impl RunLines {
                         None => "from the cache".into(),
                     }
                 ));
-                // DESIGN.md §3: a pixel that does not converge is reported, not hidden.
+                // docs/design.md §3: a pixel that does not converge is reported, not hidden.
                 if let Some(u) = r.unconverged {
                     if let Some((x, y, e)) = u.worst {
                         self.line(format!(

@@ -1,5 +1,5 @@
 //! What PDB and mmCIF share once their syntax is read: a list of atoms, and the selection and
-//! colouring of DESIGN.md §1 / §6 (model, alternate locations, chains, waters, hydrogens,
+//! colouring of docs/design.md §1 / §6 (model, alternate locations, chains, waters, hydrogens,
 //! `color_by`).
 
 use super::elements::{element_color, element_radius, srgb8_hex_to_linear, Element};

@@ -1,4 +1,4 @@
-//! Particle file formats (DESIGN.md §6). Each format turns a file's bytes into
+//! Particle file formats (docs/design.md §6). Each format turns a file's bytes into
 //! [`ParticleRecord`]s with the line (or byte offset) each came from, so that validation can
 //! point at it.
 //!
@@ -11,7 +11,7 @@
 //!
 //! **One loading path.** [`load_particles`] (a file) and [`load_bytes`] (bytes already read) run
 //! the reader and then, for every format alike: `radius_scale`, `color_by = "uniform"`, the
-//! refusal of a file that yields no particles (DESIGN.md §1), and the check of every record.
+//! refusal of a file that yields no particles (docs/design.md §1), and the check of every record.
 
 pub mod atoms;
 pub mod elements;
@@ -186,7 +186,7 @@ pub fn load_particles(spec: &IncludeSpec) -> Result<LoadedParticles> {
 
 /// Parses a file's bytes as `format` and applies what every format shares: `radius_scale`,
 /// `color_by = "uniform"` (no particle keeps a colour of its own), the refusal of a file with
-/// no particles (DESIGN.md §1: an error naming the file), and [`check_records`]. `spec.path`
+/// no particles (docs/design.md §1: an error naming the file), and [`check_records`]. `spec.path`
 /// names the file in messages.
 pub fn load_bytes(spec: &IncludeSpec, format: &Format, bytes: &[u8]) -> Result<LoadedParticles> {
     let mut loaded = (format.read)(spec, bytes)?;

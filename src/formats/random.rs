@@ -1,4 +1,4 @@
-//! The synthetic random set (DESIGN.md §6, §7: `pgt gen random`). The thesis evaluates a
+//! The synthetic random set (docs/design.md §6, §7: `pgt gen random`). The thesis evaluates a
 //! "randomly generated data set of 73,642 particles" (§6) without saying how it was drawn; pgt
 //! draws centres uniformly in an axis-aligned box, radii uniformly in [r_min, r_max] and colours
 //! uniformly in [0, 1]³ (linear RGB), in that order per particle, from SplitMix64 (Steele, Lea &

@@ -1,4 +1,4 @@
-//! What every format delivers and what an `[[include]]` asks of it (DESIGN.md §1, §6): the
+//! What every format delivers and what an `[[include]]` asks of it (docs/design.md §1, §6): the
 //! [`ParticleRecord`] before defaults and validation, and the [`IncludeSpec`] with its selections.
 //! They live here, not in `scene`, so that `formats` depends on nothing above it: the scene
 //! reads particle files, particle files know nothing of scenes.
@@ -38,7 +38,7 @@ fn one() -> f64 {
     1.0
 }
 
-/// `[[include]]`: particles from a file (DESIGN.md §1, §6). The path is relative to the scene
+/// `[[include]]`: particles from a file (docs/design.md §1, §6). The path is relative to the scene
 /// file. Format-specific selections are ignored by formats they do not apply to.
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]

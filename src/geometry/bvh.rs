@@ -1,4 +1,4 @@
-//! A bounding volume hierarchy over spheres, built with binned SAH (DESIGN.md §3).
+//! A bounding volume hierarchy over spheres, built with binned SAH (docs/design.md §3).
 //!
 //! Nodes live in one flat `Vec` (the GPU side flattens the same array into a storage buffer);
 //! memory is O(n): at most 2n − 1 nodes of 56 bytes and one u32 index per sphere.

@@ -1,4 +1,4 @@
-//! The pinhole camera of DESIGN.md §1 "Camera convention".
+//! The pinhole camera of docs/design.md §1 "Camera convention".
 
 use super::Ray;
 use glam::DVec3;

@@ -1,4 +1,4 @@
-//! Rays, the stable ray–sphere intersection, the pinhole camera and the BVH (DESIGN.md §1, §3).
+//! Rays, the stable ray–sphere intersection, the pinhole camera and the BVH (docs/design.md §1, §3).
 
 pub mod bvh;
 pub mod camera;

@@ -1,4 +1,4 @@
-//! The camera of DESIGN.md §1 as the matrices a rasterising engine wants: a right-handed view
+//! The camera of docs/design.md §1 as the matrices a rasterising engine wants: a right-handed view
 //! matrix and a perspective projection per graphics API, with near/far planes from the scene's
 //! bounds, so that an outside renderer draws exactly the frame pgt's reference draws.
 //!
@@ -6,7 +6,7 @@
 //! ndc = clip.xyz / clip.w, each API maps ndc to window coordinates in its own way (see
 //! [`GraphicsApi::pixel_of_ndc`]); in all of them the pixel (px, py) of pgt's image, py down, has
 //! its centre at window coordinate (px + 0.5, py + 0.5) measured from the image's top-left corner,
-//! which is exactly where DESIGN.md §1 sends its ray and where rasterisers sample fragments.
+//! which is exactly where docs/design.md §1 sends its ray and where rasterisers sample fragments.
 //!
 //! The projection is derived from pgt's frame, not the other way round: with view-space
 //! coordinates (x, y, z) = (r·v, u·v, −f·v) of a vector v from the eye, the reference's ray
@@ -131,7 +131,7 @@ pub fn near_far(camera: &Camera, spheres: impl IntoIterator<Item = (DVec3, f64)>
     (near, far)
 }
 
-/// The view matrix of DESIGN.md §1's camera frame: world → view space, right-handed, the camera
+/// The view matrix of docs/design.md §1's camera frame: world → view space, right-handed, the camera
 /// at the origin looking down −z with +x = r (right) and +y = u (up). Rows: r, u, −f, with the
 /// translation −(r·eye, u·eye, −f·eye). Equal to glam's `look_at_rh(eye, look_at, up)`.
 pub fn view_matrix(camera: &Camera) -> DMat4 {
@@ -225,7 +225,7 @@ pub struct ProjectionJson {
     pub matrix: MatrixJson,
 }
 
-/// What `pgt camera --json` prints: DESIGN.md §1's camera and the matrices of every API.
+/// What `pgt camera --json` prints: docs/design.md §1's camera and the matrices of every API.
 #[derive(Debug, Clone, serde::Serialize, serde::Deserialize)]
 pub struct CameraJson {
     /// Eye position (world, metres).
@@ -263,7 +263,7 @@ pub struct CameraJson {
     pub background: [f64; 3],
 }
 
-/// DESIGN.md §1's pixel-centre convention, in words.
+/// docs/design.md §1's pixel-centre convention, in words.
 pub const PIXEL_CONVENTION: &str = "pixel (px, py), px to the right and py down (row 0 is the \
 top), is sampled by one ray through its centre (px + 0.5, py + 0.5): a = (2(px+0.5)/W - 1)·\
 (W/H)·tan(fov_y/2), b = (1 - 2(py+0.5)/H)·tan(fov_y/2), direction = normalize(f + a·r + b·u); \

@@ -1,4 +1,4 @@
-//! The ray–sphere intersection in f64 (DESIGN.md §3).
+//! The ray–sphere intersection in f64 (docs/design.md §3).
 //!
 //! The textbook form solves t² + 2(f·d)t + |f|² − r² = 0 with f = o − c; for |o| ≫ r the term
 //! |f|² − r² loses every significant digit. Instead we project the centre on the ray

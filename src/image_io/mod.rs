@@ -1,4 +1,4 @@
-//! Images in memory and on disk (DESIGN.md §7): EXR (linear float32 `R`, `G`, `B`, plus extra
+//! Images in memory and on disk (docs/design.md §7): EXR (linear float32 `R`, `G`, `B`, plus extra
 //! layers such as the reference's `err.R/G/B`) and PNG (8-bit sRGB of the linear image).
 //! Every write is atomic: a temporary file in the target folder, renamed at the end.
 

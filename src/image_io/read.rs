@@ -1,4 +1,4 @@
-//! Reading images for comparison (DESIGN.md §5 "Inputs", §7): EXR (linear float; channels `R`,
+//! Reading images for comparison (docs/design.md §5 "Inputs", §7): EXR (linear float; channels `R`,
 //! `G`, `B`, or `LAYER.R/G/B`) and PNG (8 or 16 bit, sRGB-decoded to linear; grey PNGs are
 //! replicated into R, G, B; alpha is ignored). Every error names the file.
 

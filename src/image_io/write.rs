@@ -111,7 +111,7 @@ fn check_finite(path: &Path, image: &RgbImage, layers: &[(&str, &RgbImage)]) -> 
     Ok(())
 }
 
-/// Writes a file atomically (DESIGN.md §7: never a half-written output): `write` fills a
+/// Writes a file atomically (docs/design.md §7: never a half-written output): `write` fills a
 /// temporary file in the target folder, which is flushed, synced and renamed to `path` only when
 /// it succeeded; on any error the temporary file is removed. The result is readable by anyone
 /// (0644), as a plain file would be, not 0600 as temporary files are.

@@ -1,4 +1,4 @@
-//! Pixel error statistics of DESIGN.md §5, per channel, in f64: mean squared error, RMSE, PSNR,
+//! Pixel error statistics of docs/design.md §5, per channel, in f64: mean squared error, RMSE, PSNR,
 //! largest absolute error with the pixel where it occurs, mean absolute error and mean relative
 //! error.
 //!
@@ -39,7 +39,7 @@ struct RowSums {
     max: [(f64, usize); 3],
 }
 
-/// Error statistics of the three channels (DESIGN.md §5). Sizes must agree (checked by the
+/// Error statistics of the three channels (docs/design.md §5). Sizes must agree (checked by the
 /// caller); values must be finite (checked by the caller).
 pub fn channel_errors(
     reference: &RgbImage,
@@ -106,7 +106,7 @@ pub fn channel_errors(
 }
 
 /// The approximation's error measured against the reference's own uncertainty: the reference's
-/// per-pixel quadrature error estimate (its EXR `err` layer, DESIGN.md §3).
+/// per-pixel quadrature error estimate (its EXR `err` layer, docs/design.md §3).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct ReferenceUncertainty {
     /// Largest and mean estimate over all pixels and channels.

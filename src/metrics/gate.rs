@@ -1,9 +1,9 @@
-//! Pass/fail gates on a comparison (DESIGN.md §5, §7: exit 0 pass, 1 fail, 2 error).
+//! Pass/fail gates on a comparison (docs/design.md §5, §7: exit 0 pass, 1 fail, 2 error).
 //!
 //! A gate file is TOML; every key is optional, unknown keys are errors:
 //!
 //! ```toml
-//! # Thresholds on the mean over the channels (DESIGN.md §5 "mean").
+//! # Thresholds on the mean over the channels (docs/design.md §5 "mean").
 //! min_ssim = 0.99
 //! max_rmse = 0.01
 //! min_psnr = 35.0          # dB
@@ -145,7 +145,7 @@ impl Gate {
     }
 
     /// Parses and validates the text of the gate file `path`; errors name the file and the
-    /// line of the offending value (DESIGN.md §6 "Bad input").
+    /// line of the offending value (docs/design.md §6 "Bad input").
     pub fn parse(text: &str, path: &Path) -> Result<Gate> {
         let gate: Gate = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
         match gate.problem() {

@@ -1,4 +1,4 @@
-//! Per-pixel maps of DESIGN.md §5: absolute error, relative error, SSIM (and FLIP, from
+//! Per-pixel maps of docs/design.md §5: absolute error, relative error, SSIM (and FLIP, from
 //! [`super::flip`]), as linear RGB images (one value per channel) that are written to EXR, and
 //! the scalar reductions that the heatmaps and percentile gates use.
 
@@ -42,7 +42,7 @@ pub fn gray_image(width: u32, height: u32, values: &[f32]) -> RgbImage {
 }
 
 /// The mean over the three channels of each pixel (how heatmaps and percentile gates reduce a
-/// per-channel map to one value per pixel, consistent with "mean" in DESIGN.md §5).
+/// per-channel map to one value per pixel, consistent with "mean" in docs/design.md §5).
 pub fn channel_mean(image: &RgbImage) -> Vec<f32> {
     image
         .pixels

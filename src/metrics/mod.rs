@@ -1,4 +1,4 @@
-//! Comparison of an approximation with the reference (DESIGN.md §5): SSIM, RMSE, PSNR, max / mean
+//! Comparison of an approximation with the reference (docs/design.md §5): SSIM, RMSE, PSNR, max / mean
 //! absolute and mean relative error, per channel and their mean, FLIP (LDR), and per-pixel maps.
 //!
 //! "Mean" of a metric is the mean of its per-channel values (the thesis's "Mittelwert").
@@ -21,7 +21,7 @@ pub use ssim::ChannelSsim;
 /// Channel names in the order pgt stores them.
 pub const CHANNELS: [&str; 3] = ["R", "G", "B"];
 
-/// A per-channel value and the mean of the three (DESIGN.md §5).
+/// A per-channel value and the mean of the three (docs/design.md §5).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct PerChannel {
     #[serde(rename = "R")]
@@ -56,7 +56,7 @@ impl PerChannel {
 pub enum DataRangeSource {
     /// `--data-range` (or the experiment file).
     Given,
-    /// LDR inputs (no value above 1): 1 (DESIGN.md §5).
+    /// LDR inputs (no value above 1): 1 (docs/design.md §5).
     Default,
     /// HDR inputs without a given range: max(reference) − min(0, min(reference)).
     Derived,
@@ -138,7 +138,7 @@ pub fn is_ldr(image: &RgbImage) -> bool {
         .all(|&v| (0.0..=1.0).contains(&v))
 }
 
-/// The data range for SSIM and PSNR (DESIGN.md §5): the given one; 1 when both images are LDR;
+/// The data range for SSIM and PSNR (docs/design.md §5): the given one; 1 when both images are LDR;
 /// otherwise max(reference) − min(0, min(reference)), the reference's own range.
 pub fn resolve_data_range(
     reference: &RgbImage,
@@ -173,7 +173,7 @@ pub fn resolve_data_range(
     Ok((range, DataRangeSource::Derived))
 }
 
-/// Compares `approximation` with `reference` (DESIGN.md §5). The images must have the same size
+/// Compares `approximation` with `reference` (docs/design.md §5). The images must have the same size
 /// and finite values (an error otherwise: NaN or ∞ never pass silently).
 pub fn compare(
     reference: &RgbImage,

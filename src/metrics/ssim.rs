@@ -1,4 +1,4 @@
-//! SSIM (Wang et al. 2004) exactly as DESIGN.md §5 defines it, which is scikit-image's
+//! SSIM (Wang et al. 2004) exactly as docs/design.md §5 defines it, which is scikit-image's
 //! `structural_similarity(im1, im2, gaussian_weights=True, sigma=1.5,
 //! use_sample_covariance=False, data_range=R)`:
 //!
@@ -21,7 +21,7 @@
 use crate::image_io::RgbImage;
 use rayon::prelude::*;
 
-/// Standard deviation of the Gaussian window, in pixels (DESIGN.md §5).
+/// Standard deviation of the Gaussian window, in pixels (docs/design.md §5).
 pub const SIGMA: f64 = 1.5;
 /// scipy/scikit-image truncate the Gaussian at this many standard deviations.
 pub const TRUNCATE: f64 = 3.5;
@@ -91,7 +91,7 @@ fn reflect(i: isize, n: usize) -> usize {
 }
 
 /// SSIM of channel `channel` (0 = R, 1 = G, 2 = B) of two images of equal size, with data range
-/// `data_range` (DESIGN.md §5). Parallel over blocks of rows and columns; the result does not
+/// `data_range` (docs/design.md §5). Parallel over blocks of rows and columns; the result does not
 /// depend on the block layout or the thread count.
 pub fn ssim_channel(
     reference: &RgbImage,

@@ -1,4 +1,4 @@
-//! The emission model in closed form (DESIGN.md §2, thesis eq. 4.11), composited exactly over
+//! The emission model in closed form (docs/design.md §2, thesis eq. 4.11), composited exactly over
 //! the intervals of a ray.
 
 use super::exponential::{small_opacity, SMALL_DEPTH};
@@ -43,7 +43,7 @@ pub struct Composite {
     pub transmittance: f64,
 }
 
-/// DESIGN.md §2, emission model, per interval L_in = L_out·e^{−σΔ} + E·(1 − e^{−σΔ}), composited
+/// docs/design.md §2, emission model, per interval L_in = L_out·e^{−σΔ} + E·(1 − e^{−σΔ}), composited
 /// front to back (the same sum, and it stops at the first opaque interval): a Θmax = 1 interval
 /// contributes its colour E with weight T and makes everything behind it invisible, without
 /// ever forming ∞·0.
@@ -52,7 +52,7 @@ pub fn composite(intervals: &[Interval], background: DVec3) -> Composite {
 }
 
 /// [`composite`] with the constant source Q of each interval given by `source` instead of its
-/// emission colour E (DESIGN.md §2: the closed form holds for any Q constant per interval;
+/// emission colour E (docs/design.md §2: the closed form holds for any Q constant per interval;
 /// a model without a per-light part has Q = k·E).
 #[inline]
 pub fn composite_by(

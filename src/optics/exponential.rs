@@ -1,4 +1,4 @@
-//! 1 − e^{−τ} of thin pieces for the composites of shadow rays (DESIGN.md §2, emission
+//! 1 − e^{−τ} of thin pieces for the composites of shadow rays (docs/design.md §2, emission
 //! model: one exponential per interval), where `expm1` took a large part of a lit render's
 //! time.
 //!

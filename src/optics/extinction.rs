@@ -1,10 +1,10 @@
-//! Extinction σ of a particle: the whole of DESIGN.md §1's rule (thesis eq. 5.1).
+//! Extinction σ of a particle: the whole of docs/design.md §1's rule (thesis eq. 5.1).
 //!
 //! A particle states its extinction as Θmax, the opacity along a diameter, or as κ. Then
 //! σ = λ·κ, and for Θmax, κ = −ln(1 − Θmax)/(λ·2r), so σ = −ln(1 − Θmax)/(2r): λ matters only
 //! where κ is given directly.
 
-/// How a particle states its extinction (DESIGN.md §1): `opacity` Θmax ∈ [0, 1] or `kappa` κ ≥ 0.
+/// How a particle states its extinction (docs/design.md §1): `opacity` Θmax ∈ [0, 1] or `kappa` κ ≥ 0.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Extinction {
     /// Θmax, the opacity along a diameter.
@@ -14,7 +14,7 @@ pub enum Extinction {
 }
 
 impl Extinction {
-    /// DESIGN.md §1, thesis eq. 5.1: σ = λκ with κ = −ln(1−Θmax)/(λ·2r) for an opacity, so λ
+    /// docs/design.md §1, thesis eq. 5.1: σ = λκ with κ = −ln(1−Θmax)/(λ·2r) for an opacity, so λ
     /// cancels there (computed as [`sigma_from_opacity`], never through κ, which would round
     /// twice); σ = λκ for a κ given directly. `radius` in metres, λ ∈ (0, 1].
     #[inline]
@@ -26,7 +26,7 @@ impl Extinction {
     }
 }
 
-/// σ = −ln(1 − Θmax)/(2r) (DESIGN.md §1, thesis eq. 5.1 with σ = λκ): the extinction that makes
+/// σ = −ln(1 − Θmax)/(2r) (docs/design.md §1, thesis eq. 5.1 with σ = λκ): the extinction that makes
 /// a ray through the centre keep 1 − Θmax of its light. Θmax = 1 gives +∞ (a perfectly
 /// absorbing ball), Θmax = 0 gives 0. `ln_1p` keeps small opacities exact.
 pub fn sigma_from_opacity(opacity: f64, radius: f64) -> f64 {

@@ -1,7 +1,7 @@
-//! Cutting a ray into intervals with a constant set of particles (DESIGN.md §3 "intervals").
+//! Cutting a ray into intervals with a constant set of particles (docs/design.md §3 "intervals").
 //!
 //! Every sphere entry and exit on the ray is a cut. Inside one interval the set of particles is
-//! fixed, so σ = Σσᵢ and the emission colour E = Σσᵢ·Cᵢ / Σσᵢ (DESIGN.md §2, emission model) and
+//! fixed, so σ = Σσᵢ and the emission colour E = Σσᵢ·Cᵢ / Σσᵢ (docs/design.md §2, emission model) and
 //! the σ-weighted albedo α = Σσᵢ·αᵢ / Σσᵢ (single-scatter) are constants.
 //!
 //! **Order independence.** Floating-point sums depend on their order, and the renderer promises
@@ -24,7 +24,7 @@ use crate::geometry::Hit;
 use glam::DVec3;
 use std::cmp::Ordering;
 
-/// A piece [t0, t1] of a ray with a fixed set of particles: what the models of DESIGN.md §2 need.
+/// A piece [t0, t1] of a ray with a fixed set of particles: what the models of docs/design.md §2 need.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Interval {
     /// Ray parameter where the interval starts (m).
@@ -163,7 +163,7 @@ impl<'a> IntervalCutter<'a> {
         &self.ranks
     }
 
-    /// Cuts the part (t_min, t_max) of a ray into intervals (DESIGN.md §3), given every sphere
+    /// Cuts the part (t_min, t_max) of a ray into intervals (docs/design.md §3), given every sphere
     /// the ray crosses (`hits`, in any order). Particles with σ = 0 and those for which `skip`
     /// returns true are left out. `out` is cleared first and receives the intervals in ray
     /// order; gaps without particles produce no interval.
@@ -187,7 +187,7 @@ impl<'a> IntervalCutter<'a> {
         )
     }
 
-    /// The emission model (DESIGN.md §2) along the part (t_min, t_max) of a ray crossing the
+    /// The emission model (docs/design.md §2) along the part (t_min, t_max) of a ray crossing the
     /// spheres `hits` (any order), towards `background`: what [`composite`] gives on the
     /// intervals of [`IntervalCutter::cut`], without building them (shadow rays only need the
     /// result). Same sums in the same canonical order; the last bits may differ from
@@ -288,7 +288,7 @@ fn clipped_spans(
     spans.windows(2).all(|w| w[0].t1 <= w[1].t0)
 }
 
-/// `IntervalCutter::composite`: the emission model (DESIGN.md §2) along the chords of `hits`
+/// `IntervalCutter::composite`: the emission model (docs/design.md §2) along the chords of `hits`
 /// in (t_min, t_max), with no intervals built. Per interval it needs only σ = Σσᵢ and
 /// E = S·(1/σ), S = Σσᵢ·Cᵢ (summed in canonical order, as [`medium_of`]), and adds
 /// T·(1 − e^{−σΔ})·E as [`composite`](super::emission::composite) does without forming the

@@ -1,5 +1,5 @@
 //! Where a shadow ray grazes a sphere: the kinks of the lit and single-scatter integrands
-//! (DESIGN.md §3, "kinks ... computed in closed form and used as breakpoints").
+//! (docs/design.md §3, "kinks ... computed in closed form and used as breakpoints").
 //!
 //! Along a camera ray x(t) = o + t·d the source Q(x(t)) is smooth except where the shadow ray
 //! from x(t) towards a light becomes tangent to a sphere j: there the shadow chord through j

@@ -1,9 +1,9 @@
-//! Light sources and what arrives from them (DESIGN.md §1): directional lights with irradiance
+//! Light sources and what arrives from them (docs/design.md §1): directional lights with irradiance
 //! E, point lights with intensity I and irradiance I/d² (or I with `falloff = "none"`).
 
 use glam::DVec3;
 
-/// `light_weight` of the lit model (DESIGN.md §2): w = 1/m (`mean`, thesis eq. 4.17) or w = 1
+/// `light_weight` of the lit model (docs/design.md §2): w = 1/m (`mean`, thesis eq. 4.17) or w = 1
 /// (`sum`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -12,7 +12,7 @@ pub enum LightWeight {
     Sum,
 }
 
-/// w of the lit model (DESIGN.md §2): 1/m for `mean` (thesis eq. 4.17), 1 for `sum`; 0 without
+/// w of the lit model (docs/design.md §2): 1/m for `mean` (thesis eq. 4.17), 1 for `sum`; 0 without
 /// lights (there is nothing to weigh).
 pub fn light_weight(weight: LightWeight, lights: usize) -> f64 {
     match (weight, lights) {
@@ -32,7 +32,7 @@ pub enum Falloff {
     None,
 }
 
-/// A light source (DESIGN.md §1).
+/// A light source (docs/design.md §1).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Light {
     /// `direction` is unit length and is the way the light travels.
@@ -57,7 +57,7 @@ pub struct Incident {
 }
 
 impl Light {
-    /// The unoccluded light arriving at `x` (DESIGN.md §1: E for directional lights, I/d² for
+    /// The unoccluded light arriving at `x` (docs/design.md §1: E for directional lights, I/d² for
     /// point lights). A point exactly at a point light's position gets `None`.
     #[inline]
     pub fn incident_at(&self, x: DVec3) -> Option<Incident> {

@@ -1,6 +1,6 @@
-//! Optics: extinction from the particle description (DESIGN.md §1, eq. 5.1), lights and what
+//! Optics: extinction from the particle description (docs/design.md §1, eq. 5.1), lights and what
 //! arrives from them, the cutting of rays into intervals, the emission model's closed form, the
-//! optical models of DESIGN.md §2 (`model` says what one is, `models/` holds them, one file
+//! optical models of docs/design.md §2 (`model` says what one is, `models/` holds them, one file
 //! each) and the places where shadow rays graze spheres (breakpoints of the quadrature).
 //!
 //! Depends on `geometry` only; `scene` builds on it.

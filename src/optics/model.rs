@@ -1,4 +1,4 @@
-//! What an optical model is (DESIGN.md §2): the source term Q of
+//! What an optical model is (docs/design.md §2): the source term Q of
 //!
 //!   L = L_bg·T(0,∞) + ∫₀^∞ T(0,t)·σ(x_t)·Q(x_t) dt
 //!
@@ -29,12 +29,12 @@ pub enum LightNeed {
     IrradianceTransmittance,
 }
 
-/// An optical model of DESIGN.md §2: Q(x) = k·E(x) + Σ_l q_l(x), where E is the σ-weighted
+/// An optical model of docs/design.md §2: Q(x) = k·E(x) + Σ_l q_l(x), where E is the σ-weighted
 /// emission colour of the particles at x and q_l the part of light l.
 ///
 /// The renderer integrates the per-light parts one light at a time (Q is linear in the lights)
 /// and the constant part in closed form; [`Model::source`] is the whole Q, for the Riemann sums
-/// and the Θmax = 1 limit. Each implementation's file opens with a table citing DESIGN.md §2.
+/// and the Θmax = 1 limit. Each implementation's file opens with a table citing docs/design.md §2.
 pub trait Model: Sync + Send {
     /// The name in scene files and on the command line (`model = "lit"`, `--model lit`).
     fn name(&self) -> &'static str;
@@ -47,7 +47,7 @@ pub trait Model: Sync + Send {
     /// q_l(x), the part of Q that one light contributes, at a point inside `interval`.
     ///
     /// Must be ≥ 0 and non-decreasing in the sample's radiance, irradiance and transmittance and
-    /// in the interval's emission and albedo (true of every model of DESIGN.md §2, which are
+    /// in the interval's emission and albedo (true of every model of docs/design.md §2, which are
     /// products and sums of them with non-negative weights): the renderer bounds the far end of
     /// a nearly opaque ray by this function of their largest values, and puts that bound into
     /// err instead of integrating it (`reference::volume`, `VolumeRenderer::tail_cut`). It must
@@ -68,7 +68,7 @@ pub trait Model: Sync + Send {
     /// Q∞, the Θmax = 1 (σ → ∞) limit of Q at the surface where the ray enters an opaque
     /// particle, given each light's sample already taken to its surface limit
     /// ([`LightSample::surface_limit`]). Q is linear in the samples for every model of
-    /// DESIGN.md §2, so the limit is Q of the limit samples; a model that is not overrides this.
+    /// docs/design.md §2, so the limit is Q of the limit samples; a model that is not overrides this.
     fn opaque_limit(
         &self,
         params: &SourceParams,
@@ -79,7 +79,7 @@ pub trait Model: Sync + Send {
     }
 }
 
-/// The `model` of a scene (DESIGN.md §1 `[render]`): a handle on one entry of the registry
+/// The `model` of a scene (docs/design.md §1 `[render]`): a handle on one entry of the registry
 /// `models::ALL`. Copy, compared by name, read from TOML and the command line by name; an
 /// unknown name is an error that lists the valid ones.
 #[derive(Clone, Copy)]

@@ -1,4 +1,4 @@
-//! A particle as the renderers see it (DESIGN.md §1): a sphere with its extinction σ already
+//! A particle as the renderers see it (docs/design.md §1): a sphere with its extinction σ already
 //! resolved from Θmax or κ (`extinction`), and its colours.
 
 use glam::DVec3;
@@ -12,7 +12,7 @@ pub struct Particle {
     pub radius: f64,
     /// Linear RGB colour C ≥ 0 (emission colour in volume mode, albedo-diffuse in opaque mode).
     pub color: DVec3,
-    /// Extinction σ = λκ = −ln(1−Θmax)/(2r) in 1/m (DESIGN.md §1, thesis eq. 5.1,
+    /// Extinction σ = λκ = −ln(1−Θmax)/(2r) in 1/m (docs/design.md §1, thesis eq. 5.1,
     /// [`super::extinction::Extinction::sigma`]); may be +∞ (Θmax = 1) or 0 (Θmax = 0).
     pub sigma: f64,
     /// Single-scatter albedo (defaults to `color`).

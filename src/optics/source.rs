@@ -1,4 +1,4 @@
-//! The vocabulary the source terms Q of DESIGN.md §2 share: what a shadow ray found
+//! The vocabulary the source terms Q of docs/design.md §2 share: what a shadow ray found
 //! ([`LightSample`]), the scene's parameters of the models ([`SourceParams`]) and the weight of
 //! the Θmax = 1 surface limit. The models themselves are in `models/`, one file each; the
 //! renderer traces the shadow rays.
@@ -12,7 +12,7 @@ pub use super::light::light_weight;
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct LightSample {
     /// L_l(x): the emission model along the shadow ray with the light's arriving irradiance as
-    /// its background (DESIGN.md §2, lit model). Zero where the model needs only E_l and T_l
+    /// its background (docs/design.md §2, lit model). Zero where the model needs only E_l and T_l
     /// (`LightNeed::IrradianceTransmittance`): the renderer does not trace it then.
     pub radiance: DVec3,
     /// E_l(x): the unoccluded irradiance (E, or I/d²).
@@ -36,7 +36,7 @@ impl LightSample {
     }
 }
 
-/// The scene's parameters of the source terms (DESIGN.md §1 `[render]`), resolved once per
+/// The scene's parameters of the source terms (docs/design.md §1 `[render]`), resolved once per
 /// render so that the models' per-node work is arithmetic only.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SourceParams {

@@ -1,4 +1,4 @@
-//! The transmittance alone of a ray through overlapping particles (DESIGN.md §2): what a model
+//! The transmittance alone of a ray through overlapping particles (docs/design.md §2): what a model
 //! that reads only E_l·T_l of a shadow ray (single-scatter, `LightNeed::IrradianceTransmittance`)
 //! needs, without the interval cut and the emission composite of `intervals` (issue 10).
 //!

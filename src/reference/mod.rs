@@ -1,4 +1,4 @@
-//! The exact reference renderer (DESIGN.md §3): f64 throughout, parallel over pixel tiles with
+//! The exact reference renderer (docs/design.md §3): f64 throughout, parallel over pixel tiles with
 //! rayon, bit-identical for any thread count (each pixel is a pure function of the scene).
 
 pub mod opaque;
@@ -42,7 +42,7 @@ pub trait RadianceEstimator: Sync {
 /// How the volume renderer integrates the lit and single-scatter source terms.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Integrator {
-    /// Adaptive Gauss–Kronrod to the scene's `tol` (DESIGN.md §3).
+    /// Adaptive Gauss–Kronrod to the scene's `tol` (docs/design.md §3).
     #[default]
     Adaptive,
     /// The thesis's midpoint Riemann sums with this many samples per interval.
@@ -52,7 +52,7 @@ pub enum Integrator {
 /// Options of a reference render that are not part of the scene.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RenderOptions {
-    /// Stratified k×k samples per pixel (DESIGN.md §1: one by default).
+    /// Stratified k×k samples per pixel (docs/design.md §1: one by default).
     pub spp: u32,
     /// Worker threads; `None` uses rayon's default.
     pub threads: Option<usize>,
@@ -72,7 +72,7 @@ impl Default for RenderOptions {
     }
 }
 
-/// Figures for the one-line summary (DESIGN.md §7).
+/// Figures for the one-line summary (docs/design.md §7).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RenderStats {
     pub pixels: u64,
@@ -82,7 +82,7 @@ pub struct RenderStats {
     /// Largest and mean per-pixel, per-channel error estimate (`None` without estimates).
     pub max_error: Option<f64>,
     pub mean_error: Option<f64>,
-    /// Pixels where a sample did not reach `tol` (DESIGN.md §3: reported, not hidden).
+    /// Pixels where a sample did not reach `tol` (docs/design.md §3: reported, not hidden).
     pub unconverged: u64,
     /// The unconverged pixel with the largest error estimate: (x, y, its largest channel).
     pub worst_unconverged: Option<(u32, u32, f64)>,
@@ -230,7 +230,7 @@ pub fn render_with(
     })
 }
 
-/// One pixel: the mean of k×k stratified samples at the sub-pixel centres (DESIGN.md §1 camera
+/// One pixel: the mean of k×k stratified samples at the sub-pixel centres (docs/design.md §1 camera
 /// convention, `--spp k`), as (radiance, error estimate, shadow rays, whether a sample did not
 /// converge). Every renderer of whole
 /// images or parts goes through this one function, so a pixel is the same bits wherever it is
@@ -297,7 +297,7 @@ pub(crate) fn with_threads<T: Send>(
     }
 }
 
-/// The `err` value stored for a pixel (DESIGN.md §3: err bounds |stored − true|): the estimate
+/// The `err` value stored for a pixel (docs/design.md §3: err bounds |stored − true|): the estimate
 /// plus the rounding of the f64 radiance to the stored f32 (|f32(L) − L|, at most half an ulp),
 /// per channel, rounded up to the next f32 so that storing it cannot make it smaller.
 fn stored_error(radiance: DVec3, stored: glam::Vec3, error: DVec3) -> [f32; 3] {

@@ -1,4 +1,4 @@
-//! Opaque mode (DESIGN.md §2 "Opaque mode", thesis task 1): opaque spheres, Lambertian C/π with
+//! Opaque mode (docs/design.md §2 "Opaque mode", thesis task 1): opaque spheres, Lambertian C/π with
 //! optional Blinn–Phong, hard global shadows from every sphere, an ambient term.
 
 use super::{RadianceEstimator, Sample};
@@ -41,10 +41,10 @@ impl<'a> OpaqueRenderer<'a> {
         self.bvh.any_hit(&ray, eps, distance, |i| i == own)
     }
 
-    /// DESIGN.md §2, opaque mode, at the surface point of `p` with facing normal `n`, seen along
+    /// docs/design.md §2, opaque mode, at the surface point of `p` with facing normal `n`, seen along
     /// `view` (unit, from the eye): L = Σ_l V_l·E_l·[(C/π)·max(0, n·ω_l) + specular] + ambient·C.
     /// Specular is normalised Blinn–Phong, ks·(s+8)/(8π)·max(0, n·h)^s·max(0, n·ω_l), h the half
-    /// vector of ω_l and −view (DESIGN.md leaves the normalisation open; this one conserves
+    /// vector of ω_l and −view (docs/design.md leaves the normalisation open; this one conserves
     /// energy for ks ≤ 1).
     fn shade(
         &self,
@@ -63,7 +63,7 @@ impl<'a> OpaqueRenderer<'a> {
             };
             let cos = n.dot(inc.toward);
             // An interior surface (the eye is inside the sphere) is lit only by a point light
-            // inside the same sphere (DESIGN.md §2, opaque mode): light from outside would have
+            // inside the same sphere (docs/design.md §2, opaque mode): light from outside would have
             // to pass through the opaque sphere. From outside, a light inside this sphere lies
             // behind the surface (cos < 0); one inside another sphere is blocked by it below.
             if cos <= 0.0 || (!entering && !light_inside(light, p)) {

@@ -1,5 +1,5 @@
 //! Globally adaptive Gauss–Kronrod quadrature (G7–K15) of RGB-valued integrands, with an error
-//! estimate (DESIGN.md §3: "adaptive Gauss–Kronrod quadrature with an error estimate, to an
+//! estimate (docs/design.md §3: "adaptive Gauss–Kronrod quadrature with an error estimate, to an
 //! absolute radiance tolerance `tol` per pixel and channel").
 //!
 //! **Error estimate.** Per segment and channel the estimate is the larger of |K15 − G7| and

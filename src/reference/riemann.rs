@@ -1,11 +1,11 @@
-//! The thesis's integrator (thesis eq. 4.15–4.17, DESIGN.md §8): midpoint Riemann sums with a
+//! The thesis's integrator (thesis eq. 4.15–4.17, docs/design.md §8): midpoint Riemann sums with a
 //! fixed number of samples per interval, kept so the adaptive reference can be compared with it.
 //! It has no error estimate.
 
 use glam::DVec3;
 
 /// ∫_{t0}^{t1} e^{−σ(t−t0)}·σ·Q(t) dt ≈ Σ_i e^{−σ(t_i−t0)}·σ·Q(t_i)·Δt with Δt = (t1 − t0)/N and
-/// t_i the midpoints (thesis eq. 4.16, with the λκ = σ factor of DESIGN.md §8). The
+/// t_i the midpoints (thesis eq. 4.16, with the λκ = σ factor of docs/design.md §8). The
 /// transmittance inside the interval is exact; only Q is sampled.
 pub fn midpoint_sum(
     t0: f64,

@@ -1,7 +1,7 @@
 //! The reference over a subset of the image's rows: the unit of work of a part of a cluster
 //! render (`pgt render --tile I/N`, see [`crate::parts`]). Each pixel goes through the same
 //! [`render_pixel`] and [`stored_pixel`] as a whole-image render, and a pixel is a pure function
-//! of the scene (DESIGN.md §3: bit-identical for any thread count), so the rows of a part hold
+//! of the scene (docs/design.md §3: bit-identical for any thread count), so the rows of a part hold
 //! exactly the bits the one-machine render holds there.
 
 use super::{

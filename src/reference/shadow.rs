@@ -1,5 +1,5 @@
 //! Occluder lists: the spheres a shadow ray can cross, gathered once per piece of a camera ray
-//! instead of once per shadow ray (DESIGN.md §3; issue 10).
+//! instead of once per shadow ray (docs/design.md §3; issue 10).
 //!
 //! The lit and single-scatter integrands fire one shadow ray per quadrature node and light. All
 //! nodes of one camera-ray interval lie on the segment [x(ta), x(tb)], so every shadow ray from

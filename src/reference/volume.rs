@@ -1,9 +1,9 @@
-//! The exact volume renderer (DESIGN.md §2, §3): spheres of glowing, absorbing gas.
+//! The exact volume renderer (docs/design.md §2, §3): spheres of glowing, absorbing gas.
 //!
 //! Along a camera ray x(t) = o + t·d, t ≥ 0 (particles behind the eye are clipped away, an eye
 //! inside a particle starts in it):
 //!
-//!   L = L_bg·T(0,∞) + ∫₀^∞ T(0,t)·σ(x_t)·Q(x_t) dt                       (DESIGN.md §2)
+//!   L = L_bg·T(0,∞) + ∫₀^∞ T(0,t)·σ(x_t)·Q(x_t) dt                       (docs/design.md §2)
 //!
 //! The ray is cut into intervals with a fixed set of particles (`optics::intervals`). The
 //! optical model (`optics::models`, one file each) supplies Q as a constant part k·E and a part
@@ -178,7 +178,7 @@ const GRADE: f64 = 3.0;
 /// it stands (the pixel then may miss `tol`, and says so in its `err` value).
 pub const MAX_SEGMENTS: usize = 4000;
 
-/// The volume renderer of one scene (DESIGN.md §2, §3).
+/// The volume renderer of one scene (docs/design.md §2, §3).
 pub struct VolumeRenderer<'a> {
     scene: &'a Scene,
     /// Over the particles with σ > 0 (`Scene::build_gas_bvh`): every query of the renderer
@@ -186,7 +186,7 @@ pub struct VolumeRenderer<'a> {
     bvh: Bvh,
     cutter: IntervalCutter<'a>,
     integrator: Integrator,
-    /// The scene's optical model (DESIGN.md §2).
+    /// The scene's optical model (docs/design.md §2).
     model: &'static dyn Model,
     /// Its parameters (w, a), resolved once.
     params: SourceParams,
@@ -320,7 +320,7 @@ impl<'a> VolumeRenderer<'a> {
     }
 
     /// The emission model along a shadow ray of length `distance` whose hits are in `sh.hits`,
-    /// with the light's `irradiance` as background (DESIGN.md §2, lit model); with `cut`, it
+    /// with the light's `irradiance` as background (docs/design.md §2, lit model); with `cut`, it
     /// may stop where the transmittance falls to ε (`IntervalCutter::composite`), and then
     /// sets `sh.was_cut`.
     fn shadow_composite(
@@ -347,7 +347,7 @@ impl<'a> VolumeRenderer<'a> {
         }
     }
 
-    /// Q(x) of the scene's model (DESIGN.md §2) at a point inside interval `iv`.
+    /// Q(x) of the scene's model (docs/design.md §2) at a point inside interval `iv`.
     fn source(&self, x: DVec3, iv: &Interval, sh: &mut ShadowScratch) -> DVec3 {
         sh.lights.clear();
         for l in 0..self.scene.lights.len() {
@@ -359,7 +359,7 @@ impl<'a> VolumeRenderer<'a> {
     }
 
     /// The part of Q(x) that light `l` contributes at x = ray.at(t) in interval `k` (Q is
-    /// linear in the lights, DESIGN.md §2): lit w·L_l(x); single-scatter α(x)·E_l(x)·T_l(x)/4π,
+    /// linear in the lights, docs/design.md §2): lit w·L_l(x); single-scatter α(x)·E_l(x)·T_l(x)/4π,
     /// into `out[i]` for each t = `ts[i]`, the nodes of one quadrature segment. The shadow rays
     /// test only the candidate occluders of interval `k` (`reference::shadow`), narrowed on
     /// first use from the list of the whole camera ray (`ShadowScratch::wide`), and read that
@@ -602,7 +602,7 @@ impl<'a> VolumeRenderer<'a> {
         }
     }
 
-    /// Where the quadrature's shadow rays towards `light` from x(t), t ≥ `t`, may stop (DESIGN.md
+    /// Where the quadrature's shadow rays towards `light` from x(t), t ≥ `t`, may stop (docs/design.md
     /// §3: a neglected remainder is bounded and goes into err): (ε, M, Qb) with M ≥ the light's
     /// irradiance and every colour (what may lie behind the cut, per channel) and Qb the bound
     /// of q_l of [`VolumeRenderer::source_bound`]. A shadow ray stopped where its transmittance
@@ -632,7 +632,7 @@ impl<'a> VolumeRenderer<'a> {
 
     /// Where the camera ray's remaining weight stops mattering for light `light`: the number
     /// of pieces (from the front) to integrate, and a per-channel bound B of the part of that
-    /// light's integral ∫T·σ·q_l dt over the pieces after them (DESIGN.md §3: a neglected
+    /// light's integral ∫T·σ·q_l dt over the pieces after them (docs/design.md §3: a neglected
     /// remainder is bounded and goes into err). With q_l ≤ Qb (a bound over those points,
     /// [`VolumeRenderer::source_bound`]) the rest is at most Qb·Σ_{j≥c} T(0,t0_j)·U_j (each piece's
     /// ∫du over [0, U_j] at weight T(0,t0_j)); the first c where that is ≤ `budget` in every
@@ -667,7 +667,7 @@ impl<'a> VolumeRenderer<'a> {
         cut
     }
 
-    /// A per-channel bound of q_l(x), the part of Q that `light` contributes (DESIGN.md §2), at
+    /// A per-channel bound of q_l(x), the part of Q that `light` contributes (docs/design.md §2), at
     /// every point x(t), t ≥ `t`, of `ray`: the model's q_l of the largest colour and albedo
     /// of any particle, the light's largest irradiance along the rest of the ray, a shadow
     /// ray radiance of the larger of the two (L_l is a convex combination of the light's
@@ -697,7 +697,7 @@ impl<'a> VolumeRenderer<'a> {
     /// depths, whose first-order term is O(1/σ) against the geometry of the entry (the interval
     /// length Δ = 2r·μ_in for a sphere entered from outside), i.e. O(1/τ) relative to the
     /// largest source: err = F·Qmax/τ with F = [`LIMIT_REMAINDER_FACTOR`], generous against the
-    /// curvature and light-angle factors, and Qmax ≥ Q for every model of DESIGN.md §2 (the
+    /// curvature and light-angle factors, and Qmax ≥ Q for every model of docs/design.md §2 (the
     /// emission colour, plus every light's unoccluded irradiance weighted by 1 + albedo, plus
     /// the limit value itself). Where the limit applies, τ ≥ 1e7 or so, and the term is tiny.
     fn limit_remainder(&self, ray: &Ray, iv: &Interval, q: DVec3) -> DVec3 {
@@ -909,7 +909,7 @@ const LIMIT_REMAINDER_FACTOR: f64 = 1e3;
 
 /// Whether interval `iv` (finite σ) is too dense for the quadrature: its skin depth 1/σ is
 /// within 1/[`RESOLUTION_LIMIT`] f64 spacings of the ray parameter near its start, and it is
-/// optically deep. Then the σ → ∞ limit is the better answer (DESIGN.md §3: "very large σ
+/// optically deep. Then the σ → ∞ limit is the better answer (docs/design.md §3: "very large σ
 /// converge to the Θmax = 1 limit, never to a collapsed quadrature"). Returns the σ from which a
 /// particle counts as part of that limit: the particles whose own skin depth is unresolved.
 fn beyond_resolution(ray: &Ray, iv: &Interval) -> Option<f64> {

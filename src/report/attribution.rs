@@ -1,4 +1,4 @@
-//! The error attribution's part of a sweep report (DESIGN.md §5 "error attribution"): per
+//! The error attribution's part of a sweep report (docs/design.md §5 "error attribution"): per
 //! attributed run a stacked bar of the causes' shares (SSIM share and MSE share with the
 //! interaction term, as defined in [`crate::sweep::attribution`]), an error map per cause on one
 //! scale, and a table.

@@ -1,4 +1,4 @@
-//! Colour bars as SVG with real text (DESIGN.md §5: "error heatmap with a colour bar and its
+//! Colour bars as SVG with real text (docs/design.md §5: "error heatmap with a colour bar and its
 //! scale"): a vertical gradient of the colour map from the scale's bottom to its top, framed,
 //! with tick marks and labels that a browser sets in its own font (sharp at any zoom, readable
 //! by screen readers and searchable), inlined into the report beside each heatmap.

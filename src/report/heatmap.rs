@@ -1,4 +1,4 @@
-//! Heatmap PNGs (DESIGN.md §5): a map of values through a colour map, one image pixel per map
+//! Heatmap PNGs (docs/design.md §5): a map of values through a colour map, one image pixel per map
 //! pixel. The colour bar and its scale are SVG with real text beside the map in the page
 //! (`colorbar.rs`), not pixels drawn into the PNG.
 

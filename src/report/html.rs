@@ -1,4 +1,4 @@
-//! The self-contained HTML report of one comparison (DESIGN.md §5): reference | approximation |
+//! The self-contained HTML report of one comparison (docs/design.md §5): reference | approximation |
 //! error heatmap with its colour bar | SSIM map, relative error and FLIP maps, a metrics table and
 //! the gates, and the interactive viewer (`viewer.rs`). The page references only the files
 //! written beside it (PNGs, `pgt-data.js`, `pgt-viewer.js`) and has no external resources;

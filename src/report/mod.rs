@@ -1,4 +1,4 @@
-//! Reports of a comparison (DESIGN.md §5): colour maps and heatmaps with colour bars, the
+//! Reports of a comparison (docs/design.md §5): colour maps and heatmaps with colour bars, the
 //! self-contained HTML page with its interactive viewer (`viewer.rs`, `viewer.js`), SVG colour
 //! bars and plots of swept parameters, and the page of a sweep.
 

@@ -1,4 +1,4 @@
-//! SVG line plots of a swept parameter (DESIGN.md §5 "plots (error and time against a swept
+//! SVG line plots of a swept parameter (docs/design.md §5 "plots (error and time against a swept
 //! parameter) as SVG"), drawn with plotters: one series per value of the other parameters, like
 //! the thesis's Figures 6.2/6.3 (time against samples, one line per N).
 //!

@@ -1,4 +1,4 @@
-//! The machine-readable summary of a comparison (DESIGN.md §5, §7: `--json`), and the one-line
+//! The machine-readable summary of a comparison (docs/design.md §5, §7: `--json`), and the one-line
 //! verdict for people.
 
 use crate::metrics::gate::GateCheck;
@@ -109,7 +109,7 @@ impl Summary {
         worst
     }
 
-    /// The one-line verdict (DESIGN.md §5): PASS/FAIL (naming every failing threshold) or
+    /// The one-line verdict (docs/design.md §5): PASS/FAIL (naming every failing threshold) or
     /// "compared" without gates, then the headline metrics.
     pub fn verdict(&self) -> String {
         let ssim = match &self.ssim {

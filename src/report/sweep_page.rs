@@ -1,4 +1,4 @@
-//! The report of a sweep (DESIGN.md §5): error heatmaps on one scale for all runs, SVG plots of
+//! The report of a sweep (docs/design.md §5): error heatmaps on one scale for all runs, SVG plots of
 //! error and time against the swept parameter (the thesis's Figures 6.2/6.3), the HTML page
 //! with the table (the thesis's Tables 6.1/6.2), the error attributions, `sweep.json` and
 //! `summary.json` (size, reference time and threads, adapter, attributions), from a

@@ -1,4 +1,4 @@
-// pgt report viewer (DESIGN.md §5 "Interactive where a browser runs it"): reference,
+// pgt report viewer (docs/design.md §5 "Interactive where a browser runs it"): reference,
 // approximation and error panes with synchronised zoom and pan (nearest-neighbour pixels), an
 // A/B flip, an exposure control and a pixel probe. Reads window.PGT_DATA (pgt-data.js, written
 // by src/report/viewer.rs); without it, or without JavaScript, the page keeps its static images.

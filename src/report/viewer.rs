@@ -1,4 +1,4 @@
-//! The interactive part of a report (DESIGN.md §5: "Interactive where a browser runs it
+//! The interactive part of a report (docs/design.md §5: "Interactive where a browser runs it
 //! (synchronised zoom, A/B flip, a pixel probe with values and the reference's error estimate),
 //! and complete without it"): a section of the page, hidden until its script runs, with
 //! reference, approximation and error panes that zoom and pan together (nearest-neighbour

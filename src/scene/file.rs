@@ -1,4 +1,4 @@
-//! The TOML scene file of DESIGN.md §1, as serde types. Every table denies unknown fields so a
+//! The TOML scene file of docs/design.md §1, as serde types. Every table denies unknown fields so a
 //! misspelt key is an error, not a silently ignored setting. Tables are `Spanned` so validation
 //! can name the line.
 

@@ -1,4 +1,4 @@
-//! The default scene for a bare particle file (DESIGN.md §1).
+//! The default scene for a bare particle file (docs/design.md §1).
 
 use crate::geometry::Camera;
 use crate::optics::light::Light;

@@ -1,4 +1,4 @@
-//! The scene model of DESIGN.md §1: particles, lights, camera and render settings, already
+//! The scene model of docs/design.md §1: particles, lights, camera and render settings, already
 //! validated and resolved (σ computed, defaults applied). `file` holds the TOML format and
 //! `validate` turns it into a [`Scene`], with errors that name the file, line and field.
 
@@ -19,7 +19,7 @@ use crate::geometry::Camera;
 use glam::DVec3;
 use std::path::{Path, PathBuf};
 
-/// `mode` (DESIGN.md §1): opaque spheres or spheres of gas.
+/// `mode` (docs/design.md §1): opaque spheres or spheres of gas.
 #[derive(
     Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize, serde::Serialize, clap::ValueEnum,
 )]
@@ -76,7 +76,7 @@ pub struct Scene {
     pub warnings: Vec<String>,
 }
 
-/// Command-line overrides of the scene (DESIGN.md §1: flags override the scene).
+/// Command-line overrides of the scene (docs/design.md §1: flags override the scene).
 #[derive(Debug, Clone, Default)]
 pub struct SceneLoadOptions {
     pub size: Option<(u32, u32)>,
@@ -110,7 +110,7 @@ pub fn check_image_size(width: i64, height: i64) -> std::result::Result<(u32, u3
 
 impl Scene {
     /// Loads a scene: a TOML scene file (`.toml`), or a bare particle file that gets the default
-    /// scene of DESIGN.md §1.
+    /// scene of docs/design.md §1.
     pub fn load(path: &Path, options: &SceneLoadOptions) -> Result<Scene> {
         let is_toml = path
             .extension()

@@ -1,5 +1,5 @@
 //! Scene validation: the raw TOML tables become a [`Scene`], or an error that names the file,
-//! the line and the field (DESIGN.md §6 "Bad input").
+//! the line and the field (docs/design.md §6 "Bad input").
 
 use super::file::{
     CameraTable, LightKind, LightTable, ParticleDefaults, ParticleTable, RenderTable, SceneFile,
@@ -173,7 +173,7 @@ pub(super) fn scene_from_toml(
     })
 }
 
-/// A bare particle file with the default scene of DESIGN.md §1.
+/// A bare particle file with the default scene of docs/design.md §1.
 pub(super) fn bare_particle_file(path: &Path, options: &SceneLoadOptions) -> Result<Scene> {
     let whole = At {
         path,
@@ -311,7 +311,7 @@ impl ResolvedDefaults {
     }
 
     /// σ from the particle's own opacity/kappa, else the defaults, else Θmax =
-    /// [`DEFAULT_OPACITY`] (DESIGN.md §1); the equation itself is [`Extinction::sigma`].
+    /// [`DEFAULT_OPACITY`] (docs/design.md §1); the equation itself is [`Extinction::sigma`].
     fn sigma(&self, opacity: Option<f64>, kappa: Option<f64>, radius: f64, lambda: f64) -> f64 {
         let extinction = match (opacity, kappa) {
             (Some(o), _) => Extinction::Opacity(o),

@@ -1,4 +1,4 @@
-//! Error attribution (DESIGN.md §5): an approximation's error split into its causes by swapping
+//! Error attribution (docs/design.md §5): an approximation's error split into its causes by swapping
 //! one stage at a time for its exact counterpart, along the chain an experiment's
 //! `[[attribution]]` declares (format: the module documentation of [`crate::sweep`]).
 //!

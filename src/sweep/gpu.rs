@@ -1,4 +1,4 @@
-//! The GPU approximations (DESIGN.md §4) as sweep methods: every method of the approximation
+//! The GPU approximations (docs/design.md §4) as sweep methods: every method of the approximation
 //! registry (`approx::methods::METHODS`) is sweepable with every parameter it declares, through
 //! one adapter from the sweep's [`SweepMethod`] to `approx::render_approx_with` on the sweep's
 //! one GPU context. Nothing here names a method: a new registry entry is sweepable as it is.

@@ -1,4 +1,4 @@
-//! Sweeps (DESIGN.md §5, §7 `pgt sweep`): the reference once, an approximation for each
+//! Sweeps (docs/design.md §5, §7 `pgt sweep`): the reference once, an approximation for each
 //! parameter combination an experiment lists, each compared with the reference (and with a
 //! baseline run where one is named). The results feed `report::sweep_page`: a table (the
 //! thesis's Tables 6.1/6.2: SSIM per channel and mean, in %) and SVG plots of error and time
@@ -23,7 +23,7 @@
 //! spp = [1]                   # optional, default: the reference's spp
 //!
 //! [[approximations]]
-//! method = "thesis"           # a GPU approximation (DESIGN.md §4)
+//! method = "thesis"           # a GPU approximation (docs/design.md §4)
 //! samples = 100               # one value or a list
 //! n_exact = [1, 2, 3, 5, "all"]
 //! baseline = { n_exact = "all" }
@@ -32,7 +32,7 @@
 //! method = "thesis-cpu"       # the same scheme in f64 on the CPU (for the float32 stage)
 //! n_exact = [5, "all"]
 //!
-//! [[attribution]]             # optional: split a run's error into causes (DESIGN.md §5)
+//! [[attribution]]             # optional: split a run's error into causes (docs/design.md §5)
 //! run = { method = "thesis", samples = 100, n_exact = 5 }
 //! steps = [
 //!     { cause = "float32",  swap = { method = "thesis-cpu" } },

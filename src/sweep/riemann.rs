@@ -1,4 +1,4 @@
-//! `riemann`: the exact reference renderer (exact intervals, DESIGN.md §3) with the thesis's
+//! `riemann`: the exact reference renderer (exact intervals, docs/design.md §3) with the thesis's
 //! midpoint Riemann sums instead of adaptive quadrature (`Integrator::Riemann`), so the thesis's
 //! integrator can be measured apart from its other approximations. Runs on the CPU.
 //!

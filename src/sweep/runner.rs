@@ -35,7 +35,7 @@ pub struct ReferenceInfo {
     pub cache_file: PathBuf,
     /// Render time in seconds; `None` when it came from the cache.
     pub seconds: Option<f64>,
-    /// Pixels that did not reach `tol` (DESIGN.md §3: reported, not hidden) and the worst one
+    /// Pixels that did not reach `tol` (docs/design.md §3: reported, not hidden) and the worst one
     /// (x, y, its largest error estimate); `None` for a cached render from before pgt kept
     /// this beside the cached image.
     pub unconverged: Option<Unconverged>,
@@ -128,7 +128,7 @@ pub fn reference_key(scene: &Scene, options: &RenderOptions) -> String {
     crate::parts::render_hash(scene, options)
 }
 
-/// The exact reference (adaptive quadrature, DESIGN.md §3), from the cache or rendered and
+/// The exact reference (adaptive quadrature, docs/design.md §3), from the cache or rendered and
 /// cached.
 fn cached_reference(
     exp: &Experiment,

@@ -1,7 +1,7 @@
-//! `thesis-cpu`: the `thesis` approximation (DESIGN.md §4, thesis chapter 5) on the CPU in f64,
+//! `thesis-cpu`: the `thesis` approximation (docs/design.md §4, thesis chapter 5) on the CPU in f64,
 //! step for step as `shaders/thesis.wgsl` does it: the particles a camera ray crosses, sorted by
 //! entry, composited one particle at a time (overlaps ignored); the first `n_exact` with the lit
-//! model (DESIGN.md §2, eq. 4.17) by `samples` midpoint samples per chord, each with one shadow
+//! model (docs/design.md §2, eq. 4.17) by `samples` midpoint samples per chord, each with one shadow
 //! ray per light along which the emission model is composited per particle; the rest with the
 //! emission closed form L = L_behind·T + C·(1−T).
 //!
@@ -60,12 +60,12 @@ struct Shading<'a> {
     samples: u32,
     n_exact: u32,
     lit: bool,
-    /// w of the lit model: 1/m or 1 (DESIGN.md §2).
+    /// w of the lit model: 1/m or 1 (docs/design.md §2).
     weight: f64,
 }
 
 impl Shading<'_> {
-    /// DESIGN.md §2, emission model composited per particle back to front along (t_min, t_max),
+    /// docs/design.md §2, emission model composited per particle back to front along (t_min, t_max),
     /// the light's irradiance as the background: what the thesis's shadow rays carry.
     fn emission_along(
         &self,
@@ -85,7 +85,7 @@ impl Shading<'_> {
         radiance
     }
 
-    /// Q(x) of the lit model (DESIGN.md §2, thesis eq. 4.17): w·Σ_l L_l(x).
+    /// Q(x) of the lit model (docs/design.md §2, thesis eq. 4.17): w·Σ_l L_l(x).
     fn lit_source(&self, x: DVec3, hits: &mut Vec<Hit>) -> DVec3 {
         let mut q = DVec3::ZERO;
         for light in &self.scene.lights {
@@ -98,7 +98,7 @@ impl Shading<'_> {
     }
 
     /// Σ_j Q(x_j)·σ·e^{−σ(t_j − t0)}·Δt, t_j = t0 + (j + ½)Δt: the midpoint rule for ∫ σQT dt
-    /// over one particle's chord (the σ factor of DESIGN.md §8).
+    /// over one particle's chord (the σ factor of docs/design.md §8).
     fn lit_samples(&self, ray: &Ray, sigma: f64, t0: f64, t1: f64, hits: &mut Vec<Hit>) -> DVec3 {
         let dt = (t1 - t0) / self.samples as f64;
         let mut sum = DVec3::ZERO;

@@ -174,7 +174,7 @@ pub fn emission_per_particle(
     l
 }
 
-/// Oracle, f64: the emission model with exact intervals (DESIGN.md §3) — overlaps handled:
+/// Oracle, f64: the emission model with exact intervals (docs/design.md §3) — overlaps handled:
 /// in each interval σ = Σσᵢ and E = Σσᵢ·Cᵢ/Σσᵢ. Finite σ only.
 pub fn emission_exact_intervals(scene: &Scene, bvh: &Bvh, ray: &Ray) -> DVec3 {
     let mut hits: Vec<Hit> = Vec::new();
@@ -207,7 +207,7 @@ pub fn emission_exact_intervals(scene: &Scene, bvh: &Bvh, ray: &Ray) -> DVec3 {
     l
 }
 
-/// Oracle, f64: the lit model's source Q(x) = w·Σ_l L_l(x) (DESIGN.md §2), each L_l the
+/// Oracle, f64: the lit model's source Q(x) = w·Σ_l L_l(x) (docs/design.md §2), each L_l the
 /// emission model along the shadow ray with the light as background (disjoint particles).
 pub fn lit_source(scene: &Scene, bvh: &Bvh, x: DVec3) -> DVec3 {
     let w = match scene.render.light_weight {

@@ -1,7 +1,7 @@
 //! # `emission` — per-particle compositing with the emission model's closed form
 //!
 //! The particles a camera ray crosses, sorted by entry and composited back to front with
-//! DESIGN.md §2's closed form L = L_behind·T + C·(1 − T) per particle (`shaders/emission.wgsl`).
+//! docs/design.md §2's closed form L = L_behind·T + C·(1 − T) per particle (`shaders/emission.wgsl`).
 //! Exact where particles do not overlap; the scene's optical model is ignored (the emission
 //! model is used). Volume mode only.
 //!

@@ -1,4 +1,4 @@
-//! The approximation methods pgt ships (DESIGN.md §4): the [`ApproxMethod`] trait and the
+//! The approximation methods pgt ships (docs/design.md §4): the [`ApproxMethod`] trait and the
 //! registry [`METHODS`]. Each method is one Rust file here (its docs, parameters and scene
 //! check) and one WGSL file in `shaders/` that defines `shade` on top of the prelude. Adding a
 //! method is those two files and one line in the `registry!` list below; the CLI

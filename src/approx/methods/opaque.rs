@@ -1,6 +1,6 @@
 //! # `opaque` — opaque spheres: first hit, Lambert + Blinn–Phong, hard shadows
 //!
-//! DESIGN.md §2 "Opaque mode" as `src/reference/opaque.rs` defines it, in f32
+//! docs/design.md §2 "Opaque mode" as `src/reference/opaque.rs` defines it, in f32
 //! (`shaders/opaque.wgsl`): the first sphere hit, Lambertian C/π plus normalised Blinn–Phong,
 //! one shadow ray per light through the BVH, plus the scene's `ambient`·C. Any scene: every
 //! particle is drawn opaque.

@@ -1,7 +1,7 @@
 //! # `sorted-blend` — centre-sorted whole-particle blending, as rasterisers do
 //!
 //! What real-time renderers do with transparent particles (3D Gaussian splatting, Mol* and
-//! MegaMol transparency), DESIGN.md §4: the particles hit by a ray are sorted by the view-space
+//! MegaMol transparency), docs/design.md §4: the particles hit by a ray are sorted by the view-space
 //! depth of their centres, dot(centre − eye, camera forward), and each is composited whole,
 //! back to front, with the emission model's closed form over its own chord,
 //! L = L_behind·T + C·(1 − T) (`shaders/sorted_blend.wgsl`). It equals the exact emission model

@@ -1,8 +1,8 @@
 //! # `thesis` — the thesis's scheme (chapter 5)
 //!
 //! The particles a camera ray crosses, sorted by entry and composited one particle at a time
-//! (overlaps ignored, DESIGN.md §4 and §8). The first `n_exact` particles from the eye use the
-//! lit model (DESIGN.md §2, thesis eq. 4.17) with `samples` midpoint-rule samples along their
+//! (overlaps ignored, docs/design.md §4 and §8). The first `n_exact` particles from the eye use the
+//! lit model (docs/design.md §2, thesis eq. 4.17) with `samples` midpoint-rule samples along their
 //! chord and one shadow ray per sample per light; the rest, and every particle of an
 //! emission-model scene, use the emission model's closed form (`shaders/thesis.wgsl`). Volume
 //! mode, `emission` or `lit` model. On a Cpu adapter (lavapipe) the lit samples are spread over

@@ -2,7 +2,7 @@
 //!
 //! | | |
 //! |---|---|
-//! | DESIGN.md | §2, emission model (thesis 4.1, eq. 4.11) |
+//! | docs/design.md | §2, emission model (thesis 4.1, eq. 4.11) |
 //! | source | Q(x) = E(x) = Σσᵢ·Cᵢ / Σσᵢ over the particles that contain x |
 //! | constant part | k = 1: Q = E |
 //! | per light | none: no shadow rays; L_in = L_out·e^{−σΔ} + E·(1 − e^{−σΔ}) per interval, exact |
@@ -44,7 +44,7 @@ impl Model for Emission {
         DVec3::ZERO
     }
 
-    /// DESIGN.md §2, emission model: Q(x) = E(x).
+    /// docs/design.md §2, emission model: Q(x) = E(x).
     fn source(&self, _: &SourceParams, interval: &Interval, _: &[LightSample]) -> DVec3 {
         interval.emission
     }

@@ -2,7 +2,7 @@
 //!
 //! | | |
 //! |---|---|
-//! | DESIGN.md | §2, lit model (thesis 4.2, eq. 4.17; the factor σ of §8 is the renderer's) |
+//! | docs/design.md | §2, lit model (thesis 4.2, eq. 4.17; the factor σ of §8 is the renderer's) |
 //! | source | Q(x) = w·Σ_l L_l(x) |
 //! | constant part | k = 0 |
 //! | per light | w·L_l(x): the emission model along the shadow ray from x towards l, the light's E (or I/d²) as its background, the particle containing x included |
@@ -47,7 +47,7 @@ impl Model for Lit {
         params.light_weight * light.radiance
     }
 
-    /// DESIGN.md §2, lit model: Q(x) = w·Σ_l L_l(x).
+    /// docs/design.md §2, lit model: Q(x) = w·Σ_l L_l(x).
     fn source(&self, params: &SourceParams, _: &Interval, lights: &[LightSample]) -> DVec3 {
         let mut sum = DVec3::ZERO;
         for l in lights {

@@ -1,4 +1,4 @@
-//! The optical models of DESIGN.md §2, one file each, and their registry.
+//! The optical models of docs/design.md §2, one file each, and their registry.
 //!
 //! A new model is one file here implementing [`Model`](super::model::Model) (opening with its
 //! table, as the others do), its `mod` line and one entry in [`ALL`]. Scene files, `--model`,
@@ -10,11 +10,11 @@ mod single_scatter;
 
 use super::model::OpticalModel;
 
-/// DESIGN.md §2, emission model.
+/// docs/design.md §2, emission model.
 pub const EMISSION: OpticalModel = OpticalModel::new(&emission::Emission);
-/// DESIGN.md §2, lit model (the default).
+/// docs/design.md §2, lit model (the default).
 pub const LIT: OpticalModel = OpticalModel::new(&lit::Lit);
-/// DESIGN.md §2, single-scatter model.
+/// docs/design.md §2, single-scatter model.
 pub const SINGLE_SCATTER: OpticalModel = OpticalModel::new(&single_scatter::SingleScatter);
 
 /// The registry, one entry per model, in the order of `--help` and of error messages.

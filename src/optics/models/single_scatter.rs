@@ -2,7 +2,7 @@
 //!
 //! | | |
 //! |---|---|
-//! | DESIGN.md | §2, single-scatter model (the physical one) |
+//! | docs/design.md | §2, single-scatter model (the physical one) |
 //! | source | Q(x) = a·E(x) + α(x)·(1/4π)·Σ_l E_l(x)·T_l(x) |
 //! | constant part | k = a: a·E(x), E the σ-weighted particle colour |
 //! | per light | α(x)·E_l(x)·T_l(x)/4π: isotropic phase, α the σ-weighted albedo, E_l the unoccluded irradiance (I/d² for point lights), T_l the transmittance to the light through all particles |
@@ -47,7 +47,7 @@ impl Model for SingleScatter {
         interval.albedo * (light.irradiance * light.transmittance) / (4.0 * PI)
     }
 
-    /// DESIGN.md §2, single-scatter model: Q(x) = a·E(x) + α(x)·(1/4π)·Σ_l E_l(x)·T_l(x).
+    /// docs/design.md §2, single-scatter model: Q(x) = a·E(x) + α(x)·(1/4π)·Σ_l E_l(x)·T_l(x).
     fn source(&self, params: &SourceParams, interval: &Interval, lights: &[LightSample]) -> DVec3 {
         let mut inscatter = DVec3::ZERO;
         for l in lights {
