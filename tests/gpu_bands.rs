@@ -10,7 +10,7 @@ use gpu_common::*;
 use pgt::approx::dispatch::{self, Pipeline};
 use pgt::approx::layout::{GpuFrame, SceneBuffers};
 use pgt::approx::{ApproxParams, GpuContext, Method};
-use pgt::scene::{OpticalModel, RenderMode, Scene};
+use pgt::scene::{Model, RenderMode, Scene};
 
 /// The compiled method, the scene's buffers and frame, as `ApproxPipeline::render` makes them.
 fn prepare(
@@ -31,7 +31,7 @@ fn prepare(
 }
 
 /// A scene of `width`×`height` (neither a multiple of the workgroup side).
-fn odd_scene(model: OpticalModel, mode: RenderMode, width: u32, height: u32) -> Scene {
+fn odd_scene(model: Model, mode: RenderMode, width: u32, height: u32) -> Scene {
     let mut s = scene(disjoint_particles(), lights(), mode, model);
     s.camera = pgt::geometry::Camera::new(
         s.camera.position,
@@ -48,7 +48,7 @@ fn odd_scene(model: OpticalModel, mode: RenderMode, width: u32, height: u32) -> 
 type Case = (
     &'static str,
     &'static [(&'static str, u32)],
-    OpticalModel,
+    Model,
     RenderMode,
 );
 

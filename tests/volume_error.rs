@@ -5,7 +5,7 @@
 mod volume_support;
 
 use glam::DVec3;
-use pgt::optics::{models, Falloff, Light, OpticalModel, Particle};
+use pgt::optics::{models, Falloff, Light, Model, Particle};
 use pgt::reference::volume::VolumeRenderer;
 use pgt::reference::{Integrator, RadianceEstimator, Sample};
 use pgt::scene::Scene;
@@ -26,7 +26,7 @@ fn render_f64(scene: &Scene) -> Vec<Sample> {
 
 /// A 32×32 render of six overlapping particles, a directional and a point light, at tol 1e-4 and
 /// 1e-6, against the same render at tol 1e-10.
-fn honest_at(model: OpticalModel, seed: u64) {
+fn honest_at(model: Model, seed: u64) {
     let mut rng = Rng::new(seed);
     let s = scene(model, random_particles(&mut rng, 6), two_lights(), SIZE);
     check_honest(&format!("{} seed {seed}", model.name()), s, 1e-10);

@@ -6,7 +6,7 @@ mod volume_support;
 
 use glam::DVec3;
 use pgt::geometry::Ray;
-use pgt::optics::{models, Light, OpticalModel};
+use pgt::optics::{models, Light, Model};
 use pgt::reference::Integrator;
 use volume_support::*;
 
@@ -99,7 +99,7 @@ fn overlapping_huge_sigmas_that_add_to_infinity_give_the_limit() {
     }
 }
 
-fn one_sphere(model: OpticalModel, sigma: f64) -> pgt::scene::Scene {
+fn one_sphere(model: Model, sigma: f64) -> pgt::scene::Scene {
     let mut s = scene(
         model,
         vec![particle(DVec3::ZERO, 1.0, DVec3::new(0.8, 0.3, 0.5), sigma)],

@@ -7,7 +7,7 @@ mod volume_support;
 
 use glam::DVec3;
 use pgt::geometry::Ray;
-use pgt::optics::{models, LightWeight, OpticalModel, Particle};
+use pgt::optics::{models, LightWeight, Model, Particle};
 use pgt::reference::Integrator;
 use pgt::scene::Scene;
 use std::f64::consts::PI;
@@ -148,7 +148,7 @@ fn mean_and_standard_error(samples: &[DVec3]) -> (DVec3, DVec3) {
     (mean, (var / n).powf(0.5))
 }
 
-fn agree_on_random_scenes(model: OpticalModel) {
+fn agree_on_random_scenes(model: Model) {
     const SAMPLES: usize = 40_000;
     // The model's place in the registry (0, 1, 2: the old enum's discriminants, so the random
     // scenes are the ones this test has always drawn).

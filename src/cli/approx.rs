@@ -5,7 +5,7 @@
 use super::Outcome;
 use crate::approx::{self, methods, ApproxParams, Method, Timing, N_EXACT_ALL};
 use crate::image_io::write_image;
-use crate::scene::{OpticalModel, RenderMode, SceneLoadOptions};
+use crate::scene::{Model, RenderMode, SceneLoadOptions};
 use clap::builder::PossibleValuesParser;
 use clap::Args;
 use std::path::PathBuf;
@@ -50,7 +50,7 @@ pub struct ApproxArgs {
     #[arg(long, value_enum)]
     pub mode: Option<RenderMode>,
     #[arg(long, value_enum)]
-    pub model: Option<OpticalModel>,
+    pub model: Option<Model>,
     /// PNG exposure in stops (2^exposure scales the linear image before encoding).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,

@@ -26,7 +26,7 @@ use crate::optics::model::LightNeed;
 use crate::optics::models;
 use crate::reference::{self, Integrator, RenderOptions, RenderOutput};
 use crate::scene::{
-    bounding_sphere, default_camera, thesis_lights, Falloff, Light, OpticalModel, Particle,
+    bounding_sphere, default_camera, thesis_lights, Falloff, Light, Model, Particle,
     RenderSettings, Scene, SceneLoadOptions,
 };
 use anyhow::Context;
@@ -139,7 +139,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<Outcome> {
 /// Renders `scene` with `integrator` (and `model` instead of the scene's, if given).
 fn render(
     scene: &Scene,
-    model: Option<OpticalModel>,
+    model: Option<Model>,
     integrator: Integrator,
     tol: f64,
     threads: Option<usize>,
@@ -181,7 +181,7 @@ fn bench_scene(name: &str, scene: &Scene, args: &BenchArgs) -> anyhow::Result<Ve
     // (model, integrator) of each renderer of this workload, in the order they take turns:
     // the scene's own model alone where it has no lights to integrate or no baselines are
     // asked for.
-    let renderers: &[(Option<OpticalModel>, Integrator)] = if !lit || args.no_baselines {
+    let renderers: &[(Option<Model>, Integrator)] = if !lit || args.no_baselines {
         &[(None, Integrator::Adaptive)]
     } else {
         &[

@@ -3,7 +3,7 @@
 use super::Outcome;
 use crate::image_io::write_image;
 use crate::reference::{self, Integrator, RenderOptions};
-use crate::scene::{OpticalModel, RenderMode, SceneLoadOptions};
+use crate::scene::{Model, RenderMode, SceneLoadOptions};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 
@@ -28,7 +28,7 @@ pub struct RenderArgs {
     #[arg(long, value_enum)]
     pub mode: Option<RenderMode>,
     #[arg(long, value_enum)]
-    pub model: Option<OpticalModel>,
+    pub model: Option<Model>,
     /// Absolute radiance tolerance of the quadrature, per pixel and channel.
     #[arg(long)]
     pub tol: Option<f64>,

@@ -1,5 +1,6 @@
 //! The emission model in closed form (docs/design.md §2, thesis eq. 4.11), composited exactly over
-//! the intervals of a ray.
+//! the intervals of a ray: [`composite`] over intervals known in advance (a camera ray), and
+//! [`FrontToBack`] while they are being found (a shadow ray, which may stop early).
 
 use super::exponential::{small_opacity, SMALL_DEPTH};
 use super::intervals::Interval;
@@ -75,6 +76,127 @@ pub fn composite_by(
     Composite {
         radiance: radiance + transmittance * background,
         transmittance,
+    }
+}
+
+/// The emission model composited front to back while the intervals are still being found (a
+/// shadow ray's, `optics::cutter` and `reference::shadow`): the same closed form as
+/// [`composite`], with two differences that let it stop early and save exponentials. It may
+/// stop where the transmittance has fallen to a given ε (then [`FrontToBack::finish`] bounds
+/// what lies behind), and consecutive pieces of the same colour are composited as one. Its
+/// opacity comes from [`opacity_and_transmittance`], so its last bits may differ from
+/// [`composite`]'s.
+#[derive(Debug, Clone, Copy)]
+pub struct FrontToBack {
+    radiance: DVec3,
+    transmittance: f64,
+    /// Transmittance at or below which nothing more is added (0: only an opaque stop).
+    stop_at: f64,
+    /// The run of intervals added since the last flush, all of this emission E, and their
+    /// summed optical depth Σσ·Δ (0 and NaN emission: none).
+    run_emission: DVec3,
+    run_depth: f64,
+}
+
+impl FrontToBack {
+    /// Nothing composited yet; stopping where T falls to the cut's ε, if any (`cut` is (ε, M):
+    /// see [`FrontToBack::finish`]).
+    pub fn new(cut: Option<(f64, DVec3)>) -> Self {
+        FrontToBack {
+            radiance: DVec3::ZERO,
+            transmittance: 1.0,
+            stop_at: cut.map_or(0.0, |(epsilon, _)| epsilon),
+            run_emission: DVec3::NAN,
+            run_depth: 0.0,
+        }
+    }
+
+    /// Adds a homogeneous piece of finite extinction σ, σ-weighted colour S = Σσᵢ·Cᵢ and the
+    /// given length; false once nothing more is to be added (T ≤ `stop_at`). E = S·(1/σ) is
+    /// formed before the exponential, which it does not depend on: dividing after it (T·a/σ)
+    /// put the division's latency on the path from each exponential to the running sums.
+    #[inline]
+    pub fn add(&mut self, sigma: f64, weighted: DVec3, length: f64) -> bool {
+        self.add_emission(sigma, weighted * (1.0 / sigma), length)
+    }
+
+    /// [`FrontToBack::add`] with E = S·(1/σ) formed by the caller. Consecutive pieces of the
+    /// same E (bit for bit) are one homogeneous source behind each other: their composite is
+    /// T·(1 − e^{−Σσ·Δ})·E, so their depths are summed and composited as one, with one
+    /// exponential (on a shadow ray, one particle is often followed by
+    /// another of the same colour). T is checked against `stop_at` where a run ends.
+    #[inline]
+    pub fn add_emission(&mut self, sigma: f64, emission: DVec3, length: f64) -> bool {
+        if emission == self.run_emission {
+            self.run_depth += sigma * length;
+            return true;
+        }
+        if !self.flush() {
+            return false;
+        }
+        self.run_emission = emission;
+        self.run_depth = sigma * length;
+        true
+    }
+
+    /// Composites the pending run; false once nothing more is to be added.
+    #[inline]
+    pub fn flush(&mut self) -> bool {
+        if self.run_depth != 0.0 {
+            let (a, e) = opacity_and_transmittance(self.run_depth);
+            self.radiance += (self.transmittance * a) * self.run_emission;
+            self.transmittance *= e;
+        }
+        self.run_emission = DVec3::NAN;
+        self.run_depth = 0.0;
+        self.transmittance > self.stop_at
+    }
+
+    /// Adds an interval as [`composite`] does (σ may be ∞).
+    pub fn add_interval(&mut self, iv: Interval) -> bool {
+        if !self.flush() {
+            return false;
+        }
+        if iv.sigma.is_infinite() {
+            self.radiance += self.transmittance * iv.emission;
+            self.transmittance = 0.0;
+        } else {
+            let (a, e) = opacity_and_transmittance(iv.sigma * iv.length());
+            self.radiance += (self.transmittance * a) * iv.emission;
+            self.transmittance *= e;
+        }
+        self.transmittance > self.stop_at
+    }
+
+    /// The end of the composite: the background behind what was composited, or, where the
+    /// composite stopped with something still visible behind, the middle of what the rest
+    /// could add (also where the stop came at the last interval: conservative, and within the
+    /// same bound); whether it stopped so.
+    ///
+    /// With `cut = Some((ε, M))` the composite stops once T has fallen to ε or below (after the
+    /// piece that took it there); what lies behind contributes T·L_rest with 0 ≤ L_rest ≤ M per
+    /// channel (M ≥ `background` and every colour behind, a caller's bound), so the radiance
+    /// becomes F + T·M/2 and the transmittance T/2, each off by at most half its range (T·M/2
+    /// and T/2, both ≤ ε·(M, 1)/2). An exactly opaque stop (T = 0) is exact and is not a cut.
+    pub fn finish(mut self, background: DVec3, cut: Option<(f64, DVec3)>) -> (Composite, bool) {
+        self.flush();
+        let t = self.transmittance;
+        match cut {
+            Some((epsilon, bound)) if t > 0.0 && t <= epsilon => (
+                Composite {
+                    radiance: self.radiance + t * (0.5 * bound),
+                    transmittance: 0.5 * t,
+                },
+                true,
+            ),
+            _ => (
+                Composite {
+                    radiance: self.radiance + t * background,
+                    transmittance: t,
+                },
+                false,
+            ),
+        }
     }
 }
 

@@ -5,6 +5,7 @@
 //!
 //! Depends on `geometry` only; `scene` builds on it.
 
+pub mod cutter;
 pub mod emission;
 pub mod exponential;
 pub mod extinction;
@@ -18,5 +19,5 @@ pub mod source;
 pub mod transmittance;
 
 pub use light::{Falloff, Incident, Light, LightWeight};
-pub use model::{LightNeed, Model, OpticalModel};
+pub use model::{LightNeed, OpticalModel, Model};
 pub use particle::Particle;

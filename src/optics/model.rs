@@ -33,14 +33,14 @@ pub enum LightNeed {
 /// emission colour of the particles at x and q_l the part of light l.
 ///
 /// The renderer integrates the per-light parts one light at a time (Q is linear in the lights)
-/// and the constant part in closed form; [`Model::source`] is the whole Q, for the Riemann sums
+/// and the constant part in closed form; [`OpticalModel::source`] is the whole Q, for the Riemann sums
 /// and the Θmax = 1 limit. Each implementation's file opens with a table citing docs/design.md §2.
-pub trait Model: Sync + Send {
+pub trait OpticalModel: Sync + Send {
     /// The name in scene files and on the command line (`model = "lit"`, `--model lit`).
     fn name(&self) -> &'static str;
     /// One line for `--help` and the docs.
     fn summary(&self) -> &'static str;
-    /// What [`Model::light_source`] reads from each light's shadow ray.
+    /// What [`OpticalModel::light_source`] reads from each light's shadow ray.
     fn light_need(&self) -> LightNeed;
     /// k of the constant part k·E(x) of Q.
     fn emission_factor(&self, params: &SourceParams) -> f64;
@@ -83,108 +83,51 @@ pub trait Model: Sync + Send {
 /// `models::ALL`. Copy, compared by name, read from TOML and the command line by name; an
 /// unknown name is an error that lists the valid ones.
 #[derive(Clone, Copy)]
-pub struct OpticalModel(&'static dyn Model);
+pub struct Model(&'static dyn OpticalModel);
 
-impl OpticalModel {
+impl Model {
     /// Wraps a model; the registry does this once per model.
-    pub const fn new(model: &'static dyn Model) -> Self {
-        OpticalModel(model)
+    pub const fn new(model: &'static dyn OpticalModel) -> Self {
+        Model(model)
     }
 
     /// The model behind the handle.
     #[inline]
-    pub fn model(self) -> &'static dyn Model {
+    pub fn model(self) -> &'static dyn OpticalModel {
         self.0
-    }
-
-    /// The registered model called `name`, or `None`.
-    pub fn from_name(name: &str) -> Option<OpticalModel> {
-        super::models::ALL
-            .iter()
-            .copied()
-            .find(|m| m.name() == name)
-    }
-
-    /// The registered names, for messages: "`emission`, `lit`, `single-scatter`".
-    pub fn names() -> String {
-        super::models::ALL
-            .iter()
-            .map(|m| format!("`{}`", m.name()))
-            .collect::<Vec<_>>()
-            .join(", ")
-    }
-
-    /// The message for a name that is not registered.
-    pub fn unknown(name: &str) -> String {
-        format!(
-            "unknown optical model `{name}`, expected one of {}",
-            Self::names()
-        )
     }
 }
 
-impl std::ops::Deref for OpticalModel {
-    type Target = dyn Model;
+impl std::ops::Deref for Model {
+    type Target = dyn OpticalModel;
     #[inline]
-    fn deref(&self) -> &(dyn Model + 'static) {
+    fn deref(&self) -> &(dyn OpticalModel + 'static) {
         self.0
     }
 }
 
-impl PartialEq for OpticalModel {
+impl PartialEq for Model {
     fn eq(&self, other: &Self) -> bool {
         self.name() == other.name()
     }
 }
 
-impl Eq for OpticalModel {}
+impl Eq for Model {}
 
-impl std::hash::Hash for OpticalModel {
+impl std::hash::Hash for Model {
     fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
         self.name().hash(state)
     }
 }
 
-impl fmt::Debug for OpticalModel {
+impl fmt::Debug for Model {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "OpticalModel({:?})", self.name())
+        write!(f, "Model({:?})", self.name())
     }
 }
 
-impl fmt::Display for OpticalModel {
+impl fmt::Display for Model {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
-    }
-}
-
-impl std::str::FromStr for OpticalModel {
-    type Err = String;
-    fn from_str(s: &str) -> Result<Self, String> {
-        OpticalModel::from_name(s).ok_or_else(|| OpticalModel::unknown(s))
-    }
-}
-
-impl<'de> serde::Deserialize<'de> for OpticalModel {
-    /// By name; toml attaches the line of the value to the error.
-    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        let name = String::deserialize(d)?;
-        name.parse().map_err(serde::de::Error::custom)
-    }
-}
-
-impl serde::Serialize for OpticalModel {
-    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
-        s.serialize_str(self.name())
-    }
-}
-
-/// `--model NAME`: the registry is the list of values, each model's summary its help.
-impl clap::ValueEnum for OpticalModel {
-    fn value_variants<'a>() -> &'a [Self] {
-        super::models::ALL
-    }
-
-    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
-        Some(clap::builder::PossibleValue::new(self.name()).help(self.summary()))
     }
 }

@@ -1,17 +1,16 @@
 //! The transmittance alone of a ray through overlapping particles (docs/design.md §2): what a model
 //! that reads only E_l·T_l of a shadow ray (single-scatter, `LightNeed::IrradianceTransmittance`)
-//! needs, without the interval cut and the emission composite of `intervals` (issue 10).
+//! needs, without the interval cut and the emission composite of `cutter`.
 //!
 //! T = e^{−τ} with τ = Σᵢ σᵢ·|chordᵢ ∩ (t_min, t_max)|: the optical depth ∫Σσᵢ written per
 //! particle instead of per interval (∫Σσᵢ = Σ∫σᵢ), so no sort by position, no sweep over the
-//! chord ends and one exponential instead of one per interval. On 1UUN single-scatter this
-//! halved the time of a render. The composite's transmittance is the product of the
-//! intervals' e^{−σΔ}; the two agree to rounding (a test in `intervals` compares them).
+//! chord ends and one exponential instead of one per interval. The composite's transmittance is the product of the
+//! intervals' e^{−σΔ}; the two agree to rounding (a test in `cutter` compares them).
 
 // `!(a > b)` is deliberate: unlike `a <= b` it is also true when σ is NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use super::intervals::IntervalCutter;
+use super::cutter::IntervalCutter;
 use crate::geometry::Hit;
 
 /// e^{−τ} along the part (t_min, t_max) of a ray crossing the spheres `hits` (any order), the

@@ -7,7 +7,7 @@
 //!
 //! The ray is cut into intervals with a fixed set of particles (`optics::intervals`). The
 //! optical model (`optics::models`, one file each) supplies Q as a constant part k·E and a part
-//! per light (`optics::model::Model`); this file never asks which model it is.
+//! per light (`optics::model::OpticalModel`); this file never asks which model it is.
 //!
 //! * **no per-light part** (emission): Q = k·E is constant per interval, and the integral has
 //!   the closed form L_in = L_out·e^{−σΔ} + Q·(1 − e^{−σΔ}) (`optics::emission`). Error
@@ -53,7 +53,7 @@
 //!
 //! where "rest" is the shadow ray from the entry point without the Θmax = 1 particle(s) that
 //! start there (`LightSample::surface_limit`), and Q∞ is Q of those limits
-//! (`Model::opaque_limit`). This is the value the renderer converges to as Θmax → 1 (a test checks it); the
+//! (`OpticalModel::opaque_limit`). This is the value the renderer converges to as Θmax → 1 (a test checks it); the
 //! naive "Q at the entry point" would give L_l,rest, which no finite Θmax approaches. An eye
 //! inside a Θmax = 1 particle sees its colour (c = ∞). Several Θmax = 1 particles entered at the
 //! same point act as one (mean colour, largest c).
@@ -127,14 +127,15 @@ use super::quadrature::{
     integrate_adaptive_batched, Level, Piece, BOTH_ENDS, HIGH_END, LOW_END, MAX_NODES,
 };
 use super::riemann::midpoint_sum;
-use super::shadow::{Occluders, ShadowRay};
+use super::shadow::{KeptEndOrders, Occluders, ShadowCompositor, ShadowRay};
 use super::{Integrator, RadianceEstimator, Sample};
 use crate::geometry::{Bvh, Hit, Ray};
 use crate::optics::emission::{composite_by, opacity};
-use crate::optics::intervals::{Interval, IntervalCutter, IntervalScratch};
+use crate::optics::cutter::{IntervalCutter, SweepScratch};
+use crate::optics::intervals::Interval;
 use crate::optics::kinks::{CROSSES_ABOVE, CROSSES_BELOW};
 use crate::optics::light::Light;
-use crate::optics::model::{LightNeed, Model};
+use crate::optics::model::{LightNeed, OpticalModel};
 use crate::optics::source::{surface_limit_weight, LightSample, SourceParams};
 use crate::optics::transmittance::transmittance;
 use crate::scene::Scene;
@@ -187,7 +188,7 @@ pub struct VolumeRenderer<'a> {
     cutter: IntervalCutter<'a>,
     integrator: Integrator,
     /// The scene's optical model (docs/design.md §2).
-    model: &'static dyn Model,
+    model: &'static dyn OpticalModel,
     /// Its parameters (w, a), resolved once.
     params: SourceParams,
     /// Whether the model reads only E_l and T_l of a shadow ray
@@ -206,7 +207,7 @@ pub struct VolumeRenderer<'a> {
 #[derive(Default)]
 struct ShadowScratch {
     hits: Vec<Hit>,
-    cut: IntervalScratch,
+    compositor: KeptEndOrders,
     /// `optics::transmittance`'s buffer.
     depths: Vec<(u32, f64)>,
     lights: Vec<LightSample>,
@@ -240,7 +241,7 @@ impl ShadowScratch {
         }
         // The kept layout of the shadow composite names particles by index: this may be
         // another scene's camera ray.
-        self.cut.forget();
+        self.compositor.forget();
     }
 }
 
@@ -331,13 +332,12 @@ impl<'a> VolumeRenderer<'a> {
         cut: Option<(f64, DVec3)>,
         sh: &mut ShadowScratch,
     ) -> LightSample {
-        let (c, was_cut) = self.cutter.composite(
+        let (c, was_cut) = sh.compositor.composite(
+            &self.cutter,
             &sh.hits,
             (0.0, distance),
             skip,
-            irradiance,
-            cut,
-            &mut sh.cut,
+            (irradiance, cut),
         );
         sh.was_cut |= was_cut;
         LightSample {
@@ -608,7 +608,7 @@ impl<'a> VolumeRenderer<'a> {
     /// of q_l of [`VolumeRenderer::source_bound`]. A shadow ray stopped where its transmittance
     /// T has fallen to ε ≤ `budget`/(2·max Qb) takes the middle of what is left out
     /// (`IntervalCutter::composite`); q_l is linear in the shadow ray's radiance and
-    /// transmittance and monotone (`Model::light_source`), so that changes q_l by at most
+    /// transmittance and monotone (`OpticalModel::light_source`), so that changes q_l by at most
     /// T·Qb/2 ≤ ε·Qb/2 at every point. The integrand then differs from the true one by at most
     /// that, with small jumps where the cut moves from one interval to another, which the error
     /// estimate may not see: err gets 2·ε·Qb per unit of Σ weight·Δu (one ε·Qb/2 for the
@@ -672,7 +672,7 @@ impl<'a> VolumeRenderer<'a> {
     /// of any particle, the light's largest irradiance along the rest of the ray, a shadow
     /// ray radiance of the larger of the two (L_l is a convex combination of the light's
     /// irradiance and particle colours) and transmittance 1. Valid because every model's q_l
-    /// is non-decreasing in these (`Model::light_source`). `None` without a finite bound.
+    /// is non-decreasing in these (`OpticalModel::light_source`). `None` without a finite bound.
     fn source_bound(&self, ray: &Ray, t: f64, light: &Light) -> Option<DVec3> {
         let (color, albedo) = self.source_bounds?;
         let irradiance = light.max_irradiance_beyond(ray.origin, ray.direction, t);
@@ -967,7 +967,7 @@ impl VolumeRenderer<'_> {
         let mut hits = Vec::new();
         self.bvh.all_hits(ray, 0.0, f64::INFINITY, &mut hits);
         let mut intervals = Vec::new();
-        let mut cut_scratch = IntervalScratch::default();
+        let mut cut_scratch = SweepScratch::default();
         self.cutter.cut(
             &hits,
             0.0,
@@ -1048,7 +1048,7 @@ impl VolumeRenderer<'_> {
 mod tests {
     use super::*;
     use crate::geometry::Camera;
-    use crate::optics::{models, OpticalModel, Particle};
+    use crate::optics::{models, Model, Particle};
     use crate::scene::{LightWeight, RenderMode, RenderSettings};
 
     /// A gas sphere of the given opacity Θmax, its albedo its colour.
@@ -1069,7 +1069,7 @@ mod tests {
     /// three layers of the roof, most of them near a centre, and its transmittance falls far
     /// below the cut's ε at tol 1e-4 (about 2.5e-8); near the gaps between the columns it
     /// does not, so the cut comes and goes along each camera ray.
-    fn roof_scene(model: OpticalModel, tol: f64) -> Scene {
+    fn roof_scene(model: Model, tol: f64) -> Scene {
         let mut particles = vec![sphere(DVec3::ZERO, 1.0, DVec3::new(0.9, 0.6, 0.3), 0.5)];
         for i in 0..27 {
             let c = DVec3::new((i % 3) as f64, 3.0 + (i / 9) as f64, ((i / 3) % 3) as f64);
@@ -1109,7 +1109,7 @@ mod tests {
 
     /// A camera ray's sample at tol 1e-4 against its truth (a much tighter render): both
     /// converged, err covers the difference (with the truth's own err), and err meets tol.
-    fn assert_honest(model: OpticalModel, (x, y): (f64, f64), got: &Sample, want: &Sample) {
+    fn assert_honest(model: Model, (x, y): (f64, f64), got: &Sample, want: &Sample) {
         assert!(!got.unconverged && !want.unconverged);
         let actual = (got.radiance - want.radiance).abs();
         assert!(

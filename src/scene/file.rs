@@ -2,7 +2,7 @@
 //! misspelt key is an error, not a silently ignored setting. Tables are `Spanned` so validation
 //! can name the line.
 
-use super::{Falloff, LightWeight, OpticalModel, RenderMode};
+use super::{Falloff, LightWeight, Model, RenderMode};
 use crate::formats::IncludeSpec;
 use serde::Deserialize;
 use toml::Spanned;
@@ -37,7 +37,7 @@ pub(super) struct CameraTable {
 #[serde(deny_unknown_fields)]
 pub(super) struct RenderTable {
     pub mode: Option<RenderMode>,
-    pub model: Option<OpticalModel>,
+    pub model: Option<Model>,
     pub background: Option<[f64; 3]>,
     pub lambda: Option<f64>,
     pub light_weight: Option<LightWeight>,

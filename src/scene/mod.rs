@@ -11,7 +11,7 @@ pub use framing::{bounding_sphere, default_camera, thesis_lights};
 // The light physics, the resolved particle and the optical models live in `optics` (the scene
 // builds on optics, never the reverse); re-exported so that `scene::Light` etc. keep working.
 pub use crate::optics::light::{Falloff, Incident, Light, LightWeight};
-pub use crate::optics::model::OpticalModel;
+pub use crate::optics::model::Model;
 pub use crate::optics::particle::Particle;
 
 use crate::error::{PgtError, Result};
@@ -34,7 +34,7 @@ pub enum RenderMode {
 pub struct RenderSettings {
     pub mode: RenderMode,
     /// The optical model of the volume mode, an entry of `optics::models::ALL`.
-    pub model: OpticalModel,
+    pub model: Model,
     /// L_bg, linear RGB.
     pub background: DVec3,
     /// λ ∈ (0, 1].
@@ -81,7 +81,7 @@ pub struct Scene {
 pub struct SceneLoadOptions {
     pub size: Option<(u32, u32)>,
     pub mode: Option<RenderMode>,
-    pub model: Option<OpticalModel>,
+    pub model: Option<Model>,
     pub tol: Option<f64>,
 }
 

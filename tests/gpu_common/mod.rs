@@ -10,7 +10,7 @@ use pgt::approx::GpuContext;
 use pgt::geometry::{Bvh, Camera, Hit, Ray};
 use pgt::image_io::RgbImage;
 use pgt::optics::extinction::sigma_from_opacity;
-use pgt::scene::{Light, LightWeight, OpticalModel, Particle, RenderMode, RenderSettings, Scene};
+use pgt::scene::{Light, LightWeight, Model, Particle, RenderMode, RenderSettings, Scene};
 use rayon::prelude::*;
 use std::sync::OnceLock;
 
@@ -52,7 +52,7 @@ pub fn scene(
     particles: Vec<Particle>,
     lights: Vec<Light>,
     mode: RenderMode,
-    model: OpticalModel,
+    model: Model,
 ) -> Scene {
     Scene {
         source: "gpu-test".into(),

@@ -4,7 +4,7 @@
 use glam::DVec3;
 use pgt::formats::random::SplitMix64;
 use pgt::geometry::{Camera, Ray};
-use pgt::optics::{models, Falloff, Light, LightWeight, OpticalModel, Particle};
+use pgt::optics::{models, Falloff, Light, LightWeight, Model, Particle};
 use pgt::reference::volume::VolumeRenderer;
 use pgt::reference::{Integrator, RadianceEstimator, Sample};
 use pgt::scene::{RenderMode, RenderSettings, Scene};
@@ -54,7 +54,7 @@ pub fn particle(center: DVec3, radius: f64, color: DVec3, sigma: f64) -> Particl
 }
 
 pub fn scene(
-    model: OpticalModel,
+    model: Model,
     particles: Vec<Particle>,
     lights: Vec<Light>,
     size: u32,
@@ -119,4 +119,4 @@ pub fn radiance(scene: &Scene, integrator: Integrator, ray: &Ray) -> Sample {
     VolumeRenderer::new(scene, integrator).radiance(ray)
 }
 
-pub const MODELS: [OpticalModel; 3] = [models::EMISSION, models::LIT, models::SINGLE_SCATTER];
+pub const MODELS: [Model; 3] = [models::EMISSION, models::LIT, models::SINGLE_SCATTER];

@@ -16,14 +16,14 @@
 //! One particle alone gives exactly L = L_bg·T + C·(1 − T).
 
 use crate::optics::intervals::Interval;
-use crate::optics::model::{LightNeed, Model};
+use crate::optics::model::{LightNeed, OpticalModel};
 use crate::optics::source::{LightSample, SourceParams};
 use glam::DVec3;
 
 /// The emission model (module documentation).
 pub struct Emission;
 
-impl Model for Emission {
+impl OpticalModel for Emission {
     fn name(&self) -> &'static str {
         "emission"
     }

@@ -17,14 +17,14 @@
 //! Light changes colour as it passes through coloured gas (thesis task 3).
 
 use crate::optics::intervals::Interval;
-use crate::optics::model::{LightNeed, Model};
+use crate::optics::model::{LightNeed, OpticalModel};
 use crate::optics::source::{LightSample, SourceParams};
 use glam::DVec3;
 
 /// The lit model (module documentation).
 pub struct Lit;
 
-impl Model for Lit {
+impl OpticalModel for Lit {
     fn name(&self) -> &'static str {
         "lit"
     }

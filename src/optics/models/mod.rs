@@ -1,6 +1,6 @@
 //! The optical models of docs/design.md §2, one file each, and their registry.
 //!
-//! A new model is one file here implementing [`Model`](super::model::Model) (opening with its
+//! A new model is one file here implementing [`OpticalModel`](super::model::OpticalModel) (opening with its
 //! table, as the others do), its `mod` line and one entry in [`ALL`]. Scene files, `--model`,
 //! error messages and the renderer read [`ALL`]; nothing matches on a model's name.
 
@@ -8,17 +8,77 @@ mod emission;
 mod lit;
 mod single_scatter;
 
-use super::model::OpticalModel;
+use super::model::Model;
 
 /// docs/design.md §2, emission model.
-pub const EMISSION: OpticalModel = OpticalModel::new(&emission::Emission);
+pub const EMISSION: Model = Model::new(&emission::Emission);
 /// docs/design.md §2, lit model (the default).
-pub const LIT: OpticalModel = OpticalModel::new(&lit::Lit);
+pub const LIT: Model = Model::new(&lit::Lit);
 /// docs/design.md §2, single-scatter model.
-pub const SINGLE_SCATTER: OpticalModel = OpticalModel::new(&single_scatter::SingleScatter);
+pub const SINGLE_SCATTER: Model = Model::new(&single_scatter::SingleScatter);
 
 /// The registry, one entry per model, in the order of `--help` and of error messages.
-pub const ALL: &[OpticalModel] = &[EMISSION, LIT, SINGLE_SCATTER];
+pub const ALL: &[Model] = &[EMISSION, LIT, SINGLE_SCATTER];
+
+/// The registry's lookups by name: scene files, `--model` and messages go through [`ALL`].
+impl Model {
+    /// The registered model called `name`, or `None`.
+    pub fn from_name(name: &str) -> Option<Model> {
+        ALL
+            .iter()
+            .copied()
+            .find(|m| m.name() == name)
+    }
+
+    /// The registered names, for messages: "`emission`, `lit`, `single-scatter`".
+    pub fn names() -> String {
+        ALL
+            .iter()
+            .map(|m| format!("`{}`", m.name()))
+            .collect::<Vec<_>>()
+            .join(", ")
+    }
+
+    /// The message for a name that is not registered.
+    pub fn unknown(name: &str) -> String {
+        format!(
+            "unknown optical model `{name}`, expected one of {}",
+            Self::names()
+        )
+    }
+}
+
+impl std::str::FromStr for Model {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        Model::from_name(s).ok_or_else(|| Model::unknown(s))
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for Model {
+    /// By name; toml attaches the line of the value to the error.
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let name = String::deserialize(d)?;
+        name.parse().map_err(serde::de::Error::custom)
+    }
+}
+
+impl serde::Serialize for Model {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.serialize_str(self.name())
+    }
+}
+
+/// `--model NAME`: the registry is the list of values, each model's summary its help.
+impl clap::ValueEnum for Model {
+    fn value_variants<'a>() -> &'a [Self] {
+        ALL
+    }
+
+    fn to_possible_value(&self) -> Option<clap::builder::PossibleValue> {
+        Some(clap::builder::PossibleValue::new(self.name()).help(self.summary()))
+    }
+}
 
 #[cfg(test)]
 mod tests {
@@ -56,16 +116,16 @@ mod tests {
     #[test]
     fn names_are_unique_and_resolve() {
         for (i, m) in ALL.iter().enumerate() {
-            assert_eq!(OpticalModel::from_name(m.name()), Some(*m));
+            assert_eq!(Model::from_name(m.name()), Some(*m));
             assert!(ALL[..i].iter().all(|o| o.name() != m.name()), "{m} twice");
             assert!(!m.summary().is_empty());
         }
-        assert_eq!(OpticalModel::from_name("glow"), None);
+        assert_eq!(Model::from_name("glow"), None);
         assert_eq!(
-            OpticalModel::unknown("glow"),
+            Model::unknown("glow"),
             "unknown optical model `glow`, expected one of `emission`, `lit`, `single-scatter`"
         );
-        assert_eq!("single-scatter".parse::<OpticalModel>(), Ok(SINGLE_SCATTER));
+        assert_eq!("single-scatter".parse::<Model>(), Ok(SINGLE_SCATTER));
         assert_ne!(LIT, EMISSION);
     }
 
@@ -88,7 +148,7 @@ mod tests {
     fn light_parts_are_linear_in_the_shadow_rays_radiance_and_transmittance() {
         // The renderer's shadow-ray cut (`reference::volume`) bounds q_l's error through this:
         // q_l(λ·s₁ + μ·s₂) = λ·q_l(s₁) + μ·q_l(s₂) in (L_l, T_l) at one irradiance E_l
-        // (`Model::light_source`).
+        // (`OpticalModel::light_source`).
         let p = SourceParams {
             light_weight: 0.5,
             emission_weight: 0.3,

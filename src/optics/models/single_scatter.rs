@@ -16,7 +16,7 @@
 //! ```
 
 use crate::optics::intervals::Interval;
-use crate::optics::model::{LightNeed, Model};
+use crate::optics::model::{LightNeed, OpticalModel};
 use crate::optics::source::{LightSample, SourceParams};
 use glam::DVec3;
 use std::f64::consts::PI;
@@ -24,7 +24,7 @@ use std::f64::consts::PI;
 /// The single-scatter model (module documentation).
 pub struct SingleScatter;
 
-impl Model for SingleScatter {
+impl OpticalModel for SingleScatter {
     fn name(&self) -> &'static str {
         "single-scatter"
     }
