@@ -384,7 +384,11 @@ pub(crate) mod tests {
             let chords: Vec<Hit> = clipped_chords(&hits, (0.0, 4.0), &ps, |_| false).collect();
             let swept = cut_by_events(&chords, &ps, cutter.ranks());
             assert_eq!(bits(&fast), bits(&swept), "trial {trial}: {hits:?}");
-            if !s.chords.windows(2).all(|w| w[0].chord.t_exit <= w[1].chord.t_enter) {
+            if !s
+                .chords
+                .windows(2)
+                .all(|w| w[0].chord.t_exit <= w[1].chord.t_enter)
+            {
                 fallbacks += 1;
             }
             // The composite along the chords is `composite` of these intervals, to the last

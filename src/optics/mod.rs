@@ -19,5 +19,5 @@ pub mod source;
 pub mod transmittance;
 
 pub use light::{Falloff, Incident, Light, LightWeight};
-pub use model::{LightNeed, OpticalModel, Model};
+pub use model::{LightNeed, Model, OpticalModel};
 pub use particle::Particle;

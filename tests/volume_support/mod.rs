@@ -53,12 +53,7 @@ pub fn particle(center: DVec3, radius: f64, color: DVec3, sigma: f64) -> Particl
     }
 }
 
-pub fn scene(
-    model: Model,
-    particles: Vec<Particle>,
-    lights: Vec<Light>,
-    size: u32,
-) -> Scene {
+pub fn scene(model: Model, particles: Vec<Particle>, lights: Vec<Light>, size: u32) -> Scene {
     Scene {
         source: "test".into(),
         camera: Camera::new(

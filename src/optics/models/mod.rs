@@ -24,16 +24,12 @@ pub const ALL: &[Model] = &[EMISSION, LIT, SINGLE_SCATTER];
 impl Model {
     /// The registered model called `name`, or `None`.
     pub fn from_name(name: &str) -> Option<Model> {
-        ALL
-            .iter()
-            .copied()
-            .find(|m| m.name() == name)
+        ALL.iter().copied().find(|m| m.name() == name)
     }
 
     /// The registered names, for messages: "`emission`, `lit`, `single-scatter`".
     pub fn names() -> String {
-        ALL
-            .iter()
+        ALL.iter()
             .map(|m| format!("`{}`", m.name()))
             .collect::<Vec<_>>()
             .join(", ")

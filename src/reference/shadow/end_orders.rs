@@ -731,7 +731,12 @@ impl EndOrder {
     /// `new_group`, where the open set before `lo` is `open`: pushed onto `intervals`, with
     /// their sums, each taken from one of `before` with the same open set within
     /// [`SUMS_REACH`] of its place where there is one (the same terms in the same order).
-    fn form_groups(&mut self, (lo, end): (usize, usize), mut open: u64, before: &[OrderedInterval]) {
+    fn form_groups(
+        &mut self,
+        (lo, end): (usize, usize),
+        mut open: u64,
+        before: &[OrderedInterval],
+    ) {
         let n = self.order.len();
         let mut k = lo;
         while k < end.min(n) {
