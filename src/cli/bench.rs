@@ -16,8 +16,8 @@
 //! gives the adaptive time as a ratio to both. `--accuracy` adds a tol 1e-9 render and the
 //! largest error of the adaptive and Riemann images against it (the target: adaptive ≥ 100×
 //! smaller). `--repeat N` renders the workload's renderers N times in turn and keeps the
-//! fastest run of each: on two shared cores one render's time varies by ±15 % with the load,
-//! and the fastest of a few interleaved runs is the steadier basis for a ratio.
+//! fastest run of each: on shared cores one render's time moves with the load, and the
+//! fastest of a few interleaved runs is the steadier basis for a ratio.
 
 use super::Outcome;
 use crate::formats::random::{generate, RandomSpec, SplitMix64, THESIS_COUNT};

@@ -1,14 +1,10 @@
 //! 1 − e^{−τ} of thin pieces for the composites of shadow rays (docs/design.md §2, emission
-//! model: one exponential per interval), where `expm1` took a large part of a lit render's
-//! time.
+//! model: one exponential per interval).
 //!
 //! Why not `f64::exp_m1`: glibc's `expm1` costs several times its `exp`, and thin pieces
 //! (chords that end close together) are common in a shadow ray's composite through
-//! overlapping atoms: profiled (`perf record -e cpu-clock`, 1UUN lit 128², one thread) it took
-//! 5.5 % of the render time, and the polynomial below, inlined, takes a fraction of that. An
-//! inlined table-driven `exp` (Tang's method, 64 entries) was also tried for the thicker
-//! pieces and measured no faster than glibc's (which uses FMA, where pgt's baseline target
-//! cannot), so `f64::exp` stays.
+//! overlapping atoms; the polynomial below, inlined, costs a fraction of it. Thicker pieces
+//! keep `f64::exp` (docs/performance.md, "Exponentials").
 
 /// 1 − e^{−τ} = −expm1(−τ) for 0 ≤ τ < [`SMALL_DEPTH`] (and NaN for NaN), as τ·p(τ) with p
 /// the Taylor series Σ_{k<9} (−τ)^k/(k+1)!. The first term left out, τ⁹/10!, is below 6e-19

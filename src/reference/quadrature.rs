@@ -28,32 +28,18 @@
 //! interpolatory 5-node rule on five of its nodes (degree 5 against G7's 13, so for smooth
 //! integrands the estimate is far above G7's error), and raised to K15 by eight more nodes only
 //! where that does not meet the budget.
-//! On the 1UUN benchmark shadow rays per pixel fell from 253.8 to 162.2, which puts about two
-//! thirds of the segments at 7 nodes (an estimate from those counts). A nested family
-//! whose two rules share more nodes (Patterson's 7 → 15 extension of G3–K7) was tried and
-//! rejected: on the honesty scenes of `tests/volume_error.rs` its 15- and 7-node rules missed
-//! the same feature of a smooth-looking lit integrand (estimate 1.9e-8, actual error 1.6e-7),
-//! where K15 against G7 reported 1.8e-5 and refined.
-//! Three cheaper schemes were measured on 1UUN lit at 128², tol 1e-4, against a tol 1e-9 render;
-//! this scheme takes 2.66 M shadow rays and its largest error is 2.4e-7:
-//! * G7's estimate as the plain |G7 − R5|, without QUADPACK's amplification: 22 % fewer rays,
-//!   largest error 6.8e-6.
-//! * A 5-node first level (R5 against the 3-node rule on G7's nodes 0, ±XGK[3]): 7.6 % fewer
-//!   rays, largest error 9.8e-7. A 3-node first level saved 3.5 % of the rays.
-//! * Two kink-to-kink pieces as one segment, under a quintic map flat at both ends and at the
-//!   shared kink: 5 % more rays, largest error 1.7e-6.
+//! Cheaper schemes (fewer nodes at the first level, no amplification of the estimate, nested
+//! rules that share more nodes) were measured and rejected: each was honest or nearly so, but
+//! either missed features of lit integrands that K15 against G7 catches, or let the actual
+//! error at tol 1e-4 rise towards Riemann-100's, and the pessimism of this estimate is what
+//! keeps it far below (docs/performance.md, "The quadrature's levels").
 //!
-//! err covered the actual error everywhere in all three. They were rejected because the
-//! adaptive error at tol 1e-4 must stay ≥ 100× below Riemann-100's (7.7e-5 on that scene, issue
-//! 10), and it is the pessimism of this estimate that keeps it there.
-//!
-//! **A third, lower level where the caller allows it.** The second of those schemes is kept
-//! for segments the caller chooses ([`Level::R5`], [`integrate_adaptive_batched`]'s
+//! **A third, lower level where the caller allows it.** A 5-node first level is kept for
+//! segments the caller chooses ([`Level::R5`], [`integrate_adaptive_batched`]'s
 //! `first_level`): R5 on G7's nodes 0, ±XGK[1], ±XGK[3] ([`WG7_SUB5`]), estimated against the
 //! 3-node rule on 0, ±XGK[3] ([`R3`]), raised to G7 by the two nodes ±XGK[5] and then to K15.
 //! The volume renderer starts a piece there only where its whole contribution is bounded by a
-//! few tol (`volume::R5_SHARE`); on 1UUN lit 128² that takes 9.6 % of the shadow rays off and
-//! leaves the largest error at 4.9e-7 (157× below Riemann-100's), all of it covered by err.
+//! few tol (`R5_START_LIMIT` of `reference::volume`'s error budget).
 //!
 //! **Global adaptivity.** All segments of one pixel (every interval of the camera ray) share
 //! one error budget: the segment with the largest estimate is raised or split until the summed
@@ -246,13 +232,8 @@ const QUADPACK_AMPLIFICATION: f64 = 200.0;
 /// The factor a of the same heuristic for the lower levels, G7 against R5 and R5 against R3.
 /// There the difference of the pair is the coarse rule's error (R5's: degree 5 against G7's
 /// 13), far above that of the value returned, so the estimate is pessimistic before any
-/// amplification. Halving a took 4.4 % of the shadow rays off on 1UUN lit 128² (tol 1e-4;
-/// largest error against a tol 1e-9 render 4.9e-7 → 5.2e-7, 148× below Riemann-100's), with no
-/// new pixel channel above its err there, with two point lights (one inside the gas), or on
-/// the honesty scenes of `tests/volume_error.rs`. a = 50 took 8.1 % off but made the largest
-/// error 6.3e-7 and left one channel of the dark-roof scene above its err at tol 1e-6; it
-/// was not kept. (Lowering a for K15 as well, to 100, left 6 channels above their err near
-/// Θmax = 1.)
+/// amplification, and half of QUADPACK's factor keeps every honesty scene honest (a = 50 did
+/// not; docs/performance.md, "The quadrature's levels").
 const LOWER_AMPLIFICATION: f64 = 100.0;
 
 /// The error estimate of a pair of rules on one segment (module documentation): `resk` the
@@ -273,7 +254,7 @@ fn pair_estimate(
     let mut relative = 0.0f64;
     for c in 0..3 {
         if resasc[c] > 0.0 && diff[c] > 0.0 {
-            // q^{3/2} as q·√q: one square root instead of `powf` (1 % of a lit render).
+            // q^{3/2} as q·√q: one square root instead of `powf`.
             let q = amplification * diff[c] / resasc[c];
             error[c] = diff[c].max(resasc[c] * (q * q.sqrt()).min(1.0));
             relative = relative.max(error[c] / resasc[c]);
@@ -354,11 +335,9 @@ impl NestedSegment {
     /// or K15 against G7 (QUADPACK's `qk15`). Returns the number of nodes evaluated.
     fn raise_to(&mut self, level: Level, f: &mut Nodes) -> usize {
         // The nodes the level adds, as (abscissa, slot in `fv`), from one end of the segment to
-        // the other: consecutive shadow rays then differ least, and the interval cutter's most
-        // recent layout of chord ends (`optics::intervals`) is the one that holds, where the
-        // order ±x₁, ±x₃, … jumped across the segment and found it second (1UUN lit 128²: the
-        // first layout held for 70 % of the shadow rays, against 44 %). The values do not
-        // depend on the order.
+        // the other: consecutive shadow rays then differ least, and the most recent end order
+        // of the shadow compositor (`reference::shadow`) is the one that holds. The values do
+        // not depend on the order.
         let nodes: &[(f64, usize)] = match (self.level, level) {
             (None, Level::R5) => &[
                 (-XGK[1], 2),
@@ -504,8 +483,7 @@ pub const BOTH_ENDS: u8 = LOW_END | HIGH_END;
 /// only where the singularity is: at a tangency kink the integrand has its square root on the
 /// side where the shadow ray crosses the sphere and is smooth on the other
 /// (`optics::kinks::push_sided_tangencies`), and flattening a smooth end only crowds the nodes
-/// there. On 1UUN lit 512² this took 11 % of the shadow rays off, and the largest error
-/// against a tol 1e-9 render fell from 3.9e-7 to 3.6e-7.
+/// there.
 pub fn integrate_adaptive_with_ends(
     pieces: &[Piece],
     tol: f64,

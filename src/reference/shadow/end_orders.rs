@@ -637,7 +637,7 @@ impl EndOrder {
     }
 
     /// The end order of the same members for ends that came in another order (two ends crossed
-    /// between the nodes of a quadrature segment: 17 % of the shadow rays on 1UUN lit 128²),
+    /// between the nodes of a quadrature segment),
     /// in place: the order re-sorted by insertion from the old one, which it nearly is, and
     /// the intervals formed again, where an interval with the same open set as one of the
     /// old intervals about its place takes its sums (the same terms added in the same order:

@@ -1,5 +1,5 @@
 //! Occluder lists: the spheres a shadow ray can cross, gathered once per piece of a camera ray
-//! instead of once per shadow ray (docs/design.md §3; issue 10).
+//! instead of once per shadow ray (docs/design.md §3).
 //!
 //! The lit and single-scatter integrands fire one shadow ray per quadrature node and light. All
 //! nodes of one camera-ray interval lie on the segment [x(ta), x(tb)], so every shadow ray from
@@ -13,9 +13,8 @@
 //!
 //! The lists are gathered once per (camera-ray interval, light). Between two kinks of a light
 //! (where a shadow ray grazes a sphere, `optics::kinks`) the set of spheres crossed does not
-//! change, so a list per kink-free stretch would be shorter still; measured on 1UUN, the extra
-//! BVH queries (one per quadrature segment, since segments end at kinks) cost more than the
-//! longer lists: per interval was about twice as fast, per whole camera ray slower again.
+//! change, so a list per kink-free stretch would be shorter still, but it would cost a BVH
+//! query per quadrature segment (segments end at kinks), more than the longer lists cost.
 //! Instead, for a directional light each candidate keeps the range of camera-ray parameters t
 //! from which a shadow ray can reach it at all (the inside of its tangency cylinder, padded for
 //! round-off: `reach_range`), and a node outside that range skips the sphere test: the effect of
@@ -29,8 +28,6 @@
 //! camera ray), and each interval's list is *narrowed* from it ([`Occluders::narrow`]: the same
 //! reach-range and half-space tests, no BVH). The narrowed list keeps the wide one's order and
 //! is a superset of the spheres crossed, so the hits are the same, in the same order (tested).
-//! On 1UUN (two directional lights) this took about 10 % of the instructions off; with the
-//! cones, a point-light scene lost about 23 %.
 
 // `!(a > b)` is deliberate: unlike `a <= b` it is also true when a value is NaN, so degenerate
 // input takes the safe branch.
@@ -111,9 +108,8 @@ impl Occluders {
     /// Gathers the spheres of `bvh` whose padded box the polygon swept from [x(ta), x(tb)]
     /// towards `light` may touch, for interval `tag` and light index `l`. The renderer's BVH
     /// holds the spheres with σ > 0 only (`Scene::build_gas_bvh`), the only ones that
-    /// contribute to a shadow ray: no particle is read here, where in a large scene each
-    /// read was a cache miss (the random set: 29 % of this function's time, after the
-    /// centres and radii were laid out in leaf order).
+    /// contribute to a shadow ray: no particle is read here (in a large scene each read would
+    /// be a cache miss).
     pub fn gather(
         &mut self,
         bvh: &Bvh,
