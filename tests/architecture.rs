@@ -3,7 +3,11 @@
 //!
 //! * data flows one way: the `use crate::X` graph between the top-level modules of `src/` has no
 //!   cycle (a module may use itself, `error` and the leaf helpers freely);
-//! * no function outside tests is longer than [`MAX_FUNCTION_LINES`] lines.
+//! * inside every module, the files (and sub-folders) use one another without a cycle: a
+//!   module's `mod.rs` is its face (it declares, re-exports and may orchestrate its files) and
+//!   is not a node, and test code (`#[cfg(test)]` items, `tests.rs`, `*_tests.rs`) is left out;
+//! * no function outside tests (test modules and test files) is longer than
+//!   [`MAX_FUNCTION_LINES`] lines.
 //!
 //! Both scans read text, not the compiler's view: they are deliberately simple, and each has a
 //! test below showing that it catches what it is meant to catch.
@@ -209,6 +213,302 @@ fn end_of_item(lines: &[&str], start: usize, indent: usize) -> Option<usize> {
     None
 }
 
+/// Removes `#[cfg(test)]` items (test modules, test-only helpers) from `text`.
+fn strip_test_items(text: &str) -> String {
+    let lines: Vec<&str> = text.lines().collect();
+    let mut out = Vec::new();
+    let mut i = 0;
+    while i < lines.len() {
+        let trimmed = lines[i].trim_start();
+        if trimmed.starts_with("#[cfg(test)]") {
+            let indent = lines[i].len() - trimmed.len();
+            // The item after the attribute: up to its closing brace, or its `;`.
+            let next = i + 1;
+            let end = if lines.get(next).is_some_and(|l| l.trim_end().ends_with(';')) {
+                Some(next)
+            } else {
+                end_of_item(&lines, next, indent)
+            };
+            i = end.map_or(next + 1, |e| e + 1);
+            continue;
+        }
+        out.push(lines[i]);
+        i += 1;
+    }
+    out.join("\n")
+}
+
+/// Whether a file holds only tests (`tests.rs`, `*_tests.rs`).
+fn is_test_file(file: &Path) -> bool {
+    file.file_name()
+        .and_then(|n| n.to_str())
+        .is_some_and(|n| n == "tests.rs" || n.ends_with("_tests.rs"))
+}
+
+/// The module path of a file under `src/`: `src/optics/emission.rs` → `optics::emission`,
+/// `src/optics/mod.rs` → `optics`; empty for `lib.rs` and `main.rs`.
+fn file_module_path(src: &Path, file: &Path) -> Vec<String> {
+    let rel = file.strip_prefix(src).expect("a file under src/");
+    let mut parts: Vec<String> = rel
+        .components()
+        .map(|c| c.as_os_str().to_string_lossy().into_owned())
+        .collect();
+    let last = parts.pop().unwrap_or_default();
+    let stem = last.trim_end_matches(".rs");
+    if !matches!(stem, "mod" | "lib" | "main") {
+        parts.push(stem.to_string());
+    }
+    parts
+}
+
+/// The paths of a `use` tree or path expression starting at `text` (just after `crate::`,
+/// `super::` or `self::`): `a::b` → [[a, b]], `{a::B, c::{d, e}}` → [[a, B], [c, d], [c, e]].
+fn path_tree(text: &str) -> Vec<Vec<String>> {
+    fn ident(s: &str) -> (&str, &str) {
+        let n = s
+            .find(|c: char| !(c.is_ascii_alphanumeric() || c == '_'))
+            .unwrap_or(s.len());
+        (&s[..n], &s[n..])
+    }
+    fn tree(s: &str) -> (Vec<Vec<String>>, &str) {
+        let s = s.trim_start();
+        if let Some(mut rest) = s.strip_prefix('{') {
+            let mut out = Vec::new();
+            loop {
+                rest = rest.trim_start();
+                if let Some(r) = rest.strip_prefix('}') {
+                    return (out, r);
+                }
+                if rest.is_empty() {
+                    return (out, rest);
+                }
+                let (paths, r) = tree(rest);
+                out.extend(paths);
+                rest = r.trim_start();
+                rest = rest.strip_prefix(',').unwrap_or(rest);
+                if rest.len() == r.trim_start().len() && !rest.starts_with('}') {
+                    // Neither a comma nor the closing brace: not a use tree.
+                    return (out, rest);
+                }
+            }
+        }
+        let (name, rest) = ident(s);
+        if name.is_empty() {
+            return (vec![], rest);
+        }
+        // `name as alias`: the alias is no path.
+        let rest = match rest.trim_start().strip_prefix("as ") {
+            Some(r) => ident(r.trim_start()).1,
+            None => rest,
+        };
+        match rest.strip_prefix("::") {
+            Some(after) => {
+                let (subs, r) = tree(after);
+                let paths = if subs.is_empty() {
+                    vec![vec![name.to_string()]]
+                } else {
+                    subs.into_iter()
+                        .map(|mut p| {
+                            p.insert(0, name.to_string());
+                            p
+                        })
+                        .collect()
+                };
+                (paths, r)
+            }
+            None => (vec![vec![name.to_string()]], rest),
+        }
+    }
+    tree(text).0
+}
+
+/// Every module path `text` names, made absolute for a file whose module path is `module`
+/// (`crate::x::y`, `super::x`, `super::super::x`, `self::x`, braced groups included). A
+/// `mod.rs` file's module is its folder's.
+fn referenced_paths(text: &str, module: &[String]) -> Vec<Vec<String>> {
+    let code = strip_comments(text);
+    let mut out = Vec::new();
+    let bytes = code.as_bytes();
+    let mut i = 0;
+    while i < code.len() {
+        let boundary = i == 0 || !(bytes[i - 1].is_ascii_alphanumeric() || bytes[i - 1] == b'_');
+        let rest = &code[i..];
+        if boundary {
+            // A mod.rs file is its folder's module; `self` is that module, `super` its parent.
+            let own: Vec<String> = module.to_vec();
+            // `super` from module M is M's parent (for a mod.rs too: its module is the folder's).
+            let parent = |n: usize| (own.len() >= n).then(|| own[..own.len() - n].to_vec());
+            let (base, after) = if let Some(r) = rest.strip_prefix("crate::") {
+                (Some(vec![]), r)
+            } else if let Some(r) = rest.strip_prefix("self::") {
+                (Some(own.clone()), r)
+            } else if rest.starts_with("super::") {
+                let mut r = rest;
+                let mut n = 0;
+                while let Some(next) = r.strip_prefix("super::") {
+                    r = next;
+                    n += 1;
+                }
+                (parent(n), r)
+            } else {
+                (None, rest)
+            };
+            if let Some(base) = base {
+                for p in path_tree(after) {
+                    let mut abs = base.clone();
+                    abs.extend(p);
+                    out.push(abs);
+                }
+                i += rest.len() - after.len();
+                continue;
+            }
+        }
+        i += rest.chars().next().map_or(1, char::len_utf8);
+    }
+    out
+}
+
+/// The nodes of the module whose folder is `dir`: its files (but `mod.rs` and test files) and
+/// its sub-folders, by module name.
+fn module_children(dir: &Path) -> BTreeSet<String> {
+    let mut out = BTreeSet::new();
+    for e in std::fs::read_dir(dir).unwrap_or_else(|e| panic!("{}: {e}", dir.display())) {
+        let p = e.unwrap().path();
+        let name = p.file_name().unwrap().to_string_lossy().into_owned();
+        if p.is_dir() {
+            out.insert(name);
+        } else if let Some(stem) = name.strip_suffix(".rs") {
+            if stem != "mod" && !is_test_file(&p) {
+                out.insert(stem.to_string());
+            }
+        }
+    }
+    out
+}
+
+/// For every module folder under `src/` (by module path), the graph between its files and
+/// sub-folders: an edge a → b where code in a (or under it) names b.
+fn file_graphs(src: &Path) -> BTreeMap<String, BTreeMap<String, BTreeSet<String>>> {
+    let mut files = Vec::new();
+    rust_files(src, &mut files);
+    let mut graphs: BTreeMap<String, BTreeMap<String, BTreeSet<String>>> = BTreeMap::new();
+    for f in files.iter().filter(|f| !is_test_file(f)) {
+        let module = file_module_path(src, f);
+        let text = strip_test_items(&std::fs::read_to_string(f).unwrap());
+        for path in referenced_paths(&text, &module) {
+            // Each module folder that holds this file, below the crate root.
+            for depth in 1..module.len() {
+                let level = &module[..depth];
+                let dir = level.iter().fold(src.to_path_buf(), |d, s| d.join(s));
+                if !dir.is_dir() || !path.starts_with(level) || path.len() <= depth {
+                    continue;
+                }
+                let (from, to) = (&module[depth], &path[depth]);
+                let children = module_children(&dir);
+                if from != to && children.contains(from) && children.contains(to) {
+                    graphs
+                        .entry(level.join("::"))
+                        .or_default()
+                        .entry(from.clone())
+                        .or_default()
+                        .insert(to.clone());
+                }
+            }
+        }
+    }
+    graphs
+}
+
+/// The strongly connected components of more than one node: every set of nodes that reach one
+/// another, each a cycle or several.
+fn cyclic_components(graph: &BTreeMap<String, BTreeSet<String>>) -> Vec<BTreeSet<String>> {
+    let reach = |from: &String| {
+        let mut seen = BTreeSet::new();
+        let mut stack = vec![from.clone()];
+        while let Some(n) = stack.pop() {
+            for m in graph.get(&n).into_iter().flatten() {
+                if seen.insert(m.clone()) {
+                    stack.push(m.clone());
+                }
+            }
+        }
+        seen
+    };
+    let reached: BTreeMap<&String, BTreeSet<String>> =
+        graph.keys().map(|n| (n, reach(n))).collect();
+    let mut out: Vec<BTreeSet<String>> = Vec::new();
+    for (n, r) in &reached {
+        if !r.contains(*n) || out.iter().any(|c| c.contains(*n)) {
+            continue;
+        }
+        let component: BTreeSet<String> = r
+            .iter()
+            .filter(|m| reached.get(m).is_some_and(|back| back.contains(*n)))
+            .cloned()
+            .collect();
+        out.push(component);
+    }
+    out
+}
+
+#[test]
+fn files_inside_each_module_have_no_cycle() {
+    let graphs = file_graphs(&src_dir());
+    assert!(
+        graphs.len() >= 6 && graphs.contains_key("optics") && graphs.contains_key("reference"),
+        "the scan found too few module folders: {:?}",
+        graphs.keys()
+    );
+    let cycles: Vec<String> = graphs
+        .iter()
+        .flat_map(|(m, g)| {
+            cyclic_components(g).into_iter().map(move |c| {
+                let names: Vec<&str> = c.iter().map(String::as_str).collect();
+                format!("{m}: {{{}}} use one another", names.join(", "))
+            })
+        })
+        .collect();
+    assert!(
+        cycles.is_empty(),
+        "cycles between files inside a module:\n{}",
+        cycles.join("\n")
+    );
+}
+
+#[test]
+fn the_file_scan_finds_a_cycle_between_files() {
+    // A module `m` in a scratch tree whose files a and b use each other (b through a braced
+    // `super` group, a through `crate::`), and c uses a: the scan must report a ↔ b.
+    let root = std::env::temp_dir().join(format!("pgt-arch-{}", std::process::id()));
+    let src = root.join("src");
+    let m = src.join("m");
+    std::fs::create_dir_all(&m).unwrap();
+    std::fs::write(src.join("lib.rs"), "pub mod m;\n").unwrap();
+    std::fs::write(
+        m.join("mod.rs"),
+        "pub mod a;\npub mod b;\npub mod c;\npub use a::A;\n",
+    )
+    .unwrap();
+    std::fs::write(m.join("a.rs"), "use crate::m::b::B;\npub struct A(B);\n").unwrap();
+    std::fs::write(
+        m.join("b.rs"),
+        "use super::{a::A as _, c};\n// super::c in a comment is no edge\npub struct B;\n",
+    )
+    .unwrap();
+    std::fs::write(
+        m.join("c.rs"),
+        "#[cfg(test)]\nmod tests {\n    use super::super::b;\n}\n",
+    )
+    .unwrap();
+    let graphs = file_graphs(&src);
+    std::fs::remove_dir_all(&root).unwrap();
+    let g = &graphs["m"];
+    let names = |v: &[&str]| -> BTreeSet<String> { v.iter().map(|s| s.to_string()).collect() };
+    assert_eq!(cyclic_components(g), vec![names(&["a", "b"])], "{g:?}");
+    assert_eq!(g["b"], names(&["a", "c"]));
+    assert!(!g.contains_key("c"), "test code is no edge: {g:?}");
+}
+
 #[test]
 fn top_level_modules_have_no_cycle() {
     let graph = module_graph(&src_dir());
@@ -229,7 +529,7 @@ fn no_function_is_longer_than_the_limit() {
     let mut files = Vec::new();
     rust_files(&src_dir(), &mut files);
     let mut long = Vec::new();
-    for f in &files {
+    for f in files.iter().filter(|f| !is_test_file(f)) {
         let text = std::fs::read_to_string(f).unwrap();
         for (line, name, len) in long_functions(&text, MAX_FUNCTION_LINES) {
             long.push(format!("{}:{line}: fn {name} is {len} lines", f.display()));

@@ -3,7 +3,8 @@
 //! `src/approx/layout.rs`; no file under `shaders/` may declare them again or write their
 //! numbers. No GPU needed.
 
-use pgt::approx::contract::{self, WgslConst, BINDINGS};
+use pgt::approx::contract::{self, BINDINGS};
+use pgt::approx::wgsl::{self, WgslConst};
 use std::path::{Path, PathBuf};
 
 fn wgsl_files(dir: &Path, out: &mut Vec<PathBuf>) {
@@ -52,7 +53,7 @@ fn repetitions(text: &str) -> Vec<String> {
         .filter(|t| !t.is_empty())
         .map(|t| t.to_ascii_lowercase())
         .collect();
-    for c in contract::constants() {
+    for c in wgsl::constants() {
         if code.contains(&format!("const {}", c.name())) {
             found.push(format!("declares const {}", c.name()));
         }
@@ -132,7 +133,7 @@ fn the_check_finds_hand_copies() {
 
 #[test]
 fn the_generated_prelude_carries_the_rust_values() {
-    let text = contract::wgsl_declarations();
+    let text = wgsl::wgsl_declarations();
     assert!(text.contains(&format!("const MAX_HITS: u32 = {}u;", contract::MAX_HITS)));
     assert!(text.contains(&format!(
         "@group(0) @binding({}) var<storage, read_write> stats: Stats;",

@@ -1,5 +1,5 @@
 //! The Rust structs of `src/approx/layout.rs` and the WGSL structs generated from them
-//! (`pgt::approx::contract::wgsl_declarations`, prepended to `shaders/common.wgsl`) must agree
+//! (`pgt::approx::wgsl::wgsl_declarations`, prepended to `shaders/common.wgsl`) must agree
 //! byte for byte (docs/design.md §4): generating the text does not make WGSL's alignment rules
 //! Rust's. naga computes the WGSL layout; this compares every named member's offset and every
 //! struct's size with `offset_of!` and `size_of`. No GPU needed.

@@ -20,15 +20,18 @@ pub mod contract;
 pub mod dispatch;
 pub mod layout;
 pub mod methods;
+pub mod param_spec;
 pub mod params;
 pub mod shader;
 pub mod user_shader;
+pub mod wgsl;
 
 pub use context::{GpuContext, NO_ADAPTER};
 pub use contract::{MAX_HITS, STACK_DEPTH};
 pub use dispatch::Timing;
 pub use methods::{find_method, ApproxMethod, METHODS};
-pub use params::{ApproxParams, Method, ParamSpec, N_EXACT_ALL};
+pub use param_spec::{ParamSpec, N_EXACT_ALL};
+pub use params::{ApproxParams, Method};
 
 use crate::error::{PgtError, Result};
 use crate::image_io::RgbImage;

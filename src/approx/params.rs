@@ -1,49 +1,17 @@
-//! Method parameters (docs/design.md §4: "methods, chosen by name, each a documented set of
-//! parameters"): what a parameter is ([`ParamSpec`]), which method runs ([`Method`]) and the
-//! values chosen for it by name ([`ApproxParams`]), validated against the method's specs. The
-//! values travel to the GPU in `GpuFrame::params`, slot k for the k-th parameter, so a new
-//! parameter needs no new field anywhere.
+//! Which method runs ([`Method`]: one of the registry's or a user's file) and the parameter
+//! values chosen for it by name ([`ApproxParams`]), validated against the method's
+//! [`ParamSpec`]s (docs/design.md §4: "methods, chosen by name, each a documented set of
+//! parameters"). The values travel to the GPU in `GpuFrame::params`, slot k for the k-th
+//! parameter, so a new parameter needs no new field anywhere.
 
 use super::contract::PARAM_SLOTS;
 use super::methods::{self, ApproxMethod};
+use super::param_spec::{ParamSpec, N_EXACT_ALL};
 use super::shader::{ShaderPart, ShaderProgram};
 use crate::error::{PgtError, Result};
 use crate::scene::Scene;
 use std::borrow::Cow;
 use std::path::PathBuf;
-
-/// `n_exact` meaning "every particle on the ray" (`--n-exact all`).
-pub const N_EXACT_ALL: u32 = u32::MAX;
-
-/// One parameter of a method: its name, default, valid range and meaning.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct ParamSpec {
-    /// Name on the command line (`--param NAME=VALUE`), in sweeps and in WGSL (`PARAM_NAME`).
-    pub name: &'static str,
-    pub default: u32,
-    /// Smallest valid value.
-    pub min: u32,
-    /// Largest valid value ([`N_EXACT_ALL`] where "all" is meaningful).
-    pub max: u32,
-    /// One line: what it does.
-    pub doc: &'static str,
-}
-
-impl ParamSpec {
-    /// A value as people write it: "all" for [`N_EXACT_ALL`] where that is the maximum.
-    pub fn show(&self, value: u32) -> String {
-        if value == N_EXACT_ALL && self.max == N_EXACT_ALL {
-            "all".into()
-        } else {
-            value.to_string()
-        }
-    }
-
-    /// "1..=16777216", "0..=all".
-    pub fn range(&self) -> String {
-        format!("{}..={}", self.show(self.min), self.show(self.max))
-    }
-}
 
 /// The parameters a user shader (`--shader`) always has, so that `PARAM_SAMPLES` and
 /// `PARAM_N_EXACT` exist for it as they do for `thesis`; `--param` adds more.

@@ -1,5 +1,5 @@
 //! WGSL programs: the declarations generated from the CPU–GPU contract
-//! ([`super::contract::wgsl_declarations`]), the method's parameter slot names, the prelude
+//! ([`super::wgsl::wgsl_declarations`]), the method's parameter slot names, the prelude
 //! `shaders/common.wgsl`, one method file and the entry point `shaders/entry.wgsl`,
 //! concatenated, then parsed and validated with naga before any pipeline exists (docs/design.md §4). Errors name the file the offending line came from and its line in
 //! *that* file, so a user's mistake points at the user's line, not at the concatenation.
@@ -26,7 +26,7 @@ pub fn prelude_parts() -> Vec<ShaderPart> {
     vec![
         ShaderPart {
             name: GENERATED_CONTRACT.into(),
-            text: Cow::Owned(super::contract::wgsl_declarations()),
+            text: Cow::Owned(super::wgsl::wgsl_declarations()),
         },
         ShaderPart {
             name: "shaders/common.wgsl".into(),
@@ -77,7 +77,7 @@ impl ShaderProgram {
         let mut parts = prelude_parts();
         parts.push(ShaderPart {
             name: GENERATED_PARAMS.into(),
-            text: Cow::Owned(super::contract::param_declarations(param_names)),
+            text: Cow::Owned(super::wgsl::param_declarations(param_names)),
         });
         parts.push(method);
         parts.push(ShaderPart {

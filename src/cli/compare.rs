@@ -155,7 +155,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
             eprintln!("{verdict}");
         }
         Some(path) => {
-            report::html::write_text(path, &(serde_json::to_string_pretty(&summary)? + "\n"))?;
+            report::text::write_text(path, &(serde_json::to_string_pretty(&summary)? + "\n"))?;
             println!("{verdict}");
         }
         None => println!("{verdict}"),

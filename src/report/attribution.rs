@@ -3,7 +3,7 @@
 //! interaction term, as defined in [`crate::sweep::attribution`]), an error map per cause on one
 //! scale, and a table.
 
-use super::html::escape;
+use super::text::escape;
 use super::{heatmap, ColorMap, Scale};
 use crate::error::Result;
 use crate::sweep::AttributionResult;
@@ -126,7 +126,7 @@ pub fn write_attribution_files(
     height: u32,
 ) -> Result<()> {
     for a in attributions {
-        super::html::write_text(&dir.join(bar_file(a)), &bars_svg(a))?;
+        super::text::write_text(&dir.join(bar_file(a)), &bars_svg(a))?;
         // One scale for all causes of a run, so that the maps compare by eye.
         let highs: Vec<f32> = a
             .causes

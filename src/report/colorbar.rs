@@ -41,7 +41,7 @@ pub fn colorbar_svg(scale: Scale, cmap: ColorMap, title: &str, id: &str) -> Stri
     let _ = write!(
         s,
         "<svg class=\"colorbar\" xmlns=\"http://www.w3.org/2000/svg\" width=\"{width}\" height=\"{height}\" viewBox=\"0 0 {width} {height}\" role=\"img\" aria-label=\"{}\">",
-        super::html::escape(title)
+        super::text::escape(title)
     );
     let _ = write!(
         s,
@@ -69,7 +69,7 @@ pub fn colorbar_svg(scale: Scale, cmap: ColorMap, title: &str, id: &str) -> Stri
             "<line x1=\"{x0}\" y1=\"{y:.2}\" x2=\"{:.2}\" y2=\"{y:.2}\" stroke=\"#000\"/><text x=\"{:.2}\" y=\"{y:.2}\" dominant-baseline=\"middle\" font-family=\"sans-serif\" font-size=\"{FONT_PX}\">{}</text>",
             x0 + 4.0,
             x0 + 6.0,
-            super::html::escape(label)
+            super::text::escape(label)
         );
     }
     s += "</svg>";

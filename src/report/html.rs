@@ -9,6 +9,7 @@ use super::colorbar::colorbar_svg;
 use super::colormap::{ColorMap, Scale};
 use super::heatmap::heatmap;
 use super::summary::{format_db, short, Summary};
+use super::text::{escape, write_text};
 use super::viewer::{write_viewer, Viewer, ViewerImage};
 use crate::error::{PgtError, Result};
 use crate::image_io::{write_image, RgbImage};
@@ -383,22 +384,8 @@ window.addEventListener("load", function () {{
     )
 }
 
-/// HTML-escapes text.
-pub fn escape(s: &str) -> String {
-    s.replace('&', "&amp;")
-        .replace('<', "&lt;")
-        .replace('>', "&gt;")
-        .replace('"', "&quot;")
-}
-
 /// Writes the maps as a float32 EXR, atomically: `abs` as the unnamed `R`, `G`, `B`, each of
 /// `layers` as `NAME.R/G/B` (run-length compressed: see `image_io`).
 fn write_maps_exr(path: &Path, abs: &RgbImage, layers: &[(&str, &RgbImage)]) -> Result<()> {
     write_image(path, abs, layers, 0.0)
-}
-
-/// Writes a text file atomically.
-pub fn write_text(path: &Path, text: &str) -> Result<()> {
-    use std::io::Write;
-    crate::image_io::write_atomically(path, |w| w.write_all(text.as_bytes()))
 }

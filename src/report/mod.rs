@@ -17,4 +17,5 @@ pub use html::{write_report, ReportInputs, ReportOptions};
 pub use summary::Summary;
 pub mod plot;
 pub mod sweep_page;
+pub mod text;
 pub mod viewer;

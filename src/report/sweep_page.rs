@@ -6,9 +6,10 @@
 
 use super::attribution::{attribution_json, attribution_section, write_attribution_files};
 use super::colorbar::colorbar_svg;
-use super::html::{escape, page, write_text};
+use super::html::page;
 use super::plot::{line_plot_svg, PlotSpec, Series};
 use super::summary::{format_db, short};
+use super::text::{escape, write_text};
 use super::viewer::{write_viewer, Viewer, ViewerImage};
 use super::{heatmap, ColorMap, Scale};
 use crate::error::{PgtError, Result};

@@ -14,7 +14,7 @@
 //! pan and flip still work; the page says why the probe is off). The script itself is
 //! `pgt-viewer.js` (`src/report/viewer.js`), the same file for every report.
 
-use super::html::{escape, write_text};
+use super::text::{escape, write_text};
 use crate::error::{PgtError, Result};
 use crate::image_io::RgbImage;
 use std::fmt::Write as _;

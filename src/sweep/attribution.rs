@@ -17,7 +17,7 @@
 //! ones gone); the experiment file fixes the order, and the report states it.
 
 use super::experiment::{Attribution, Experiment};
-use super::runner::RunResult;
+use super::run_result::RunResult;
 use crate::error::Result;
 use crate::image_io::RgbImage;
 use crate::metrics::{compare, maps, CompareOptions};

@@ -3,7 +3,8 @@
 //! expansion of each `[[approximations]]` entry into runs (the Cartesian product of its lists),
 //! each with the index of its baseline run where the entry names one.
 
-use super::method::{find_method, method_names, ParamDefault, ParamValue, SweepMethod, SweepParam};
+use super::method::{ParamDefault, ParamValue, SweepMethod, SweepParam};
+use super::registry::{find_method, method_names};
 use crate::error::{line_of, toml_error, with_quoted_line, PgtError, Result};
 use crate::reference::MAX_SPP;
 use std::collections::BTreeMap;

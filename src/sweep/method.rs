@@ -1,5 +1,5 @@
-//! What a sweep can run: the [`SweepMethod`] trait, the parameter values an experiment lists,
-//! and the table of methods ([`find_method`], [`method_names`]).
+//! What a sweep can run: the [`SweepMethod`] trait and the parameter values an experiment
+//! lists (the table of methods by name is `registry.rs`).
 //!
 //! A method declares its parameters ([`SweepParam`]: name, default, smallest value, whether
 //! `"all"` is allowed, doc); the experiment file is validated against them, so a new method is
@@ -149,30 +149,4 @@ pub fn value_of(values: &[(&'static str, u32)], name: &str, default: u32) -> u32
         .iter()
         .find(|(k, _)| *k == name)
         .map_or(default, |(_, v)| *v)
-}
-
-/// The CPU methods: `riemann` and `thesis-cpu`.
-fn cpu_methods() -> [&'static dyn SweepMethod; 2] {
-    [&super::riemann::RIEMANN, &super::thesis_cpu::THESIS_CPU]
-}
-
-/// The method named `name`: the CPU methods (`riemann`, `thesis-cpu`), then every method of
-/// the approximation registry.
-pub fn find_method(name: &str) -> Option<&'static dyn SweepMethod> {
-    if let Some(m) = cpu_methods().into_iter().find(|m| m.name() == name) {
-        return Some(m);
-    }
-    super::gpu::gpu_methods()
-        .iter()
-        .find(|m| m.name() == name)
-        .map(|m| m as &'static dyn SweepMethod)
-}
-
-/// The names [`find_method`] knows, for error messages and docs.
-pub fn method_names() -> Vec<&'static str> {
-    cpu_methods()
-        .into_iter()
-        .map(|m| m.name())
-        .chain(super::gpu::gpu_methods().iter().map(|m| m.name()))
-        .collect()
 }

@@ -76,17 +76,18 @@ pub mod attribution;
 pub mod experiment;
 pub mod gpu;
 pub mod method;
+pub mod registry;
 pub mod riemann;
+pub mod run_result;
 pub mod runner;
 pub mod thesis_cpu;
 
 pub use attribution::{AttributionResult, CauseResult};
 pub use experiment::{Attribution, AttributionStep, Experiment, ReferenceSpec, Run};
-pub use method::{
-    find_method, method_names, ParamDefault, ParamValue, RunImage, SweepContext, SweepMethod,
-    SweepParam,
-};
+pub use method::{ParamDefault, ParamValue, RunImage, SweepContext, SweepMethod, SweepParam};
+pub use registry::{find_method, method_names};
+pub use run_result::{BaselineResult, RunResult};
 pub use runner::{
-    load_scene, reference_key, run_sweep, BaselineResult, Progress, ReferenceInfo, RunResult,
-    SweepOptions, SweepResults, Unconverged,
+    load_scene, reference_key, run_sweep, Progress, ReferenceInfo, SweepOptions, SweepResults,
+    Unconverged,
 };

@@ -5,10 +5,12 @@
 
 use super::attribution::{attribute, AttributionResult};
 use super::experiment::{Experiment, Run};
-use super::method::{find_method, SweepContext, SweepMethod};
+use super::method::{SweepContext, SweepMethod};
+use super::registry::find_method;
+use super::run_result::{BaselineResult, RunResult};
 use crate::error::{PgtError, Result};
 use crate::image_io::{read_exr_layer, write_atomically, write_image, RgbImage};
-use crate::metrics::{compare, maps, CompareOptions, Comparison};
+use crate::metrics::{compare, maps, CompareOptions};
 use crate::reference::{self, Integrator, RenderOptions};
 use crate::scene::{Scene, SceneLoadOptions};
 use std::io::Write as _;
@@ -47,33 +49,6 @@ pub struct Unconverged {
     pub count: u64,
     /// (x, y, largest channel of its error estimate).
     pub worst: Option<(u32, u32, f64)>,
-}
-
-/// A run compared with its baseline run.
-#[derive(Debug, Clone)]
-pub struct BaselineResult {
-    /// The baseline run's label.
-    pub label: String,
-    /// The run's image against the baseline's (the baseline in the reference's place).
-    pub comparison: Comparison,
-}
-
-/// The result of one run.
-#[derive(Debug, Clone)]
-pub struct RunResult {
-    pub run: Run,
-    /// GPU time for GPU methods, wall time for CPU ones.
-    pub seconds: f64,
-    /// Against the exact reference.
-    pub comparison: Comparison,
-    pub baseline: Option<BaselineResult>,
-    /// The run's PNG, relative to the sweep's folder.
-    pub image_file: String,
-    /// |a − r| against the reference, mean over channels, per pixel (for the heatmaps).
-    pub abs_error: Vec<f32>,
-    /// The run's image (linear float), for the report's pixel probe.
-    pub image: RgbImage,
-    pub warnings: Vec<String>,
 }
 
 /// Everything a sweep measured.

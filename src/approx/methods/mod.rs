@@ -8,7 +8,7 @@
 //! User shaders (`pgt approx --shader FILE.wgsl`, docs/user-shaders.md) are not registered:
 //! they are [`super::Method::User`].
 
-use super::params::ParamSpec;
+use super::param_spec::ParamSpec;
 use crate::error::Result;
 use crate::scene::{RenderMode, Scene};
 use std::fmt::Write as _;

@@ -18,7 +18,7 @@
 //! ```
 
 use super::ApproxMethod;
-use crate::approx::params::{ParamSpec, N_EXACT_ALL};
+use crate::approx::param_spec::{ParamSpec, N_EXACT_ALL};
 use crate::error::{PgtError, Result};
 use crate::optics::models;
 use crate::scene::{RenderMode, Scene};

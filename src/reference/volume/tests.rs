@@ -1,11 +1,11 @@
 //! Unit tests of the volume renderer: honesty of err where shadow rays stop early, where segments start at R5, near point lights inside gas; buffers reused across camera rays change no bit.
 
-use super::*;
 use super::per_light::{t_at, POINT_LIGHT_GRADING};
+use super::*;
 use crate::geometry::Camera;
 use crate::optics::light::Light;
-use crate::reference::shadow::Occluders;
 use crate::optics::{models, Model, Particle};
+use crate::reference::shadow::Occluders;
 use crate::scene::{LightWeight, RenderMode, RenderSettings};
 
 /// A gas sphere of the given opacity Θmax, its albedo its colour.
