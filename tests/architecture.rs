@@ -7,7 +7,11 @@
 //!   module's `mod.rs` is its face (it declares, re-exports and may orchestrate its files) and
 //!   is not a node, and test code (`#[cfg(test)]` items, `tests.rs`, `*_tests.rs`) is left out;
 //! * no function outside tests (test modules and test files) is longer than
-//!   [`MAX_FUNCTION_LINES`] lines.
+//!   [`MAX_FUNCTION_LINES`] lines;
+//! * the contract is inside the repository: every `§N` the code cites is a heading of
+//!   `docs/design.md`, every `docs/….md` it names exists (with the heading it quotes), and every
+//!   relative link of README.md and `docs/` resolves (to a file, and to a heading where it has
+//!   a `#fragment`).
 //!
 //! Both scans read text, not the compiler's view: they are deliberately simple, and each has a
 //! test below showing that it catches what it is meant to catch.
@@ -583,4 +587,239 @@ fn the_length_scan_measures_functions_and_skips_tests() {
     assert_eq!(found[0].1, "long");
     assert_eq!(found[0].2, 135);
     assert_eq!(found[0].0, 5);
+}
+
+/// The repository's root.
+fn root_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The headings of a Markdown file, as written (without the `#`s).
+fn headings(markdown: &str) -> Vec<String> {
+    let mut in_code = false;
+    let mut out = Vec::new();
+    for line in markdown.lines() {
+        if line.trim_start().starts_with("```") {
+            in_code = !in_code;
+        } else if !in_code && line.starts_with('#') {
+            out.push(line.trim_start_matches('#').trim().to_string());
+        }
+    }
+    out
+}
+
+/// GitHub's anchor of a heading: lower case, spaces to hyphens, other punctuation dropped.
+fn anchor(heading: &str) -> String {
+    heading
+        .to_lowercase()
+        .chars()
+        .filter_map(|c| match c {
+            ' ' => Some('-'),
+            c if c.is_alphanumeric() || c == '-' || c == '_' => Some(c),
+            _ => None,
+        })
+        .collect()
+}
+
+/// Every `§N` citation of `text` that refers to docs/design.md, with its line: all of them
+/// but those of outside documents (a paper's or a standard's sections, named just before).
+fn design_citations(text: &str) -> Vec<(usize, u32)> {
+    let mut out = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        for (i, _) in line.match_indices('§') {
+            let before = &line[..i];
+            let window = &before[before.len().saturating_sub(40)..];
+            if window.contains("paper") || window.contains("14772") || window.contains("thesis §")
+            {
+                continue;
+            }
+            let digits: String = line[i + '§'.len_utf8()..]
+                .chars()
+                .take_while(char::is_ascii_digit)
+                .collect();
+            if let Ok(section) = digits.parse() {
+                out.push((n + 1, section));
+            }
+        }
+    }
+    out
+}
+
+/// `docs/NAME.md` paths named in `text`, each with the heading quoted right after it
+/// (`docs/performance.md, "Exponentials"`), if any.
+fn docs_mentions(text: &str) -> Vec<(usize, String, Option<String>)> {
+    let mut out = Vec::new();
+    for (n, line) in text.lines().enumerate() {
+        let mut rest = line;
+        while let Some(i) = rest.find("docs/") {
+            let after = &rest[i..];
+            let end = after
+                .find(|c: char| !(c.is_ascii_alphanumeric() || "/-_.".contains(c)))
+                .unwrap_or(after.len());
+            let path = after[..end].trim_end_matches('.');
+            if path.ends_with(".md") {
+                let quoted = after[path.len()..]
+                    .strip_prefix(", \"")
+                    .and_then(|q| q.split('"').next())
+                    .map(str::to_string);
+                out.push((n + 1, path.to_string(), quoted));
+            }
+            rest = &after[end.max(1)..];
+        }
+    }
+    out
+}
+
+#[test]
+fn every_citation_in_the_code_resolves_in_the_docs() {
+    let root = root_dir();
+    let design = std::fs::read_to_string(root.join("docs/design.md")).expect("docs/design.md");
+    let sections: BTreeSet<u32> = headings(&design)
+        .iter()
+        .filter_map(|h| h.split('.').next()?.parse().ok())
+        .collect();
+    let mut files = Vec::new();
+    rust_files(&src_dir(), &mut files);
+    let mut bad = Vec::new();
+    let mut cited = 0;
+    for f in &files {
+        let text = std::fs::read_to_string(f).unwrap();
+        for (line, section) in design_citations(&text) {
+            cited += 1;
+            if !sections.contains(&section) {
+                bad.push(format!(
+                    "{}:{line}: §{section} is no section of docs/design.md",
+                    f.display()
+                ));
+            }
+        }
+        for (line, path, quoted) in docs_mentions(&text) {
+            match std::fs::read_to_string(root.join(&path)) {
+                Err(_) => bad.push(format!("{}:{line}: {path} does not exist", f.display())),
+                Ok(doc) => {
+                    if let Some(q) = quoted {
+                        if !headings(&doc).iter().any(|h| h == &q) {
+                            bad.push(format!(
+                                "{}:{line}: {path} has no heading \"{q}\"",
+                                f.display()
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+    }
+    assert!(cited > 100, "the scan found only {cited} citations");
+    assert!(
+        bad.is_empty(),
+        "citations that do not resolve:\n{}",
+        bad.join("\n")
+    );
+}
+
+/// The relative links of a Markdown file that do not resolve, as messages.
+fn broken_links(file: &Path) -> Vec<String> {
+    let text = std::fs::read_to_string(file).unwrap_or_else(|e| panic!("{}: {e}", file.display()));
+    let dir = file.parent().unwrap();
+    let mut bad = Vec::new();
+    let mut in_code = false;
+    for (n, line) in text.lines().enumerate() {
+        if line.trim_start().starts_with("```") {
+            in_code = !in_code;
+            continue;
+        }
+        if in_code {
+            continue;
+        }
+        for (i, _) in line.match_indices("](") {
+            let target = &line[i + 2..];
+            let Some(end) = target.find(')') else {
+                continue;
+            };
+            let target = target[..end].trim();
+            if target.contains("://") || target.starts_with("mailto:") {
+                continue;
+            }
+            let (path, fragment) = match target.split_once('#') {
+                Some((p, f)) => (p, Some(f)),
+                None => (target, None),
+            };
+            let linked = if path.is_empty() {
+                file.to_path_buf()
+            } else {
+                dir.join(path)
+            };
+            let here = format!("{}:{}: ({target})", file.display(), n + 1);
+            if !linked.exists() {
+                bad.push(format!("{here}: no such file"));
+                continue;
+            }
+            if let (Some(fragment), true) =
+                (fragment, linked.extension().is_some_and(|e| e == "md"))
+            {
+                let doc = std::fs::read_to_string(&linked).unwrap();
+                if !headings(&doc).iter().any(|h| anchor(h) == fragment) {
+                    bad.push(format!("{here}: no heading with the anchor #{fragment}"));
+                }
+            }
+        }
+    }
+    bad
+}
+
+#[test]
+fn every_relative_link_of_the_docs_resolves() {
+    let root = root_dir();
+    let mut files = vec![root.join("README.md")];
+    for dir in ["docs", "reports/examples", "contrib/slurm", "contrib/k8s"] {
+        for e in std::fs::read_dir(root.join(dir)).unwrap() {
+            let p = e.unwrap().path();
+            if p.extension().is_some_and(|e| e == "md") {
+                files.push(p);
+            }
+        }
+    }
+    assert!(files.len() >= 8, "{files:?}");
+    let bad: Vec<String> = files.iter().flat_map(|f| broken_links(f)).collect();
+    assert!(
+        bad.is_empty(),
+        "links that do not resolve:\n{}",
+        bad.join("\n")
+    );
+}
+
+#[test]
+fn the_docs_scans_find_what_they_should() {
+    // Citations: design sections, not a paper's or a standard's.
+    let text = "/// docs/design.md §2, and §8\n/// (paper §3.1) ISO/IEC 14772-1 §5.1\n";
+    assert_eq!(design_citations(text), vec![(1, 2), (1, 8)]);
+    assert_eq!(
+        docs_mentions("see docs/performance.md, \"Exponentials\"; docs/cli.md."),
+        vec![
+            (1, "docs/performance.md".into(), Some("Exponentials".into())),
+            (1, "docs/cli.md".into(), None)
+        ]
+    );
+    assert_eq!(
+        anchor("5. Comparison and reports"),
+        "5-comparison-and-reports"
+    );
+    assert_eq!(anchor("`pgt render`"), "pgt-render");
+    // A broken link and a broken fragment are found, a good one is not.
+    let dir = std::env::temp_dir().join(format!("pgt-links-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("b.md"), "# Title here\n").unwrap();
+    let a = dir.join("a.md");
+    std::fs::write(
+        &a,
+        "[ok](b.md#title-here) [gone](c.md) [bad](b.md#nope)\n```\n[code](x.md)\n```\n",
+    )
+    .unwrap();
+    let bad = broken_links(&a);
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(bad.len(), 2, "{bad:?}");
+    assert!(
+        bad[0].contains("c.md") && bad[1].contains("#nope"),
+        "{bad:?}"
+    );
 }
