@@ -1,4 +1,4 @@
-//! The exact reference renderer (docs/design.md §3): f64 throughout, parallel over pixel tiles with
+//! The exact reference renderer (docs/design.md §3): f64 throughout, parallel over blocks of pixels with
 //! rayon, bit-identical for any thread count (each pixel is a pure function of the scene).
 
 pub mod opaque;
@@ -135,8 +135,8 @@ pub fn estimator_for<'a>(
 /// Largest k of k×k samples per pixel.
 pub const MAX_SPP: u32 = 64;
 
-/// Side of a square tile of pixels, the unit of parallel work.
-const TILE: u32 = 16;
+/// Side of a square block of pixels, the unit of parallel work.
+const BLOCK: u32 = 16;
 
 /// Runs `estimator` over every pixel of `camera`'s image.
 pub fn render_with(
@@ -146,13 +146,13 @@ pub fn render_with(
 ) -> Result<RenderOutput> {
     let start = Instant::now();
     let (w, h) = (camera.width, camera.height);
-    let tiles_x = w.div_ceil(TILE);
-    let tiles_y = h.div_ceil(TILE);
-    let tiles: Vec<(u32, u32)> = (0..tiles_y)
-        .flat_map(|ty| (0..tiles_x).map(move |tx| (tx, ty)))
+    let blocks_x = w.div_ceil(BLOCK);
+    let blocks_y = h.div_ceil(BLOCK);
+    let blocks: Vec<(u32, u32)> = (0..blocks_y)
+        .flat_map(|ty| (0..blocks_x).map(move |tx| (tx, ty)))
         .collect();
     let bar = if options.progress {
-        let bar = indicatif::ProgressBar::new(tiles.len() as u64);
+        let bar = indicatif::ProgressBar::new(blocks.len() as u64);
         bar.set_style(
             indicatif::ProgressStyle::with_template(
                 "{elapsed_precise} [{bar:40}] {percent}% eta {eta}",
@@ -165,13 +165,13 @@ pub fn render_with(
     };
     let k = options.spp;
     let run = || {
-        tiles
+        blocks
             .par_iter()
             .map(|&(tx, ty)| {
-                let mut out = Vec::with_capacity((TILE * TILE) as usize);
+                let mut out = Vec::with_capacity((BLOCK * BLOCK) as usize);
                 let mut shadow_rays = 0u64;
-                for py in ty * TILE..((ty + 1) * TILE).min(h) {
-                    for px in tx * TILE..((tx + 1) * TILE).min(w) {
+                for py in ty * BLOCK..((ty + 1) * BLOCK).min(h) {
+                    for px in tx * BLOCK..((tx + 1) * BLOCK).min(w) {
                         let (radiance, error, rays, unconverged) =
                             render_pixel(camera, estimator, px, py, k);
                         shadow_rays += rays;
@@ -194,9 +194,9 @@ pub fn render_with(
     let mut shadow_rays = 0;
     let mut unconverged = 0;
     let mut worst_unconverged: Option<(u32, u32, f64)> = None;
-    for (tile, rays) in results {
+    for (block, rays) in results {
         shadow_rays += rays;
-        for (px, py, rad, err, not_converged) in tile {
+        for (px, py, rad, err, not_converged) in block {
             let i = py as usize * w as usize + px as usize;
             (image.pixels[i], err_image.pixels[i]) = stored_pixel(rad, err);
             if not_converged {

@@ -76,7 +76,7 @@ pub struct KeptEndOrders {
     plain: PlainSweep,
 }
 
-/// How [`KeptEndOrders::composite_by`] came to its end order (the tests count the paths).
+/// How [`KeptEndOrders::composite_with_path`] came to its end order (the tests count the paths).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub(crate) enum Path {
     /// More chords than an end order holds: the plain sweep.
@@ -121,7 +121,7 @@ impl ShadowCompositor for KeptEndOrders {
         skip: impl Fn(u32) -> bool,
         (background, cut): (DVec3, Option<(f64, DVec3)>),
     ) -> (Composite, bool) {
-        self.composite_by(cutter, hits, range, skip, (background, cut))
+        self.composite_with_path(cutter, hits, range, skip, (background, cut))
             .0
     }
 
@@ -134,7 +134,7 @@ impl ShadowCompositor for KeptEndOrders {
 
 impl KeptEndOrders {
     /// [`ShadowCompositor::composite`], and how the end order was found.
-    pub(crate) fn composite_by(
+    pub(crate) fn composite_with_path(
         &mut self,
         cutter: &IntervalCutter,
         hits: &[Hit],

@@ -97,7 +97,8 @@ fn kept_end_orders_give_the_sweeps_composite_bit_for_bit() {
             } else {
                 built += 1;
             }
-            let (got, path) = kept.composite_by(&cutter, &hits, range, skip, (background, cut));
+            let (got, path) =
+                kept.composite_with_path(&cutter, &hits, range, skip, (background, cut));
             match path {
                 Path::Reordered(Reorder::Swap) => swaps += 1,
                 Path::Reordered(Reorder::Reform) => reforms += 1,
@@ -230,7 +231,8 @@ fn end_orders_through_changes(seed: u64, steps: usize) -> Result<(usize, usize),
         let hits: Vec<Hit> = chords.iter().map(|&(i, a, b)| hit(i, a, b)).collect();
         let range = (0.0, f64::INFINITY);
         let before = kept.orders.first().map(order_bits);
-        let (_, path) = kept.composite_by(&cutter, &hits, range, |_| false, (DVec3::ONE, None));
+        let (_, path) =
+            kept.composite_with_path(&cutter, &hits, range, |_| false, (DVec3::ONE, None));
         splices += usize::from(path == Path::Near(Near::Spliced));
         reforms += usize::from(path == Path::Reordered(Reorder::Reform));
         // The composite's own ends: `t.max(0.0)` of a chord that starts at −0 may give
