@@ -136,6 +136,113 @@ pub fn with_quoted_line(message: String, text: &str, line: usize) -> String {
     }
 }
 
+/// A text input being validated (a scene file, an experiment file): its path and text, so that
+/// an error names `file:line` and quotes the line. Scene validation and the experiment reader
+/// both report through it and the [`At`] it hands out.
+#[derive(Debug, Clone, Copy)]
+pub struct SourceText<'a> {
+    pub path: &'a Path,
+    pub text: &'a str,
+}
+
+impl<'a> SourceText<'a> {
+    /// The 1-based line of a TOML value.
+    pub fn line<T>(&self, value: &toml::Spanned<T>) -> usize {
+        line_of(self.text, value.span().start)
+    }
+
+    /// An error at `line` that quotes the line's text ([`with_quoted_line`]).
+    pub fn error(&self, line: usize, message: String) -> PgtError {
+        PgtError::at_line(self.path, line, with_quoted_line(message, self.text, line))
+    }
+
+    /// The place of the byte range `span` (its first line), for [`At`]'s checks.
+    pub fn at(&self, span: std::ops::Range<usize>) -> At<'a> {
+        At {
+            path: self.path,
+            location: Location::Line(line_of(self.text, span.start)),
+        }
+    }
+
+    /// The file as a whole (for what no line stands for, e.g. a command-line override).
+    pub fn whole(&self) -> At<'a> {
+        At::whole(self.path)
+    }
+}
+
+/// A place in an input that errors name (`file:line`, `file (byte N)` or the file), with the
+/// checks that validation makes of the values found there; each error names the field.
+#[derive(Debug, Clone)]
+pub struct At<'a> {
+    pub path: &'a Path,
+    pub location: Location,
+}
+
+impl<'a> At<'a> {
+    /// The file as a whole.
+    pub fn whole(path: &'a Path) -> At<'a> {
+        At {
+            path,
+            location: Location::File,
+        }
+    }
+
+    /// An error here.
+    pub fn err(&self, message: impl Into<String>) -> PgtError {
+        PgtError::Input {
+            path: self.path.to_path_buf(),
+            location: self.location.clone(),
+            message: message.into(),
+        }
+    }
+
+    /// `v`, if finite.
+    pub fn finite(&self, field: &str, v: f64) -> Result<f64> {
+        if v.is_finite() {
+            Ok(v)
+        } else {
+            Err(self.err(format!("{field} must be a finite number, got {v}")))
+        }
+    }
+
+    /// Three finite numbers as a vector.
+    pub fn vec3(&self, field: &str, v: [f64; 3]) -> Result<glam::DVec3> {
+        if v.iter().all(|x| x.is_finite()) {
+            Ok(glam::DVec3::from(v))
+        } else {
+            Err(self.err(format!("{field} must hold three finite numbers, got {v:?}")))
+        }
+    }
+
+    /// Three finite numbers ≥ 0 (a colour, an irradiance).
+    pub fn non_negative3(&self, field: &str, v: [f64; 3]) -> Result<glam::DVec3> {
+        let d = self.vec3(field, v)?;
+        if d.min_element() < 0.0 {
+            return Err(self.err(format!("{field} must be ≥ 0 in every channel, got {v:?}")));
+        }
+        Ok(d)
+    }
+
+    /// A non-zero vector, normalised.
+    pub fn direction(&self, field: &str, v: [f64; 3]) -> Result<glam::DVec3> {
+        let d = self.vec3(field, v)?;
+        let len = d.length();
+        if len == 0.0 || !len.is_finite() {
+            return Err(self.err(format!("{field} must be a non-zero vector, got {v:?}")));
+        }
+        Ok(d / len)
+    }
+
+    /// A finite `v` in [lo, hi]; `what` says the range in the message ("in [0, 1]").
+    pub fn in_range(&self, field: &str, v: f64, lo: f64, hi: f64, what: &str) -> Result<f64> {
+        let v = self.finite(field, v)?;
+        if v < lo || v > hi {
+            return Err(self.err(format!("{field} must be {what}, got {v}")));
+        }
+        Ok(v)
+    }
+}
+
 pub type Result<T, E = PgtError> = std::result::Result<T, E>;
 
 #[cfg(test)]

@@ -1,12 +1,13 @@
 //! The `pgt` binary: parse, run, map the outcome to an exit code (docs/design.md §7: 0 success,
 //! 1 gate failed, 2 error).
 
-use clap::Parser;
 use pgt::cli::{self, Outcome};
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
-    let cli = match cli::Cli::try_parse() {
+    // Before any thread starts: it sets an environment variable.
+    pgt::approx::context::quiet_device_select_probe();
+    let cli = match cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
             let code = if e.use_stderr() { 2 } else { 0 };

@@ -1,4 +1,4 @@
-//! A reference render cut into parts for a cluster (docs/design.md §7: `pgt render SCENE --tile I/N
+//! A reference render cut into parts for a cluster (docs/design.md §7: `pgt render SCENE --part I/N
 //! -o PART.exr` and `pgt merge PART... -o OUT`; issue 12), and their bit-identical merge.
 //!
 //! **Which pixels a part holds.** Part I of N (I 0-based, as Slurm's `$SLURM_ARRAY_TASK_ID` and
@@ -36,21 +36,21 @@ use std::path::{Path, PathBuf};
 /// `pgtFormat` of a part file; bump the number when the layout changes.
 pub const FORMAT_TAG: &str = "pgt-part/1";
 
-/// Which part of how many (`--tile I/N`, I 0-based).
+/// Which part of how many (`--part I/N`, I 0-based).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-pub struct Tile {
+pub struct PartOf {
     pub index: u32,
     pub count: u32,
 }
 
-impl std::fmt::Display for Tile {
+impl std::fmt::Display for PartOf {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(f, "{}/{}", self.index, self.count)
     }
 }
 
-/// Parses `I/N` with 0 ≤ I < N (the command-line form of [`Tile`]).
-pub fn parse_tile(s: &str) -> std::result::Result<Tile, String> {
+/// Parses `I/N` with 0 ≤ I < N (the command-line form of [`PartOf`]).
+pub fn parse_part(s: &str) -> std::result::Result<PartOf, String> {
     let err = || format!("expected I/N with 0 <= I < N (I counts from 0), got '{s}'");
     let (i, n) = s.split_once('/').ok_or_else(err)?;
     let index: u32 = i.trim().parse().map_err(|_| err())?;
@@ -58,12 +58,12 @@ pub fn parse_tile(s: &str) -> std::result::Result<Tile, String> {
     if index >= count {
         return Err(err());
     }
-    Ok(Tile { index, count })
+    Ok(PartOf { index, count })
 }
 
-/// The rows of part `tile` of an image `height` rows high: y = I, I + N, I + 2N, …
-pub fn rows_of(tile: Tile, height: u32) -> Vec<u32> {
-    (tile.index..height).step_by(tile.count as usize).collect()
+/// The rows of part `part` of an image `height` rows high: y = I, I + N, I + 2N, …
+pub fn rows_of(part: PartOf, height: u32) -> Vec<u32> {
+    (part.index..height).step_by(part.count as usize).collect()
 }
 
 /// 128-bit FNV-1a, fed through `fmt::Write` so that a scene's `Debug` text (exact: floats print
@@ -108,7 +108,8 @@ pub struct PartHeader {
     /// Size of the whole image.
     pub width: u32,
     pub height: u32,
-    pub tile: Tile,
+    /// Which part of how many it is.
+    pub part: PartOf,
     /// [`render_hash`] of the render the part belongs to.
     pub hash: String,
 }
@@ -122,31 +123,31 @@ pub struct Part {
     pub error: Option<RgbImage>,
 }
 
-/// Renders part `tile` of the scene's image.
+/// Renders part `part` of the scene's image.
 pub fn render_part(
     scene: &Scene,
     options: &RenderOptions,
-    tile: Tile,
+    part: PartOf,
 ) -> Result<(Part, RenderStats)> {
     let (width, height) = (scene.camera.width, scene.camera.height);
-    if tile.count > height {
+    if part.count > height {
         return Err(PgtError::Usage(format!(
-            "--tile {tile}: at most {height} parts for an image {height} rows high (a part is a set of rows)"
+            "--part {part}: at most {height} parts for an image {height} rows high (a part is a set of rows)"
         )));
     }
-    let out = render_rows(scene, options, &rows_of(tile, height))?;
+    let out = render_rows(scene, options, &rows_of(part, height))?;
     let header = PartHeader {
         width,
         height,
-        tile,
+        part,
         hash: render_hash(scene, options),
     };
-    let part = Part {
+    let rendered = Part {
         header,
         image: out.image,
         error: out.error,
     };
-    Ok((part, out.stats))
+    Ok((rendered, out.stats))
 }
 
 /// Writes a part file (an EXR; see the module documentation for its header), atomically.
@@ -155,10 +156,10 @@ pub fn write_part(path: &Path, part: &Part) -> Result<()> {
     let header = [
         ("pgtFormat", FORMAT_TAG.to_string()),
         ("pgtImageSize", format!("{}x{}", h.width, h.height)),
-        ("pgtPart", h.tile.to_string()),
+        ("pgtPart", h.part.to_string()),
         (
             "pgtRows",
-            format!("y mod {} = {}", h.tile.count, h.tile.index),
+            format!("y mod {} = {}", h.part.count, h.part.index),
         ),
         ("pgtRenderHash", h.hash.clone()),
     ];
@@ -192,7 +193,7 @@ pub fn read_part(path: &Path) -> Result<Part> {
     let get = |key: &str| {
         text.get(key).ok_or_else(|| {
             not_part(format!(
-                "its header has no '{key}' attribute (`pgt render --tile I/N` writes parts)"
+                "its header has no '{key}' attribute (`pgt render --part I/N` writes parts)"
             ))
         })
     };
@@ -209,18 +210,18 @@ pub fn read_part(path: &Path) -> Result<Part> {
         .and_then(|(w, h)| Some((w.parse::<u32>().ok()?, h.parse::<u32>().ok()?)))
         .filter(|&(w, h)| w > 0 && h > 0)
         .ok_or_else(|| bad("pgtImageSize", size))?;
-    let tile_text = get("pgtPart")?;
-    let tile = parse_tile(tile_text).map_err(|_| bad("pgtPart", tile_text))?;
+    let part_text = get("pgtPart")?;
+    let part = parse_part(part_text).map_err(|_| bad("pgtPart", part_text))?;
     let header = PartHeader {
         width,
         height,
-        tile,
+        part,
         hash: get("pgtRenderHash")?.clone(),
     };
-    let rows = rows_of(tile, height).len();
+    let rows = rows_of(part, height).len();
     if (layer.size.0, layer.size.1) != (width as usize, rows) {
         return Err(not_part(format!(
-            "it holds {}x{} pixels, but part {tile} of a {width}x{height} image has {width}x{rows}",
+            "it holds {}x{} pixels, but part {part} of a {width}x{height} image has {width}x{rows}",
             layer.size.0, layer.size.1
         )));
     }
@@ -278,12 +279,12 @@ pub fn merge(parts: &[(PathBuf, Part)]) -> Result<(RgbImage, Option<RgbImage>)> 
     let mut by_index: BTreeMap<u32, &PathBuf> = BTreeMap::new();
     for (path, part) in parts {
         let h = &part.header;
-        if (h.width, h.height, h.tile.count) != (h0.width, h0.height, h0.tile.count) {
+        if (h.width, h.height, h.part.count) != (h0.width, h0.height, h0.part.count) {
             return Err(PgtError::in_file(
                 path,
                 format!(
                     "part {} of a {}x{} image, but {} is part {} of a {}x{} image: they are parts of different renders",
-                    h.tile, h.width, h.height, first_path.display(), h0.tile, h0.width, h0.height
+                    h.part, h.width, h.height, first_path.display(), h0.part, h0.width, h0.height
                 ),
             ));
         }
@@ -307,14 +308,14 @@ pub fn merge(parts: &[(PathBuf, Part)]) -> Result<(RgbImage, Option<RgbImage>)> 
                 ),
             ));
         }
-        if let Some(other) = by_index.insert(h.tile.index, path) {
+        if let Some(other) = by_index.insert(h.part.index, path) {
             return Err(PgtError::in_file(
                 path,
-                format!("part {} given twice (also as {})", h.tile, other.display()),
+                format!("part {} given twice (also as {})", h.part, other.display()),
             ));
         }
     }
-    let missing: Vec<String> = (0..h0.tile.count)
+    let missing: Vec<String> = (0..h0.part.count)
         .filter(|i| !by_index.contains_key(i))
         .map(|i| i.to_string())
         .collect();
@@ -322,12 +323,12 @@ pub fn merge(parts: &[(PathBuf, Part)]) -> Result<(RgbImage, Option<RgbImage>)> 
         return Err(PgtError::Usage(format!(
             "part(s) {} of {} missing: the parts given (such as {}, part {}) are of a {}x{} image cut into {} parts, and the merge needs all of them",
             missing.join(", "),
-            h0.tile.count,
+            h0.part.count,
             first_path.display(),
-            h0.tile,
+            h0.part,
             h0.width,
             h0.height,
-            h0.tile.count
+            h0.part.count
         )));
     }
     let mut image = RgbImage::new(h0.width, h0.height);
@@ -337,7 +338,7 @@ pub fn merge(parts: &[(PathBuf, Part)]) -> Result<(RgbImage, Option<RgbImage>)> 
         .map(|_| RgbImage::new(h0.width, h0.height));
     let w = h0.width as usize;
     for (_, part) in parts {
-        for (k, y) in rows_of(part.header.tile, h0.height).into_iter().enumerate() {
+        for (k, y) in rows_of(part.header.part, h0.height).into_iter().enumerate() {
             let (dst, src) = (y as usize * w..(y as usize + 1) * w, k * w..(k + 1) * w);
             image.pixels[dst.clone()].copy_from_slice(&part.image.pixels[src.clone()]);
             if let (Some(e), Some(pe)) = (&mut error, &part.error) {
@@ -353,14 +354,14 @@ mod tests {
     use super::*;
 
     #[test]
-    fn tiles_parse_and_cover_every_row_once() {
-        assert_eq!(parse_tile("2/8"), Ok(Tile { index: 2, count: 8 }));
+    fn parts_parse_and_cover_every_row_once() {
+        assert_eq!(parse_part("2/8"), Ok(PartOf { index: 2, count: 8 }));
         for bad in ["8/8", "1", "-1/4", "a/b", "0/0", "1/2/3"] {
-            assert!(parse_tile(bad).is_err(), "{bad}");
+            assert!(parse_part(bad).is_err(), "{bad}");
         }
         let mut seen = vec![0u32; 37];
         for i in 0..5 {
-            for y in rows_of(Tile { index: i, count: 5 }, 37) {
+            for y in rows_of(PartOf { index: i, count: 5 }, 37) {
                 seen[y as usize] += 1;
             }
         }

@@ -267,11 +267,16 @@ fn an_empty_scene_renders_the_background_with_a_warning() {
 
 #[test]
 fn an_unwritable_output_exits_2() {
+    // A file where a folder would have to be: unwritable for anyone, root included (a missing
+    // folder is made, as for `--report`).
+    let dir = tmp();
+    let file = dir.path().join("file");
+    std::fs::write(&file, "x").unwrap();
     let out = pgt(&[
         "render",
         &example("shadows.toml"),
         "-o",
-        "/nonexistent-dir/x.png",
+        s(&file.join("x.png")),
         "--size",
         "8x8",
     ]);

@@ -267,6 +267,8 @@ fn a_particle_buffer_beyond_the_storage_buffer_limit_is_refused_with_exit_2() {
             csv.to_str().unwrap(),
             "--method",
             "emission",
+            "--model",
+            "emission",
             "--size",
             "16x16",
             "-o",

@@ -231,8 +231,17 @@ fn thesis_ignores_overlaps_and_differs_from_exact_intervals() {
 #[test]
 fn an_empty_scene_renders_the_background() {
     let Some(ctx) = gpu() else { return };
-    let s = scene(vec![], vec![], RenderMode::Volume, models::LIT);
     for method in pgt::approx::METHODS {
+        // Each method on a scene of a mode and model it computes (it refuses any other).
+        let (mode, model) = [
+            (RenderMode::Volume, models::LIT),
+            (RenderMode::Volume, models::EMISSION),
+            (RenderMode::Opaque, models::LIT),
+        ]
+        .into_iter()
+        .find(|&(mode, model)| method.computes().covers(mode, model))
+        .expect("every method computes one of these");
+        let s = scene(vec![], vec![], mode, model);
         let out = render_approx_with(ctx, &s, &plain(method.name())).unwrap();
         let bg = s.render.background.as_vec3().to_array();
         assert!(out.image.pixels.iter().all(|p| *p == bg));

@@ -51,6 +51,30 @@ impl std::fmt::Debug for GpuContext {
     }
 }
 
+/// Keeps the Vulkan loader's device-selection layer from printing
+/// `error: XDG_RUNTIME_DIR is invalid or not set in the environment.` on every GPU command.
+///
+/// Mesa's implicit layer `VK_LAYER_MESA_device_select` looks for a Wayland compositor's GPU
+/// (`wl_display_connect`) whenever the instance enables `VK_KHR_wayland_surface`, which wgpu
+/// always does; libwayland prints that line (twice: the layer enumerates twice) when
+/// `XDG_RUNTIME_DIR` is unset. Without `XDG_RUNTIME_DIR` there is no Wayland session whose GPU
+/// the layer could find, and pgt chooses its adapter itself (`--adapter`, else the first
+/// hardware adapter), so the layer is switched off with its own variable, `NODEVICE_SELECT=1`.
+/// A user who configures the layer (`NODEVICE_SELECT`, `MESA_VK_DEVICE_SELECT`, `DRI_PRIME`)
+/// keeps it as configured. Nothing else is hidden: no output of the loader or driver is filtered.
+///
+/// Changes the process environment: call it before any thread starts (`main` does).
+pub fn quiet_device_select_probe() {
+    let unset = |name: &str| std::env::var_os(name).is_none_or(|v| v.is_empty());
+    if unset("XDG_RUNTIME_DIR")
+        && unset("NODEVICE_SELECT")
+        && unset("MESA_VK_DEVICE_SELECT")
+        && unset("DRI_PRIME")
+    {
+        std::env::set_var("NODEVICE_SELECT", "1");
+    }
+}
+
 fn describe(info: &wgpu::AdapterInfo) -> AdapterDescription {
     AdapterDescription {
         name: info.name.clone(),

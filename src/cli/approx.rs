@@ -2,6 +2,7 @@
 //! GPU approximation, or a user's method with `--shader FILE.wgsl`. The methods and their
 //! parameters come from the registry (`crate::approx::methods`); `--list-methods` prints it.
 
+use super::output::{check_outputs, Output, OutputKind};
 use super::Outcome;
 use crate::approx::{self, methods, ApproxParams, Method, Timing, N_EXACT_ALL};
 use crate::image_io::write_image;
@@ -9,6 +10,7 @@ use crate::scene::{Model, RenderMode, SceneLoadOptions};
 use clap::builder::PossibleValuesParser;
 use clap::Args;
 use std::path::PathBuf;
+use std::time::{Duration, Instant};
 
 /// `pgt approx` (docs/design.md §7).
 #[derive(Debug, Args)]
@@ -47,10 +49,17 @@ pub struct ApproxArgs {
     /// Image size WIDTHxHEIGHT, overriding the scene.
     #[arg(long, value_parser = super::parse_size)]
     pub size: Option<(u32, u32)>,
+    /// Render mode, overriding the scene.
     #[arg(long, value_enum)]
     pub mode: Option<RenderMode>,
+    /// Optical model of the volume mode, overriding the scene (a method refuses a model it does
+    /// not implement).
     #[arg(long, value_enum)]
     pub model: Option<Model>,
+    /// The format of a bare particle file, whatever its extension (a scene file names the
+    /// format of each include with `format = "…"`).
+    #[arg(long, value_name = "NAME", value_parser = super::format_parser())]
+    pub format: Option<&'static crate::formats::Format>,
     /// PNG exposure in stops (2^exposure scales the linear image before encoding).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
@@ -130,10 +139,9 @@ fn approx_spinner(params: &ApproxParams) -> indicatif::ProgressBar {
     bar
 }
 
-/// The spinner's message after a pass: the method's words (`approximating with …`) and where
-/// the passes stand (their number is not known in advance: the schedule adapts to each pass).
-fn pass_message(current: &str, p: approx::dispatch::PassProgress) -> String {
-    let base = current.split(": pass ").next().unwrap_or(current);
+/// Where the passes stand: "pass 57, 3200 work items done" (their number is not known in
+/// advance: the schedule adapts to each pass).
+fn pass_text(p: approx::dispatch::PassProgress) -> String {
     let items = match p.items_done {
         // A real GPU takes every item in one pass.
         u32::MAX => "all work items done".to_string(),
@@ -141,36 +149,101 @@ fn pass_message(current: &str, p: approx::dispatch::PassProgress) -> String {
     };
     if p.redone {
         format!(
-            "{base}: pass {} too heavy for lavapipe, redone with fewer work items ({items})",
+            "pass {} too heavy for lavapipe, redone with fewer work items ({items})",
             p.passes
         )
     } else {
-        format!("{base}: pass {}, {items}", p.passes)
+        format!("pass {}, {items}", p.passes)
     }
+}
+
+/// The spinner's message after a pass: the method's words (`approximating with …`) and
+/// [`pass_text`].
+fn pass_message(current: &str, p: approx::dispatch::PassProgress) -> String {
+    let base = current.split(": pass ").next().unwrap_or(current);
+    format!("{base}: {}", pass_text(p))
+}
+
+/// How often a progress line is printed off a terminal.
+const PROGRESS_EVERY: Duration = Duration::from_secs(10);
+
+/// Off a terminal (a log, a batch job), long GPU work says where it stands: a line on stderr
+/// after the first pass that ends [`PROGRESS_EVERY`] or more after the last line (or the
+/// start), as a sweep prints `[k/N]` per run. Work shorter than that prints none.
+#[derive(Debug, Default)]
+struct ProgressLines {
+    /// Time since the start at the last line.
+    last: Duration,
+}
+
+impl ProgressLines {
+    /// The line to print after a pass that ended `elapsed` after the start, if one is due.
+    fn after_pass(
+        &mut self,
+        elapsed: Duration,
+        p: approx::dispatch::PassProgress,
+    ) -> Option<String> {
+        if elapsed < self.last + PROGRESS_EVERY {
+            return None;
+        }
+        self.last = elapsed;
+        Some(format!(
+            "approx: {:.0} s, {}",
+            elapsed.as_secs_f64(),
+            pass_text(p)
+        ))
+    }
+}
+
+/// `v` with three significant digits: `362`, `4.12`, `0.000412` (a fixed number of decimals
+/// printed `0.000` for the figures of small or slow runs).
+fn three_digits(v: f64) -> String {
+    if !(v.is_finite() && v > 0.0) {
+        return format!("{v}");
+    }
+    let decimals = (2 - v.log10().floor() as i32).clamp(0, 12) as usize;
+    format!("{v:.decimals$}")
+}
+
+/// A rate with three significant digits and an SI prefix: `181 pixels/s`, `2.41 Mpixels/s`
+/// (a fixed `Mpixels/s` printed `0.000` for lavapipe's few hundred pixels a second).
+fn rate(per_second: f64, unit: &str) -> String {
+    let (value, prefix) = [(1e9, "G"), (1e6, "M"), (1e3, "k")]
+        .into_iter()
+        .find(|(scale, _)| per_second >= *scale)
+        .map_or((per_second, ""), |(scale, p)| (per_second / scale, p));
+    format!("{} {prefix}{unit}", three_digits(value))
 }
 
 /// Loads the scene, runs the approximation (docs/design.md §4), writes the image and prints the
 /// one-line summary with the adapter and the GPU time (docs/design.md §7).
 pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
     if args.list_methods {
-        print!("{}", methods::markdown_table());
+        super::print_stdout(&methods::markdown_table())?;
         return Ok(Outcome::Success);
     }
     let (Some(scene_path), Some(output)) = (&args.scene, &args.output) else {
         anyhow::bail!("pgt approx needs a SCENE and -o OUTPUT (or --list-methods)");
     };
+    check_outputs(&[Output::new("--output", output, OutputKind::Image)])?;
     let options = SceneLoadOptions {
         size: args.size,
         mode: args.mode,
         model: args.model,
         tol: None,
+        format: args.format,
     };
-    let scene = super::load_scene_for(scene_path, &options, output, args.exposure)?;
+    let scene = super::load_scene_for(scene_path, &options, args.exposure)?;
     let params = args.params()?;
     let spinner = super::stderr_is_terminal().then(|| approx_spinner(&params));
-    let out = approx::render_approx_with_progress(&scene, &params, &mut |p| {
-        if let Some(s) = &spinner {
-            s.set_message(pass_message(&s.message(), p));
+    let mut lines = ProgressLines::default();
+    let start = Instant::now();
+    let out = approx::render_approx_with_progress(&scene, &params, &mut |p| match &spinner {
+        Some(s) => s.set_message(pass_message(&s.message(), p)),
+        None => {
+            if let Some(line) = lines.after_pass(start.elapsed(), p) {
+                eprintln!("{line}");
+            }
         }
     });
     if let Some(s) = &spinner {
@@ -195,11 +268,15 @@ pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
     let passes = if out.passes == 1 {
         "1 pass".to_string()
     } else {
-        format!("{} passes", out.passes)
+        format!(
+            "{} passes, {} s a pass",
+            out.passes,
+            three_digits(out.gpu_seconds / out.passes as f64)
+        )
     };
     let pixels = scene.camera.width as f64 * scene.camera.height as f64;
     eprintln!(
-        "approximated {} ({}x{}, {} spheres, {} lights) with {}{} on {}: {:.3} s GPU ({}, {passes}), {:.3} Mpixels/s",
+        "approximated {} ({}x{}, {} spheres, {} lights) with {}{} on {}: {} s GPU ({}, {passes}), {}",
         output.display(),
         scene.camera.width,
         scene.camera.height,
@@ -208,12 +285,53 @@ pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
         out.method.name(),
         describe_params(&out.method, &out.params),
         out.adapter_name,
-        out.gpu_seconds,
+        three_digits(out.gpu_seconds),
         match out.timing {
             Timing::Timestamps => "timestamp queries",
             Timing::Wall => "wall time",
         },
-        pixels / out.gpu_seconds.max(1e-9) / 1e6
+        rate(pixels / out.gpu_seconds.max(1e-9), "pixels/s")
     );
     Ok(Outcome::Success)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::approx::dispatch::PassProgress;
+
+    fn pass(passes: u32) -> PassProgress {
+        PassProgress {
+            passes,
+            items_done: 8 * passes,
+            redone: false,
+        }
+    }
+
+    #[test]
+    fn progress_lines_come_every_ten_seconds_of_passes() {
+        let mut lines = ProgressLines::default();
+        let s = Duration::from_secs_f64;
+        assert_eq!(lines.after_pass(s(0.7), pass(1)), None);
+        assert_eq!(lines.after_pass(s(9.9), pass(14)), None);
+        assert_eq!(
+            lines.after_pass(s(10.4), pass(15)).as_deref(),
+            Some("approx: 10 s, pass 15, 120 work items done")
+        );
+        assert_eq!(lines.after_pass(s(19.0), pass(27)), None);
+        let line = lines.after_pass(s(31.0), pass(44)).unwrap();
+        assert!(line.starts_with("approx: 31 s, pass 44"), "{line}");
+    }
+
+    #[test]
+    fn rates_keep_three_digits() {
+        assert_eq!(rate(181.04, "pixels/s"), "181 pixels/s");
+        assert_eq!(rate(1706.7, "pixels/s"), "1.71 kpixels/s");
+        assert_eq!(rate(2.414e6, "pixels/s"), "2.41 Mpixels/s");
+        assert_eq!(rate(45.25e6, "pixels/s"), "45.2 Mpixels/s");
+        assert_eq!(rate(0.5, "pixels/s"), "0.500 pixels/s");
+        assert_eq!(three_digits(362.14), "362");
+        assert_eq!(three_digits(0.000_412_3), "0.000412");
+        assert_eq!(three_digits(4.0), "4.00");
+    }
 }

@@ -132,7 +132,7 @@ pub fn run(args: BenchArgs) -> anyhow::Result<Outcome> {
         );
         rows.extend(bench_scene(&name, &scene, &args)?);
     }
-    print!("{}", table(&rows));
+    super::print_stdout(&table(&rows))?;
     Ok(Outcome::Success)
 }
 

@@ -7,6 +7,7 @@ use super::Outcome;
 use crate::geometry::projection::{CameraJson, MatrixJson};
 use crate::scene::{Scene, SceneLoadOptions};
 use clap::Args;
+use std::fmt::Write as _;
 use std::path::PathBuf;
 
 /// Options of `pgt camera`.
@@ -17,6 +18,10 @@ pub struct CameraArgs {
     /// Image size WIDTHxHEIGHT, overriding the scene (as `pgt render --size` does).
     #[arg(long, value_parser = super::parse_size)]
     pub size: Option<(u32, u32)>,
+    /// The format of a bare particle file, whatever its extension (a scene file names the
+    /// format of each include with `format = "…"`).
+    #[arg(long, value_name = "NAME", value_parser = super::format_parser())]
+    pub format: Option<&'static crate::formats::Format>,
     /// Print JSON on stdout instead of text.
     #[arg(long)]
     pub json: bool,
@@ -31,10 +36,11 @@ pub fn camera_json(scene: &Scene) -> CameraJson {
     )
 }
 
-fn print_matrix(name: &str, m: &MatrixJson) {
-    println!("{name} (row by row):");
+fn write_matrix(t: &mut String, name: &str, m: &MatrixJson) {
+    let _ = writeln!(t, "{name} (row by row):");
     for row in &m.row_major {
-        println!(
+        let _ = writeln!(
+            t,
             "  [{:>14.8}, {:>14.8}, {:>14.8}, {:>14.8}]",
             row[0], row[1], row[2], row[3]
         );
@@ -45,6 +51,7 @@ fn print_matrix(name: &str, m: &MatrixJson) {
 pub fn run(args: CameraArgs) -> anyhow::Result<Outcome> {
     let options = SceneLoadOptions {
         size: args.size,
+        format: args.format,
         ..SceneLoadOptions::default()
     };
     let scene = Scene::load(&args.scene, &options)?;
@@ -52,30 +59,41 @@ pub fn run(args: CameraArgs) -> anyhow::Result<Outcome> {
         eprintln!("warning: {w}");
     }
     let cam = camera_json(&scene);
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&cam)?);
-        return Ok(Outcome::Success);
-    }
+    let text = if args.json {
+        serde_json::to_string_pretty(&cam)? + "\n"
+    } else {
+        text_of(&cam)
+    };
+    super::print_stdout(&text)?;
+    Ok(Outcome::Success)
+}
+
+/// The text form of `pgt camera`.
+fn text_of(cam: &CameraJson) -> String {
+    // Writing into a String cannot fail.
+    let mut t = String::new();
     let v = |a: [f64; 3]| format!("[{:.6}, {:.6}, {:.6}]", a[0], a[1], a[2]);
-    println!("eye:      {}", v(cam.eye));
-    println!("forward:  {}   (f)", v(cam.forward));
-    println!("right:    {}   (r = normalize(f x up))", v(cam.right));
-    println!("up:       {}   (u = r x f)", v(cam.up));
-    println!(
+    let _ = writeln!(t, "eye:      {}", v(cam.eye));
+    let _ = writeln!(t, "forward:  {}   (f)", v(cam.forward));
+    let _ = writeln!(t, "right:    {}   (r = normalize(f x up))", v(cam.right));
+    let _ = writeln!(t, "up:       {}   (u = r x f)", v(cam.up));
+    let _ = writeln!(
+        t,
         "fov:      {:.6} deg vertical, {:.6} deg horizontal",
         cam.fov_y_deg, cam.fov_x_deg
     );
-    println!(
+    let _ = writeln!(
+        t,
         "size:     {}x{} (aspect {:.6})",
         cam.width, cam.height, cam.aspect
     );
-    println!("near/far: {:.6} / {:.6}", cam.near, cam.far);
-    println!("pixels:   {}", cam.pixel_convention);
-    println!("matrices: {}", cam.matrix_convention);
-    print_matrix("view", &cam.view);
+    let _ = writeln!(t, "near/far: {:.6} / {:.6}", cam.near, cam.far);
+    let _ = writeln!(t, "pixels:   {}", cam.pixel_convention);
+    let _ = writeln!(t, "matrices: {}", cam.matrix_convention);
+    write_matrix(&mut t, "view", &cam.view);
     for (api, p) in &cam.projection {
-        print_matrix(&format!("projection {api}"), &p.matrix);
-        println!("  {}", p.convention);
+        write_matrix(&mut t, &format!("projection {api}"), &p.matrix);
+        let _ = writeln!(t, "  {}", p.convention);
     }
-    Ok(Outcome::Success)
+    t
 }

@@ -4,6 +4,7 @@
 //! verdict goes to stderr); `--report DIR` writes the HTML page and maps. Exit 0 when every gate
 //! passes (or none is set), 1 when one fails (named in the verdict), 2 on any error.
 
+use super::output::{check_outputs, Output, OutputKind};
 use super::Outcome;
 use crate::image_io::{read_image_layer, ReadImage, RgbImage};
 use crate::metrics::gate::Gate;
@@ -63,6 +64,14 @@ pub struct CompareArgs {
 
 pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
     let start = Instant::now();
+    let mut outputs = Vec::new();
+    if let Some(json) = &args.json {
+        outputs.push(Output::new("--json", json, OutputKind::Text));
+    }
+    if let Some(report) = &args.report {
+        outputs.push(Output::new("--report", report, OutputKind::Folder));
+    }
+    check_outputs(&outputs)?;
     for (name, v) in [
         ("--error-scale", args.error_scale),
         ("--rel-scale", args.rel_scale),
@@ -151,14 +160,14 @@ pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
     let verdict = summary.verdict();
     match &args.json {
         Some(path) if path.as_os_str() == "-" => {
-            println!("{}", serde_json::to_string_pretty(&summary)?);
+            super::print_stdout(&(serde_json::to_string_pretty(&summary)? + "\n"))?;
             eprintln!("{verdict}");
         }
         Some(path) => {
             report::text::write_text(path, &(serde_json::to_string_pretty(&summary)? + "\n"))?;
-            println!("{verdict}");
+            super::print_stdout(&format!("{verdict}\n"))?;
         }
-        None => println!("{verdict}"),
+        None => super::print_stdout(&format!("{verdict}\n"))?,
     }
     Ok(match summary.passed {
         Some(false) => Outcome::GateFailed,

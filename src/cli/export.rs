@@ -7,14 +7,15 @@
 //!   number in Rust's shortest round-trip notation (reading it back as f64 gives the same bits).
 //!   σ = ∞ (Θmax = 1, a perfectly absorbing ball) is written `inf`, which C's `strtod`, Python's
 //!   `float`, numpy and Rust's `f64::from_str` all read as +∞. The file is also a particle file
-//!   pgt reads back (its CSV reader takes `opacity` and ignores `sigma` with a warning, and
-//!   recomputes the same σ from Θmax up to rounding).
+//!   pgt reads back without a warning: its CSV reader takes `sigma` as the particle's σ, bit for
+//!   bit, and checks that `opacity` agrees with it (`crate::formats::xyz_csv`).
 //! * **PLY**: `binary_little_endian 1.0`, one `vertex` element per particle with `double`
 //!   properties `x y z radius red green blue opacity sigma`; σ = ∞ is the IEEE 754 +∞ double.
 //!
 //! Θmax = 1 − e^{−2rσ} (docs/design.md §1 inverted; for a particle given by κ it is the opacity that
 //! the resolved σ has along a diameter).
 
+use super::output::{check_outputs, Output, OutputKind};
 use super::Outcome;
 use crate::error::PgtError;
 use crate::image_io::write_atomically;
@@ -31,6 +32,10 @@ pub struct ExportArgs {
     /// Output file; the format follows the extension (.csv or .ply).
     #[arg(short, long)]
     pub output: PathBuf,
+    /// The format of a bare particle file, whatever its extension (a scene file names the
+    /// format of each include with `format = "…"`).
+    #[arg(long, value_name = "NAME", value_parser = super::format_parser())]
+    pub format: Option<&'static crate::formats::Format>,
 }
 
 /// The export formats.
@@ -122,8 +127,17 @@ pub fn write_ply(w: &mut impl Write, particles: &[Particle]) -> std::io::Result<
 
 /// Runs `pgt export`.
 pub fn run(args: ExportArgs) -> anyhow::Result<Outcome> {
+    check_outputs(&[Output::new(
+        "--output",
+        &args.output,
+        OutputKind::File(&["csv", "ply"]),
+    )])?;
     let format = ExportFormat::from_path(&args.output)?;
-    let scene = Scene::load(&args.scene, &SceneLoadOptions::default())?;
+    let options = SceneLoadOptions {
+        format: args.format,
+        ..SceneLoadOptions::default()
+    };
+    let scene = Scene::load(&args.scene, &options)?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }

@@ -1,8 +1,10 @@
 //! `pgt gen random --count N --seed S [--box …] [--radius a..b] -o FILE` (docs/design.md §7): the
 //! synthetic random set of [`crate::formats::random`], written as CSV, atomically.
 
+use super::output::{check_outputs, Output, OutputKind};
 use super::Outcome;
 use crate::formats::random::{particles, write_csv, RandomSpec, THESIS_COUNT};
+use crate::image_io::write_atomically;
 use clap::{Args, Subcommand};
 use glam::DVec3;
 use std::path::PathBuf;
@@ -42,7 +44,7 @@ pub struct RandomArgs {
     /// Radius range `a..b` (or one value), 0 < a ≤ b.
     #[arg(long, default_value = "0.5..2")]
     pub radius: String,
-    /// Output CSV file.
+    /// Output CSV file (.csv).
     #[arg(short, long)]
     pub output: PathBuf,
 }
@@ -90,6 +92,11 @@ fn parse_radius(s: &str) -> anyhow::Result<(f64, f64)> {
 pub fn run(args: GenArgs) -> anyhow::Result<Outcome> {
     match args.kind {
         GenKind::Random(a) => {
+            check_outputs(&[Output::new(
+                "--output",
+                &a.output,
+                OutputKind::File(&["csv"]),
+            )])?;
             let (box_min, box_max) = parse_box(&a.bbox)?;
             let spec = RandomSpec {
                 count: a.count,
@@ -110,34 +117,4 @@ pub fn run(args: GenArgs) -> anyhow::Result<Outcome> {
             Ok(Outcome::Success)
         }
     }
-}
-
-/// Writes through a temporary file in the same directory (streamed through a buffer), renamed
-/// into place when complete; on any error the temporary file is removed and nothing appears.
-fn write_atomically(
-    path: &std::path::Path,
-    write: impl FnOnce(&mut std::io::BufWriter<&std::fs::File>) -> std::io::Result<()>,
-) -> crate::Result<()> {
-    use std::io::Write;
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => std::path::Path::new("."),
-    };
-    let tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| crate::PgtError::io(path, e))?;
-    {
-        let mut w = std::io::BufWriter::new(tmp.as_file());
-        write(&mut w).map_err(|e| crate::PgtError::io(path, e))?;
-        w.flush().map_err(|e| crate::PgtError::io(path, e))?;
-    }
-    #[cfg(unix)]
-    {
-        // A temporary file is private (0600); the data set is an ordinary file.
-        use std::os::unix::fs::PermissionsExt;
-        tmp.as_file()
-            .set_permissions(std::fs::Permissions::from_mode(0o644))
-            .map_err(|e| crate::PgtError::io(path, e))?;
-    }
-    tmp.persist(path)
-        .map_err(|e| crate::PgtError::io(path, e.error))?;
-    Ok(())
 }

@@ -19,13 +19,17 @@ pub struct InfoArgs {
     /// Print JSON on stdout instead of text.
     #[arg(long)]
     pub json: bool,
+    /// The format of a bare particle file, whatever its extension (a scene file names the
+    /// format of each include with `format = "…"`).
+    #[arg(long, value_name = "NAME", value_parser = super::format_parser())]
+    pub format: Option<&'static crate::formats::Format>,
 }
 
 /// `pgt info --help` for FILE, from the table of formats.
 fn file_help() -> String {
     let mut help = String::from(
-        "A particle file or a scene file (.toml). Particle formats (the name for `format` in an \
-         [[include]], the extensions, the format):",
+        "A particle file or a scene file (.toml). Particle formats (the name for `--format` and \
+         for `format` in an [[include]], the extensions, the format):",
     );
     for f in FORMATS {
         let ext: Vec<String> = f.extensions.iter().map(|e| format!(".{e}")).collect();
@@ -166,22 +170,30 @@ pub fn summarize(
 
 /// Loads a file and summarises it: a scene (`.toml`) through [`Scene::load`], a particle file
 /// through the one loading path of [`crate::formats`] (so an empty file is refused here too),
-/// with the format's name and [`Format::details`] from the table of formats.
-pub fn info_of(path: &std::path::Path) -> crate::Result<Info> {
+/// with the format's name and [`Format::details`] from the table of formats. `format` is
+/// `--format`, for a particle file whatever its extension.
+pub fn info_of(path: &std::path::Path, format: Option<&'static Format>) -> crate::Result<Info> {
     let is_toml = path
         .extension()
         .and_then(|e| e.to_str())
         .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
     let name = path.display().to_string();
     if is_toml {
-        let scene = Scene::load(path, &SceneLoadOptions::default())?;
+        let options = SceneLoadOptions {
+            format,
+            ..SceneLoadOptions::default()
+        };
+        let scene = Scene::load(path, &options)?;
         let it = scene
             .particles
             .iter()
             .map(|p| (p.center, p.radius, Some(p.color)));
         return Ok(summarize(name, "scene".into(), it, scene.warnings.clone()));
     }
-    let spec = IncludeSpec::bare(path);
+    let spec = IncludeSpec {
+        format,
+        ..IncludeSpec::bare(path)
+    };
     let format: &Format = format_of(&spec)?;
     let bytes = read_input(path)?;
     let loaded = load_bytes(&spec, format, &bytes)?;
@@ -195,37 +207,50 @@ pub fn info_of(path: &std::path::Path) -> crate::Result<Info> {
 
 /// Runs `pgt info`.
 pub fn run(args: InfoArgs) -> anyhow::Result<Outcome> {
-    let info = info_of(&args.file)?;
-    if args.json {
-        println!("{}", serde_json::to_string_pretty(&info)?);
-        return Ok(Outcome::Success);
-    }
-    println!("{} ({})", info.file, info.format);
-    println!("particles: {}", info.particles);
+    let info = info_of(&args.file, args.format)?;
+    let text = if args.json {
+        serde_json::to_string_pretty(&info)? + "\n"
+    } else {
+        text_of(&info)
+    };
+    super::print_stdout(&text)?;
+    Ok(Outcome::Success)
+}
+
+/// The text form of `pgt info`.
+fn text_of(info: &Info) -> String {
+    use std::fmt::Write as _;
+    let mut t = String::new();
+    // Writing into a String cannot fail.
+    let _ = writeln!(t, "{} ({})", info.file, info.format);
+    let _ = writeln!(t, "particles: {}", info.particles);
     if let (Some(b), Some(r)) = (&info.bounds, &info.radius) {
         let v = |a: [f64; 3]| format!("[{:.4}, {:.4}, {:.4}]", a[0], a[1], a[2]);
-        println!("bounds:    {} .. {}", v(b.min), v(b.max));
-        println!(
+        let _ = writeln!(t, "bounds:    {} .. {}", v(b.min), v(b.max));
+        let _ = writeln!(
+            t,
             "radius:    {:.4} .. {:.4} (mean {:.4})",
             r.min, r.max, r.mean
         );
     }
     let c = &info.colors;
-    println!(
+    let _ = writeln!(
+        t,
         "colours:   {} distinct, {} without a colour (scene default)",
         c.distinct, c.uncolored
     );
     for cc in &c.most_common {
-        println!(
+        let _ = writeln!(
+            t,
             "           linear RGB [{:.4}, {:.4}, {:.4}] × {}",
             cc.rgb[0], cc.rgb[1], cc.rgb[2], cc.count
         );
     }
     for (k, v) in &info.details {
-        println!("{:<10} {v}", format!("{k}:"));
+        let _ = writeln!(t, "{:<10} {v}", format!("{k}:"));
     }
     for w in &info.warnings {
-        println!("warning:   {w}");
+        let _ = writeln!(t, "warning:   {w}");
     }
-    Ok(Outcome::Success)
+    t
 }

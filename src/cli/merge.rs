@@ -4,15 +4,16 @@
 //! part, or parts of different renders exit 2 with a message naming the file, and nothing is
 //! written.
 
+use super::output::{check_outputs, Output, OutputKind};
 use super::Outcome;
-use crate::image_io::{write_image, ImageFormat, RgbImage};
+use crate::image_io::{write_image, RgbImage};
 use crate::parts::{merge, read_part};
 use clap::Args;
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
 pub struct MergeArgs {
-    /// The part files written by `pgt render SCENE --tile I/N -o PART.exr`, in any order.
+    /// The part files written by `pgt render SCENE --part I/N -o PART.exr`, in any order.
     #[arg(required = true)]
     pub parts: Vec<PathBuf>,
     /// Output image; the format follows the extension (.exr or .png).
@@ -24,7 +25,7 @@ pub struct MergeArgs {
 }
 
 pub fn run(args: MergeArgs) -> anyhow::Result<Outcome> {
-    ImageFormat::from_path(&args.output)?;
+    check_outputs(&[Output::new("--output", &args.output, OutputKind::Image)])?;
     if !args.exposure.is_finite() {
         anyhow::bail!("--exposure must be a finite number");
     }

@@ -9,9 +9,11 @@ pub mod export;
 pub mod gen;
 pub mod info;
 pub mod merge;
+pub mod output;
 pub mod render;
 pub mod sweep;
 
+use crate::formats::{Format, FORMATS};
 use clap::{Parser, Subcommand};
 
 /// What a subcommand ended with, when it did not fail.
@@ -66,12 +68,42 @@ pub enum Command {
     Gen(gen::GenArgs),
     /// The speed of the reference on standard workloads, as one table of ratios.
     Bench(bench::BenchArgs),
-    /// Join the parts of a cluster render (`pgt render --tile I/N`) into the whole image.
+    /// Join the parts of a cluster render (`pgt render --part I/N`) into the whole image.
     Merge(merge::MergeArgs),
     /// The camera as view and projection matrices per graphics API (OpenGL, Vulkan, WebGPU, Direct3D).
     Camera(camera::CameraArgs),
     /// Write the resolved particles (centre, radius, colour, σ, Θmax) as CSV or PLY.
     Export(export::ExportArgs),
+}
+
+/// Parses the process's arguments ([`command`]).
+pub fn try_parse() -> Result<Cli, clap::Error> {
+    use clap::FromArgMatches;
+    Cli::from_arg_matches(&command().try_get_matches()?)
+}
+
+/// The command line as clap sees it, with every subcommand's usage line fixed to the one its
+/// `--help` shows: in an error, clap's own usage line lists the options given as if they were
+/// required (`pgt render --output <OUTPUT> --size <SIZE> <SCENE>`).
+pub fn command() -> clap::Command {
+    let mut cmd = <Cli as clap::CommandFactory>::command();
+    cmd.build();
+    help_usage_in_errors(cmd)
+}
+
+fn help_usage_in_errors(mut cmd: clap::Command) -> clap::Command {
+    let names: Vec<String> = cmd
+        .get_subcommands()
+        .map(|s| s.get_name().to_string())
+        .collect();
+    for name in names {
+        cmd = cmd.mut_subcommand(name, |mut sub| {
+            let usage = sub.render_usage().to_string();
+            let usage = usage.strip_prefix("Usage: ").unwrap_or(&usage).to_string();
+            help_usage_in_errors(sub.override_usage(usage))
+        });
+    }
+    cmd
 }
 
 /// Runs the parsed command line.
@@ -90,6 +122,14 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
     }
 }
 
+/// `--format NAME`: the format of a bare particle file whatever its extension, a name of the
+/// table of formats (`crate::formats::FORMATS`; `--help` lists them).
+pub fn format_parser() -> impl clap::builder::TypedValueParser<Value = &'static Format> {
+    use clap::builder::TypedValueParser;
+    clap::builder::PossibleValuesParser::new(FORMATS.iter().map(|f| f.name))
+        .try_map(|name| Format::named(&name).ok_or_else(|| format!("unknown format '{name}'")))
+}
+
 /// Parses `WxH`.
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s
@@ -104,15 +144,14 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     crate::scene::check_image_size(w as i64, h as i64)
 }
 
-/// What `render` and `approx` do before any work: check the output name and exposure (so a
-/// typo fails at once, not after a long render), load the scene, print its warnings.
+/// What `render` and `approx` do before any work, once their outputs are checked
+/// ([`output::check_outputs`]): check the exposure (so a typo fails at once, not after a long
+/// render), load the scene, print its warnings.
 pub fn load_scene_for(
     scene: &std::path::Path,
     options: &crate::scene::SceneLoadOptions,
-    output: &std::path::Path,
     exposure: f32,
 ) -> anyhow::Result<crate::scene::Scene> {
-    crate::image_io::ImageFormat::from_path(output)?;
     if !exposure.is_finite() {
         anyhow::bail!("--exposure must be a finite number");
     }
@@ -121,6 +160,18 @@ pub fn load_scene_for(
         eprintln!("warning: {w}");
     }
     Ok(scene)
+}
+
+/// Writes `text` to standard output. A closed pipe (`pgt info F --json | head -1`) ends the
+/// output quietly, as Unix tools do, and the command's outcome stands; any other failure to
+/// write is an error (exit 2).
+pub fn print_stdout(text: &str) -> anyhow::Result<()> {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    match out.write_all(text.as_bytes()).and_then(|()| out.flush()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        r => r.map_err(|e| anyhow::anyhow!("writing to standard output: {e}")),
+    }
 }
 
 /// Whether stderr is a terminal (progress bars only then).

@@ -1,7 +1,9 @@
 //! `pgt render SCENE -o OUT`: the exact reference (docs/design.md §3, §7).
 
+use super::output::{check_outputs, Output, OutputKind};
 use super::Outcome;
 use crate::image_io::write_image;
+use crate::parts::PartOf;
 use crate::reference::{self, Integrator, RenderOptions};
 use crate::scene::{Model, RenderMode, SceneLoadOptions};
 use clap::{Args, ValueEnum};
@@ -25,10 +27,16 @@ pub struct RenderArgs {
     /// Image size WIDTHxHEIGHT, overriding the scene.
     #[arg(long, value_parser = super::parse_size)]
     pub size: Option<(u32, u32)>,
+    /// Render mode, overriding the scene.
     #[arg(long, value_enum)]
     pub mode: Option<RenderMode>,
+    /// Optical model of the volume mode, overriding the scene.
     #[arg(long, value_enum)]
     pub model: Option<Model>,
+    /// The format of a bare particle file, whatever its extension (a scene file names the
+    /// format of each include with `format = "…"`).
+    #[arg(long, value_name = "NAME", value_parser = super::format_parser())]
+    pub format: Option<&'static crate::formats::Format>,
     /// Absolute radiance tolerance of the quadrature, per pixel and channel.
     #[arg(long)]
     pub tol: Option<f64>,
@@ -41,25 +49,46 @@ pub struct RenderArgs {
     /// PNG exposure in stops (2^exposure scales the linear image before encoding).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
+    /// How the volume integral is computed.
     #[arg(long, value_enum, default_value = "adaptive")]
     pub integrator: IntegratorName,
     /// Samples per interval for `--integrator riemann`.
     #[arg(long, default_value_t = 100)]
     pub samples: u32,
-    /// Render only part I of N (I from 0, as job arrays count) into an EXR part file, to be
-    /// joined by `pgt merge` (see `pgt::parts`).
-    #[arg(long, value_parser = crate::parts::parse_tile, value_name = "I/N")]
-    pub tile: Option<crate::parts::Tile>,
+    /// Render only part I of N (I from 0, as job arrays count; the part holds the rows y with
+    /// y mod N = I) into an EXR part file, to be joined by `pgt merge` (see `pgt::parts`).
+    #[arg(long, value_parser = crate::parts::parse_part, value_name = "I/N")]
+    pub part: Option<PartOf>,
+    /// The former name of `--part`: still accepted, with a warning.
+    #[arg(long, value_parser = crate::parts::parse_part, value_name = "I/N", hide = true, conflicts_with = "part")]
+    pub tile: Option<PartOf>,
+}
+
+impl RenderArgs {
+    /// `--part`, or the deprecated `--tile` with a one-line warning.
+    fn part(&self) -> Option<PartOf> {
+        if self.tile.is_some() {
+            eprintln!("warning: --tile is deprecated; it is now called --part (same I/N)");
+        }
+        self.part.or(self.tile)
+    }
 }
 
 pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
+    let part = args.part();
+    let kind = match part {
+        Some(_) => OutputKind::Part,
+        None => OutputKind::Image,
+    };
+    check_outputs(&[Output::new("--output", &args.output, kind)])?;
     let options = SceneLoadOptions {
         size: args.size,
         mode: args.mode,
         model: args.model,
         tol: args.tol,
+        format: args.format,
     };
-    let scene = super::load_scene_for(&args.scene, &options, &args.output, args.exposure)?;
+    let scene = super::load_scene_for(&args.scene, &options, args.exposure)?;
     let integrator = match args.integrator {
         IntegratorName::Adaptive => Integrator::Adaptive,
         IntegratorName::Riemann => {
@@ -77,8 +106,8 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
         progress: super::stderr_is_terminal(),
         integrator,
     };
-    if let Some(tile) = args.tile {
-        return render_part(&args, &scene, &render_options, tile);
+    if let Some(part) = part {
+        return render_part(&args, &scene, &render_options, part);
     }
     let out = reference::render(&scene, &render_options)?;
     let layers: Vec<(&str, &crate::image_io::RgbImage)> =
@@ -118,23 +147,17 @@ pub fn unconverged_warning(stats: &reference::RenderStats, tol: f64) -> Option<S
     ))
 }
 
-/// `--tile I/N`: renders and writes one part (`pgt::parts`), with a one-line summary.
+/// `--part I/N`: renders and writes one part (`pgt::parts`), with a one-line summary.
 fn render_part(
     args: &RenderArgs,
     scene: &crate::scene::Scene,
     options: &RenderOptions,
-    tile: crate::parts::Tile,
+    which: PartOf,
 ) -> anyhow::Result<Outcome> {
-    if crate::image_io::ImageFormat::from_path(&args.output)? != crate::image_io::ImageFormat::Exr {
-        anyhow::bail!(
-            "{}: a part (--tile) is written as an EXR; name it .exr and merge the parts with `pgt merge` into any format",
-            args.output.display()
-        );
-    }
-    let (part, s) = crate::parts::render_part(scene, options, tile)?;
+    let (part, s) = crate::parts::render_part(scene, options, which)?;
     crate::parts::write_part(&args.output, &part)?;
     eprintln!(
-        "rendered part {tile} ({} of {} rows of {}x{}) into {} in {:.2} s: {} primary + {} shadow rays",
+        "rendered part {which} ({} of {} rows of {}x{}) into {} in {:.2} s: {} primary + {} shadow rays",
         part.image.height,
         scene.camera.height,
         scene.camera.width,

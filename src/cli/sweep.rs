@@ -2,6 +2,7 @@
 //! experiment format and the running are in [`crate::sweep`], the page, plots and JSON in
 //! [`crate::report::sweep_page`].
 
+use super::output::{check_outputs, Output, OutputKind};
 use super::Outcome;
 use crate::image_io::write_folder_atomically;
 use crate::report::sweep_page::write_sweep_report;
@@ -29,6 +30,7 @@ pub struct SweepArgs {
 /// of runs done out of the total with the run in progress (docs/design.md §7 "Long work shows a
 /// progress bar on stderr when it is a terminal").
 pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
+    check_outputs(&[Output::new("--report", &args.report, OutputKind::Folder)])?;
     let mut experiment = Experiment::load(&args.experiment)?;
     if let Some((w, h)) = args.size {
         experiment.size = Some([w, h]);
@@ -63,7 +65,7 @@ pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
         Ok((results.runs.len(), args.report.join("index.html")))
     });
     let (runs, page) = outcome?;
-    println!("sweep: {runs} runs, report {}", page.display());
+    super::print_stdout(&format!("sweep: {runs} runs, report {}\n", page.display()))?;
     Ok(Outcome::Success)
 }
 

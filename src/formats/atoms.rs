@@ -299,6 +299,7 @@ fn make_records(
             radius: element_radius(a.element),
             color,
             opacity: None,
+            sigma: None,
             location: Location::Line(a.line),
         });
     }

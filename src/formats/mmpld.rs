@@ -492,6 +492,7 @@ fn read_list_particles(
             radius,
             color: Some(color),
             opacity: None,
+            sigma: None,
             location: Location::Byte(at as u64),
         });
     }

@@ -170,8 +170,9 @@ pub fn format_of(spec: &IncludeSpec) -> Result<&'static Format> {
     Err(PgtError::in_file(
         &spec.path,
         format!(
-            "unsupported particle file type '.{ext}': expected {} or .toml (or set `format` in the [[include]])",
-            known_extensions()
+            "unsupported particle file type '.{ext}': expected {} or .toml, or name the format: `--format NAME` for a file on the command line, `format = \"NAME\"` in a scene's [[include]] (NAME one of {})",
+            known_extensions(),
+            known_names()
         ),
     ))
 }
@@ -250,6 +251,11 @@ fn check_records(path: &Path, records: &[ParticleRecord]) -> Result<()> {
             Some(format!(
                 "the particle opacity must be in [0, 1], got {:?}",
                 r.opacity
+            ))
+        } else if r.sigma.is_some_and(|s| s.is_nan() || s < 0.0) {
+            Some(format!(
+                "the particle sigma must be ≥ 0 (or inf), got {:?}",
+                r.sigma
             ))
         } else {
             None

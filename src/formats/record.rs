@@ -17,6 +17,11 @@ pub struct ParticleRecord {
     pub color: Option<DVec3>,
     /// Θmax, if the format carries one (e.g. VRML transparency).
     pub opacity: Option<f64>,
+    /// Extinction σ in 1/(the file's length unit), if the format carries one (the `sigma` column
+    /// of CSV, as `pgt export` writes it): where given it is the particle's σ exactly, ahead of
+    /// `opacity` and of the scene's defaults (docs/design.md §1). +∞ is a perfectly absorbing
+    /// ball (Θmax = 1).
+    pub sigma: Option<f64>,
     /// Where in its file the particle was defined (line, or byte offset for binary formats).
     pub location: crate::error::Location,
 }

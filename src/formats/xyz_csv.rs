@@ -9,8 +9,16 @@
 //! any order, unknown columns ignored with a warning): `x`, `y`, `z` (required); `radius` (or
 //! `r`); colour `red`, `green`, `blue` (or `r`, `g`, `b`: where `g` and `b` are present, an `r`
 //! is red, and a second `r`, or `radius`, is the radius), linear RGB ≥ 0; `opacity` (Θmax in
-//! [0, 1]). Without a radius column every particle has radius 1 (with a warning). Blank lines and
-//! lines starting with `#` are skipped.
+//! [0, 1]); `sigma` (extinction σ in 1/length, ≥ 0, `inf` for a perfectly absorbing ball).
+//! Without a radius column every particle has radius 1 (with a warning). Blank lines and lines
+//! starting with `#` are skipped. `pgt export`'s CSV is such a file and reads back without a
+//! warning, σ bit for bit.
+//!
+//! **σ and opacity.** A particle's σ, where the file gives one, is its σ exactly (no λ, no
+//! `radius_scale` applies to it), ahead of its `opacity` and of the scene's `[defaults]`
+//! opacity or kappa. Where a row gives both, they must agree as docs/design.md §1 ties them,
+//! Θmax = 1 − e^{−2rσ} with the row's radius, to [`SIGMA_OPACITY_AGREEMENT`]; a row where they
+//! disagree is refused, naming its line (one of the two was edited without the other).
 
 use super::elements::{element_color, element_radius, Element};
 use super::{Format, IncludeSpec, LoadedParticles, ParticleRecord};
@@ -147,6 +155,7 @@ pub fn read_xyz(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
                 radius: element_radius(el),
                 color: Some(element_color(el)),
                 opacity: None,
+                sigma: None,
                 location: Location::Line(l),
             });
         }
@@ -172,6 +181,10 @@ pub fn read_xyz(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
     Ok(LoadedParticles { records, warnings })
 }
 
+/// How far a row's `opacity` may be from the opacity its `sigma` gives, 1 − e^{−2rσ}: both
+/// written with a few digits agree this well; an edit of one of them does not.
+pub const SIGMA_OPACITY_AGREEMENT: f64 = 1e-6;
+
 /// The columns a CSV header names.
 #[derive(Debug, Default)]
 struct Columns {
@@ -179,6 +192,7 @@ struct Columns {
     radius: Option<usize>,
     rgb: Option<[usize; 3]>,
     opacity: Option<usize>,
+    sigma: Option<usize>,
 }
 
 fn columns(path: &Path, line: usize, header: &str, warnings: &mut Vec<String>) -> Result<Columns> {
@@ -188,7 +202,7 @@ fn columns(path: &Path, line: usize, header: &str, warnings: &mut Vec<String>) -
         .collect();
     let find = |n: &str| names.iter().position(|c| c == n);
     let expected =
-        "expected a header row naming the columns: x,y,z[,radius][,red,green,blue][,opacity]";
+        "expected a header row naming the columns: x,y,z[,radius][,red,green,blue][,opacity][,sigma]";
     let (Some(x), Some(y), Some(z)) = (find("x"), find("y"), find("z")) else {
         return Err(PgtError::at_line(
             path,
@@ -232,9 +246,11 @@ fn columns(path: &Path, line: usize, header: &str, warnings: &mut Vec<String>) -
         cols.radius = find("radius").or(rs.first().copied());
     }
     cols.opacity = find("opacity");
+    cols.sigma = find("sigma");
     used.extend(cols.radius);
     used.extend(cols.rgb.iter().flatten());
     used.extend(cols.opacity);
+    used.extend(cols.sigma);
     let unused: Vec<&String> = names
         .iter()
         .enumerate()
@@ -255,6 +271,42 @@ fn columns(path: &Path, line: usize, header: &str, warnings: &mut Vec<String>) -
         ));
     }
     Ok(cols)
+}
+
+/// A `sigma` cell: a number ≥ 0, or `inf` (Θmax = 1).
+fn sigma(path: &Path, line: usize, s: &str) -> Result<f64> {
+    match s.trim().parse::<f64>() {
+        Ok(v) if v >= 0.0 => Ok(v),
+        Ok(v) => Err(PgtError::at_line(
+            path,
+            line,
+            format!("sigma must be ≥ 0 (or inf), found {v}"),
+        )),
+        Err(_) => Err(PgtError::at_line(
+            path,
+            line,
+            format!("expected a number for sigma, found '{}'", s.trim()),
+        )),
+    }
+}
+
+/// A row's `opacity` and `sigma` must say the same (see the module docs).
+fn check_agreement(path: &Path, line: usize, radius: f64, opacity: f64, sigma: f64) -> Result<()> {
+    let from_sigma = if sigma == f64::INFINITY {
+        1.0
+    } else {
+        -(-2.0 * radius * sigma).exp_m1()
+    };
+    if (from_sigma - opacity).abs() <= SIGMA_OPACITY_AGREEMENT {
+        return Ok(());
+    }
+    Err(PgtError::at_line(
+        path,
+        line,
+        format!(
+            "opacity {opacity} and sigma {sigma} disagree: with radius {radius}, sigma gives opacity 1 − e^(−2·r·sigma) = {from_sigma}; give one of them, or both consistent (sigma is used where both are given)"
+        ),
+    ))
 }
 
 /// The [`super::Reader`] of CSV: a file with a header row.
@@ -288,9 +340,18 @@ pub fn read_csv(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
         let get =
             |i: usize, what: &str| number(path, line, what, f.get(i).copied().unwrap_or_default());
         let [xi, yi, zi] = c.xyz;
+        let radius = c.radius.map_or(Ok(1.0), |i| get(i, "radius"))?;
+        let opacity = c.opacity.map(|i| get(i, "opacity")).transpose()?;
+        let sigma = c
+            .sigma
+            .map(|i| sigma(path, line, f.get(i).copied().unwrap_or_default()))
+            .transpose()?;
+        if let (Some(o), Some(s)) = (opacity, sigma) {
+            check_agreement(path, line, radius, o, s)?;
+        }
         records.push(ParticleRecord {
             center: DVec3::new(get(xi, "x")?, get(yi, "y")?, get(zi, "z")?),
-            radius: c.radius.map_or(Ok(1.0), |i| get(i, "radius"))?,
+            radius,
             color: c
                 .rgb
                 .map(|[r, g, b]| {
@@ -301,7 +362,8 @@ pub fn read_csv(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
                     ))
                 })
                 .transpose()?,
-            opacity: c.opacity.map(|i| get(i, "opacity")).transpose()?,
+            opacity,
+            sigma,
             location: Location::Line(line),
         });
     }
@@ -357,6 +419,26 @@ mod tests {
             .expect_err("nan")
             .to_string();
         assert!(e.contains("t.csv:2") && e.contains("not finite"), "{e}");
+    }
+
+    #[test]
+    fn csv_sigma_is_read_and_checked_against_opacity() {
+        let spec = IncludeSpec::bare(Path::new("t.csv"));
+        let o = -(-2.0f64 * 0.5 * 0.3).exp_m1();
+        let text = format!("x,y,z,radius,opacity,sigma\n0,0,0,0.5,{o:?},0.3\n1,0,0,2,1.0,inf\n");
+        let l = read_csv(&spec, text.as_bytes()).expect("ok");
+        assert!(l.warnings.is_empty(), "{:?}", l.warnings);
+        assert_eq!(l.records[0].sigma, Some(0.3));
+        assert_eq!(l.records[1].sigma, Some(f64::INFINITY));
+        let e = read_csv(&spec, b"x,y,z,radius,opacity,sigma\n0,0,0,0.5,0.7,0.3\n")
+            .expect_err("disagree")
+            .to_string();
+        assert!(e.contains("t.csv:2") && e.contains("disagree"), "{e}");
+        for bad in ["-1", "nan", "-inf", "x"] {
+            let text = format!("x,y,z,sigma\n0,0,0,{bad}\n");
+            let e = read_csv(&spec, text.as_bytes()).expect_err(bad).to_string();
+            assert!(e.contains("t.csv:2") && e.contains("sigma"), "{bad}: {e}");
+        }
     }
 
     #[test]

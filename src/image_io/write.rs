@@ -113,8 +113,9 @@ fn check_finite(path: &Path, image: &RgbImage, layers: &[(&str, &RgbImage)]) -> 
 
 /// Writes a file atomically (docs/design.md §7: never a half-written output): `write` fills a
 /// temporary file in the target folder, which is flushed, synced and renamed to `path` only when
-/// it succeeded; on any error the temporary file is removed. The result is readable by anyone
-/// (0644), as a plain file would be, not 0600 as temporary files are.
+/// it succeeded; on any error the temporary file is removed. Missing folders on the way are
+/// made (as `--report` makes its folder). The result is readable by anyone (0644), as a plain
+/// file would be, not 0600 as temporary files are.
 pub fn write_atomically(
     path: &Path,
     write: impl FnOnce(&mut BufWriter<&std::fs::File>) -> std::io::Result<()>,
@@ -123,6 +124,7 @@ pub fn write_atomically(
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
+    std::fs::create_dir_all(dir).map_err(|e| PgtError::io(dir, e))?;
     // Registered for removal on SIGINT/SIGTERM (crate::signals) from its creation on, and
     // renamed with the signal cleanup held off, so an interrupt leaves neither it nor half a file.
     let (tmp, guard) = crate::signals::track(
@@ -220,8 +222,90 @@ fn write_exr(
     let layer = Layer::new(size, attributes, encoding, channels);
     Image::from_layer(layer)
         .write()
-        .to_buffered(w)
-        .map_err(std::io::Error::other)
+        .to_buffered(&mut *w)
+        .map_err(std::io::Error::other)?;
+    if header.len() > 1 {
+        sort_header_in_file(w)?;
+    }
+    Ok(())
+}
+
+/// Most bytes of a file read to find the end of its EXR header (pgt's headers take well under
+/// a kilobyte).
+const HEADER_READ: u64 = 1 << 20;
+
+/// Sorts the header attributes of the EXR just written through `w` ([`sort_header_attributes`]),
+/// rewriting them in place.
+fn sort_header_in_file(w: &mut BufWriter<&std::fs::File>) -> std::io::Result<()> {
+    use std::io::{Read, Seek, SeekFrom};
+    w.flush()?;
+    let mut file: &std::fs::File = w.get_ref();
+    let len = file.seek(SeekFrom::End(0))?;
+    let mut prefix = vec![0u8; len.min(HEADER_READ) as usize];
+    file.seek(SeekFrom::Start(0))?;
+    file.read_exact(&mut prefix)?;
+    let end = sort_header_attributes(&mut prefix)?;
+    file.seek(SeekFrom::Start(0))?;
+    file.write_all(&prefix[..end])?;
+    file.seek(SeekFrom::End(0))?;
+    Ok(())
+}
+
+/// Puts the attributes of a single-part EXR header (`bytes` holds at least the whole header) in
+/// the order of their names, in place; returns the header's length. The exr crate writes
+/// custom attributes (a part's `pgt…` metadata) in the order of a `HashMap`, which changes from
+/// run to run, so the same part would be a different file each time. Sorting keeps every
+/// attribute and the header's length, so the offset table after it stays valid.
+///
+/// The layout (OpenEXR file layout: magic number, version field, then attributes, each a
+/// null-terminated name, a null-terminated type name, a little-endian i32 size and the value,
+/// ended by an empty name) is checked as it is walked: anything else is an error, not a guess.
+fn sort_header_attributes(bytes: &mut [u8]) -> std::io::Result<usize> {
+    const MAGIC: [u8; 4] = [0x76, 0x2f, 0x31, 0x01];
+    const MULTIPART: u32 = 0x1000;
+    let bad = |what: &str| std::io::Error::other(format!("EXR header: {what}"));
+    if bytes.len() < 8 || bytes[..4] != MAGIC {
+        return Err(bad("no magic number"));
+    }
+    if u32::from_le_bytes([bytes[4], bytes[5], bytes[6], bytes[7]]) & MULTIPART != 0 {
+        return Err(bad("a multi-part file (pgt writes single-part files)"));
+    }
+    let zero_from = |from: usize| {
+        bytes
+            .get(from..)
+            .and_then(|rest| rest.iter().position(|&b| b == 0))
+            .map(|i| from + i)
+            .ok_or_else(|| bad("it does not end within the bytes read"))
+    };
+    // (name, whole attribute) byte ranges, in file order.
+    let mut attributes = Vec::new();
+    let mut at = 8;
+    loop {
+        let name_end = zero_from(at)?;
+        if name_end == at {
+            break;
+        }
+        let type_end = zero_from(name_end + 1)?;
+        let size_bytes = bytes
+            .get(type_end + 1..type_end + 5)
+            .ok_or_else(|| bad("an attribute size is cut off"))?;
+        let size = i32::from_le_bytes([size_bytes[0], size_bytes[1], size_bytes[2], size_bytes[3]]);
+        let size = usize::try_from(size).map_err(|_| bad("a negative attribute size"))?;
+        let end = type_end + 5 + size;
+        if end > bytes.len() {
+            return Err(bad("an attribute value is cut off"));
+        }
+        attributes.push((at..name_end, at..end));
+        at = end;
+    }
+    let mut sorted = attributes.clone();
+    sorted.sort_by(|a, b| bytes[a.0.clone()].cmp(&bytes[b.0.clone()]));
+    let body: Vec<u8> = sorted
+        .iter()
+        .flat_map(|(_, whole)| bytes[whole.clone()].iter().copied())
+        .collect();
+    bytes[8..at].copy_from_slice(&body);
+    Ok(at + 1)
 }
 
 #[cfg(test)]
@@ -268,6 +352,51 @@ mod tests {
             })
             .collect();
         assert!(bytes.windows(2).all(|w| w[0] == w[1]));
+    }
+
+    /// A part's custom header attributes come out in name order, whatever order the exr
+    /// crate's map gives them: the same part is the same bytes on every run.
+    #[test]
+    fn custom_header_attributes_are_written_in_name_order() {
+        let img = RgbImage::new(7, 3);
+        let dir = tempfile::tempdir().unwrap();
+        let header: Vec<(&str, String)> = ["pgtE", "pgtB", "pgtD", "pgtA", "pgtC"]
+            .iter()
+            .map(|&k| (k, format!("value of {k}")))
+            .collect();
+        let files: Vec<Vec<u8>> = (0..4)
+            .map(|n| {
+                let path = dir.path().join(format!("{n}.exr"));
+                write_exr_with_header(&path, &img, &[("err", &img)], &header).unwrap();
+                std::fs::read(path).unwrap()
+            })
+            .collect();
+        assert!(files.windows(2).all(|w| w[0] == w[1]));
+        let text = String::from_utf8_lossy(&files[0]);
+        let at: Vec<usize> = ["pgtA", "pgtB", "pgtC", "pgtD", "pgtE"]
+            .iter()
+            .map(|k| text.find(k).unwrap())
+            .collect();
+        assert!(at.windows(2).all(|w| w[0] < w[1]), "{at:?}");
+        // Still a valid EXR with every attribute.
+        let read = exr::prelude::read_all_flat_layers_from_file(dir.path().join("0.exr")).unwrap();
+        let layer = &read.layer_data[0];
+        let n = layer
+            .attributes
+            .other
+            .keys()
+            .chain(read.attributes.other.keys())
+            .filter(|k| k.to_string().starts_with("pgt"))
+            .count();
+        assert_eq!(n, 5);
+    }
+
+    #[test]
+    fn a_header_that_is_not_an_exr_header_is_an_error() {
+        assert!(sort_header_attributes(&mut [0u8; 16]).is_err());
+        let mut cut = vec![0x76, 0x2f, 0x31, 0x01, 2, 0, 0, 0];
+        cut.extend_from_slice(b"name\0text\0");
+        assert!(sort_header_attributes(&mut cut).is_err());
     }
 
     #[test]

@@ -25,7 +25,9 @@ use std::path::{Path, PathBuf};
 )]
 #[serde(rename_all = "kebab-case")]
 pub enum RenderMode {
+    /// Solid spheres: the first hit, Lambert + Blinn–Phong, hard shadows.
     Opaque,
+    /// Spheres of glowing, absorbing gas (the optical model says how they glow).
     Volume,
 }
 
@@ -83,6 +85,9 @@ pub struct SceneLoadOptions {
     pub mode: Option<RenderMode>,
     pub model: Option<Model>,
     pub tol: Option<f64>,
+    /// `--format`: the format of a bare particle file whatever its extension (a scene file
+    /// names the format of each include with `format = "…"`).
+    pub format: Option<&'static crate::formats::Format>,
 }
 
 /// Largest image side pgt accepts; beyond it a typo (`--size 5120000x512`) would allocate
@@ -116,6 +121,14 @@ impl Scene {
             .extension()
             .and_then(|e| e.to_str())
             .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
+        if let (true, Some(format)) = (is_toml, options.format) {
+            return Err(PgtError::Usage(format!(
+                "--format {} applies to a bare particle file; {} is a scene file, which names the format of each file it includes (`format = \"{}\"` in its [[include]])",
+                format.name,
+                path.display(),
+                format.name
+            )));
+        }
         if is_toml {
             let text = std::fs::read_to_string(path).map_err(|e| PgtError::io(path, e))?;
             Scene::from_toml_str(&text, path, options)

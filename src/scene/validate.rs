@@ -6,7 +6,7 @@ use super::file::{
 };
 use super::framing::{default_camera, thesis_lights, DEFAULT_FOV_Y, DEFAULT_SIZE};
 use super::{IncludeSpec, ParticleRecord, RenderSettings, Scene, SceneLoadOptions};
-use crate::error::{line_of, toml_error, Location, PgtError, Result};
+use crate::error::{toml_error, At, PgtError, Result, SourceText};
 use crate::geometry::Camera;
 use crate::optics::extinction::Extinction;
 use crate::optics::light::{Falloff, Light};
@@ -15,77 +15,15 @@ use glam::DVec3;
 use std::path::Path;
 use toml::Spanned;
 
-/// Names a place for messages: the file and a location.
-struct At<'a> {
-    path: &'a Path,
-    location: Location,
-}
-
-impl At<'_> {
-    fn err(&self, message: impl Into<String>) -> PgtError {
-        PgtError::Input {
-            path: self.path.to_path_buf(),
-            location: self.location.clone(),
-            message: message.into(),
-        }
-    }
-
-    fn finite(&self, field: &str, v: f64) -> Result<f64> {
-        if v.is_finite() {
-            Ok(v)
-        } else {
-            Err(self.err(format!("{field} must be a finite number, got {v}")))
-        }
-    }
-
-    fn vec3(&self, field: &str, v: [f64; 3]) -> Result<DVec3> {
-        if v.iter().all(|x| x.is_finite()) {
-            Ok(DVec3::from(v))
-        } else {
-            Err(self.err(format!("{field} must hold three finite numbers, got {v:?}")))
-        }
-    }
-
-    fn non_negative3(&self, field: &str, v: [f64; 3]) -> Result<DVec3> {
-        let d = self.vec3(field, v)?;
-        if d.min_element() < 0.0 {
-            return Err(self.err(format!("{field} must be ≥ 0 in every channel, got {v:?}")));
-        }
-        Ok(d)
-    }
-
-    fn direction(&self, field: &str, v: [f64; 3]) -> Result<DVec3> {
-        let d = self.vec3(field, v)?;
-        let len = d.length();
-        if len == 0.0 || !len.is_finite() {
-            return Err(self.err(format!("{field} must be a non-zero vector, got {v:?}")));
-        }
-        Ok(d / len)
-    }
-
-    fn in_range(&self, field: &str, v: f64, lo: f64, hi: f64, what: &str) -> Result<f64> {
-        let v = self.finite(field, v)?;
-        if v < lo || v > hi {
-            return Err(self.err(format!("{field} must be {what}, got {v}")));
-        }
-        Ok(v)
-    }
-}
-
 pub(super) fn scene_from_toml(
     text: &str,
     path: &Path,
     options: &SceneLoadOptions,
 ) -> Result<Scene> {
     let file: SceneFile = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
-    let at = |span: std::ops::Range<usize>| At {
-        path,
-        location: Location::Line(line_of(text, span.start)),
-    };
-    let whole = At {
-        path,
-        location: Location::File,
-    };
+    let source = SourceText { path, text };
+    let at = |span: std::ops::Range<usize>| source.at(span);
+    let whole = source.whole();
 
     let render = match &file.render {
         Some(r) => render_settings(&at(r.span()), r.get_ref())?,
@@ -93,19 +31,13 @@ pub(super) fn scene_from_toml(
     };
     let render = apply_overrides(render, options, &whole)?;
 
-    let defaults_at = file.defaults.as_ref().map_or(whole.location.clone(), |d| {
-        Location::Line(line_of(text, d.span().start))
-    });
+    let defaults_at = file
+        .defaults
+        .as_ref()
+        .map_or(whole.clone(), |d| source.at(d.span()));
     let empty = ParticleDefaults::default();
     let defaults = file.defaults.as_ref().map_or(&empty, |d| d.get_ref());
-    let resolved_defaults = ResolvedDefaults::new(
-        &At {
-            path,
-            location: defaults_at,
-        },
-        defaults,
-        render.lambda,
-    )?;
+    let resolved_defaults = ResolvedDefaults::new(&defaults_at, defaults, render.lambda)?;
 
     let mut particles = Vec::with_capacity(file.particles.len());
     for (i, p) in file.particles.iter().enumerate() {
@@ -129,12 +61,13 @@ pub(super) fn scene_from_toml(
             f64::MAX,
             "> 0",
         )?;
+        let written = spec.path.clone();
         spec.path = base.join(&spec.path);
         // A file that cannot be read is named with the scene's include line (a typo in the
         // path is the usual cause); errors inside a file that was read name that file's line.
         let loaded = crate::formats::load_particles(&spec).map_err(|e| match e {
             PgtError::Io { path, source } => {
-                spec_at.err(format!("include: cannot read {}: {source}", path.display()))
+                unreadable_include(&spec_at, base, &written, &path, &source)
             }
             e => e,
         })?;
@@ -173,15 +106,45 @@ pub(super) fn scene_from_toml(
     })
 }
 
+/// An include that cannot be read: named with the scene's include line, the file, the cause,
+/// and, for a relative path, the folder it was taken relative to (the scene file's `base`,
+/// not the working directory: the usual surprise).
+fn unreadable_include(
+    at: &At,
+    base: &Path,
+    written: &Path,
+    path: &Path,
+    source: &std::io::Error,
+) -> PgtError {
+    let relative = if written.is_absolute() {
+        String::new()
+    } else {
+        let folder = if base.as_os_str().is_empty() {
+            "the current folder, where the scene file is".to_string()
+        } else {
+            format!("{}, the scene file's folder", base.display())
+        };
+        format!(
+            " (the path `{}` is taken relative to {folder})",
+            written.display()
+        )
+    };
+    at.err(format!(
+        "include: cannot read {}: {source}{relative}",
+        path.display()
+    ))
+}
+
 /// A bare particle file with the default scene of docs/design.md §1.
 pub(super) fn bare_particle_file(path: &Path, options: &SceneLoadOptions) -> Result<Scene> {
-    let whole = At {
-        path,
-        location: Location::File,
-    };
+    let whole = At::whole(path);
     let render = apply_overrides(RenderSettings::default(), options, &whole)?;
     let defaults = ResolvedDefaults::new(&whole, &ParticleDefaults::default(), render.lambda)?;
-    let loaded = crate::formats::load_particles(&IncludeSpec::bare(path))?;
+    let spec = IncludeSpec {
+        format: options.format,
+        ..IncludeSpec::bare(path)
+    };
+    let loaded = crate::formats::load_particles(&spec)?;
     let particles = loaded
         .records
         .iter()
@@ -397,7 +360,10 @@ fn record_particle(
         center,
         radius,
         color,
-        sigma: d.sigma(opacity, None, radius, lambda),
+        // A σ the file gives is the particle's σ exactly (crate::formats::xyz_csv, "σ and opacity").
+        sigma: rec
+            .sigma
+            .unwrap_or_else(|| d.sigma(opacity, None, radius, lambda)),
         albedo: d.albedo.unwrap_or(color),
         ks: d.ks,
         shininess: d.shininess,
@@ -625,6 +591,7 @@ opacity = 0.8
             mode: Some(super::super::RenderMode::Opaque),
             model: None,
             tol: Some(1e-3),
+            format: None,
         };
         let s = Scene::from_toml_str("[camera]\nwidth=100\nheight=100\n", Path::new("s.toml"), &o)
             .unwrap();

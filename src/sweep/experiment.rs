@@ -5,7 +5,7 @@
 
 use super::method::{ParamDefault, ParamValue, SweepMethod, SweepParam};
 use super::registry::{find_method, method_names};
-use crate::error::{line_of, toml_error, with_quoted_line, PgtError, Result};
+use crate::error::{toml_error, PgtError, Result, SourceText};
 use crate::reference::MAX_SPP;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -157,7 +157,9 @@ impl Experiment {
     /// Parses and validates the text of the experiment file `path`.
     pub fn parse(text: &str, path: &Path) -> Result<Experiment> {
         let file: ExperimentFile = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
-        let at = Place { path, text };
+        let at = Validator {
+            src: SourceText { path, text },
+        };
         at.check_globals(&file)?;
         let reference = file
             .reference
@@ -178,8 +180,8 @@ impl Experiment {
                 .try_fold(1usize, |n, l| n.checked_mul(l.len()))
                 .filter(|&n| runs.len() + n <= MAX_RUNS);
             if count.is_none() {
-                let line = table.keys().map(|k| at.line(k)).min().unwrap_or(1);
-                return Err(at.error(
+                let line = table.keys().map(|k| at.src.line(k)).min().unwrap_or(1);
+                return Err(at.src.error(
                     line,
                     format!(
                         "this entry's lists make more than {MAX_RUNS} runs in all (their product); sweep fewer values"
@@ -271,7 +273,12 @@ fn baseline_run(run: &Run, spec: &BaselineSpec, ref_spp: u32) -> Run {
 
 /// Sets each run's `baseline` index; an error at the `baseline` line when the named run is not
 /// among the experiment's runs.
-fn resolve_baselines(at: &Place, entries: &[Entry], ref_spp: u32, runs: &mut [Run]) -> Result<()> {
+fn resolve_baselines(
+    at: &Validator,
+    entries: &[Entry],
+    ref_spp: u32,
+    runs: &mut [Run],
+) -> Result<()> {
     let mut start = 0;
     for entry in entries {
         let n = entry.runs().len();
@@ -284,7 +291,7 @@ fn resolve_baselines(at: &Place, entries: &[Entry], ref_spp: u32, runs: &mut [Ru
                 match found {
                     Some(j) => runs[i].baseline = Some(j),
                     None => {
-                        return Err(at.error(
+                        return Err(at.src.error(
                             spec.line,
                             format!(
                                 "the baseline of `{}` is `{}`, which is not one of the experiment's runs; list it in an [[approximations]] entry",
@@ -313,46 +320,37 @@ fn default_value(p: &SweepParam, ref_spp: u32) -> ParamValue {
 /// mistake in a list, not a plan.
 pub const MAX_RUNS: usize = 10_000;
 
-/// The experiment file, for errors that name file:line.
-struct Place<'a> {
-    path: &'a Path,
-    text: &'a str,
+/// The checks of an experiment file's tables; errors name file:line through `src`.
+struct Validator<'a> {
+    src: SourceText<'a>,
 }
 
-impl Place<'_> {
-    fn line<T>(&self, s: &Spanned<T>) -> usize {
-        line_of(self.text, s.span().start)
-    }
-
-    fn error(&self, line: usize, message: String) -> PgtError {
-        PgtError::at_line(self.path, line, with_quoted_line(message, self.text, line))
-    }
-
+impl Validator<'_> {
     /// Checks `size`, `data_range` and `[reference]` as `pgt render` and `pgt compare` would,
     /// but before anything is rendered and naming their line.
     fn check_globals(&self, file: &ExperimentFile) -> Result<()> {
         if let Some(size) = &file.size {
             let [w, h] = *size.get_ref();
             crate::scene::check_image_size(w as i64, h as i64)
-                .map_err(|m| self.error(self.line(size), format!("size: {m}")))?;
+                .map_err(|m| self.src.error(self.src.line(size), format!("size: {m}")))?;
         }
         if let Some(range) = &file.data_range {
             let r = *range.get_ref();
             if !(r.is_finite() && r > 0.0) {
                 let message = format!("data_range must be a finite number > 0, got {r}");
-                return Err(self.error(self.line(range), message));
+                return Err(self.src.error(self.src.line(range), message));
             }
         }
         if let Some(reference) = &file.reference {
-            let line = self.line(reference);
+            let line = self.src.line(reference);
             let spec = reference.get_ref();
             if let Some(spp) = spec.spp.filter(|s| !(1..=MAX_SPP).contains(s)) {
                 let message = format!("reference.spp must be between 1 and {MAX_SPP}, got {spp}");
-                return Err(self.error(line, message));
+                return Err(self.src.error(line, message));
             }
             if let Some(tol) = spec.tol.filter(|t| !(t.is_finite() && *t > 0.0)) {
                 let message = format!("reference.tol must be a finite number > 0, got {tol}");
-                return Err(self.error(line, message));
+                return Err(self.src.error(line, message));
             }
         }
         Ok(())
@@ -366,8 +364,8 @@ impl Place<'_> {
     ) -> Result<Entry> {
         let get = |key: &str| table.iter().find(|(k, _)| k.get_ref() == key);
         let Some((_, method_value)) = get("method") else {
-            let line = table.keys().map(|k| self.line(k)).min().unwrap_or(1);
-            return Err(self.error(
+            let line = table.keys().map(|k| self.src.line(k)).min().unwrap_or(1);
+            return Err(self.src.error(
                 line,
                 format!(
                     "an [[approximations]] entry needs `method = \"NAME\"` (one of {})",
@@ -404,8 +402,8 @@ impl Place<'_> {
     fn method(&self, value: &Spanned<toml::Value>) -> Result<&'static dyn SweepMethod> {
         let name = value.get_ref().as_str();
         name.and_then(find_method).ok_or_else(|| {
-            self.error(
-                self.line(value),
+            self.src.error(
+                self.src.line(value),
                 format!(
                     "unknown method {}; the methods are {}",
                     value.get_ref(),
@@ -434,8 +432,8 @@ impl Place<'_> {
                 } else {
                     format!("its parameters are {}", valid.join(", "))
                 };
-                self.error(
-                    self.line(key),
+                self.src.error(
+                    self.src.line(key),
                     format!(
                         "method {} has no parameter '{name}'; {valid} (and `baseline`)",
                         method.name()
@@ -453,8 +451,10 @@ impl Place<'_> {
         items
             .into_iter()
             .map(|v| {
-                one_value(p, v)
-                    .map_err(|m| self.error(self.line(value), format!("{}: {m}", p.name)))
+                one_value(p, v).map_err(|m| {
+                    self.src
+                        .error(self.src.line(value), format!("{}: {m}", p.name))
+                })
             })
             .collect()
     }
@@ -465,9 +465,9 @@ impl Place<'_> {
         entry_method: &'static dyn SweepMethod,
         value: &Spanned<toml::Value>,
     ) -> Result<BaselineSpec> {
-        let line = self.line(value);
+        let line = self.src.line(value);
         let Some(table) = value.get_ref().as_table() else {
-            return Err(self.error(
+            return Err(self.src.error(
                 line,
                 "baseline must be a table, e.g. baseline = { n_exact = \"all\" }".into(),
             ));
@@ -484,7 +484,7 @@ impl Place<'_> {
             let key = Spanned::new(value.span(), name.clone());
             let (_, p) = self.param(method, &key, name)?;
             let v = one_value(p, v)
-                .map_err(|m| self.error(line, format!("baseline {}: {m}", p.name)))?;
+                .map_err(|m| self.src.error(line, format!("baseline {}: {m}", p.name)))?;
             values.push((p.name, v));
         }
         Ok(BaselineSpec {
@@ -495,15 +495,15 @@ impl Place<'_> {
     }
 }
 
-impl Place<'_> {
+impl Validator<'_> {
     /// `plot_x = "NAME"`: a parameter of at least one run.
     fn plot_x(&self, x: &Spanned<String>, runs: &[Run]) -> Result<&'static str> {
         runs.iter()
             .flat_map(|r| r.params.iter().map(|(k, _)| *k))
             .find(|k| *k == x.get_ref())
             .ok_or_else(|| {
-                self.error(
-                    self.line(x),
+                self.src.error(
+                    self.src.line(x),
                     format!("plot_x: no run has a parameter '{}'", x.get_ref()),
                 )
             })
@@ -514,7 +514,7 @@ impl Place<'_> {
         runs.iter()
             .position(|r| r.method == target.method && r.params == target.params)
             .ok_or_else(|| {
-                self.error(
+                self.src.error(
                     line,
                     format!(
                         "{what} is `{}`, which is not one of the experiment's runs; list it in an [[approximations]] entry",
@@ -527,14 +527,14 @@ impl Place<'_> {
     /// An `[[attribution]]` table: `run = { method = …, … }` and its chain of `steps`, each
     /// swap applied to the previous run as a `baseline` is (see [`baseline_run`]).
     fn attribution(&self, a: &AttributionFile, runs: &[Run], ref_spp: u32) -> Result<Attribution> {
-        let line = self.line(&a.run);
+        let line = self.src.line(&a.run);
         let has_method = a
             .run
             .get_ref()
             .as_table()
             .is_some_and(|t| t.contains_key("method"));
         if !has_method {
-            return Err(self.error(
+            return Err(self.src.error(
                 line,
                 "attribution: `run` must be a table naming the method, e.g. run = { method = \"thesis\", n_exact = 5 }".into(),
             ));
@@ -550,10 +550,10 @@ impl Place<'_> {
         let first = self.find_run(runs, &current, line, "the attributed run")?;
         let mut steps = Vec::new();
         for (i, step) in a.steps.iter().enumerate() {
-            let line = self.line(&step.swap);
+            let line = self.src.line(&step.swap);
             if step.swap.get_ref().as_str() == Some("reference") {
                 if i + 1 != a.steps.len() {
-                    return Err(self.error(
+                    return Err(self.src.error(
                         line,
                         "attribution: swap = \"reference\" ends the chain; it must be the last step".into(),
                     ));

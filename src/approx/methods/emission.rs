@@ -2,8 +2,9 @@
 //!
 //! The particles a camera ray crosses, sorted by entry and composited back to front with
 //! docs/design.md §2's closed form L = L_behind·T + C·(1 − T) per particle (`shaders/emission.wgsl`).
-//! Exact where particles do not overlap; the scene's optical model is ignored (the emission
-//! model is used). Volume mode only.
+//! Exact where particles do not overlap. It implements the emission model in volume mode; a
+//! scene of another mode or model is refused (`--model emission` approximates a lit scene's
+//! emission model on purpose).
 //!
 //! Parameters: none.
 //!
@@ -11,9 +12,8 @@
 //! pgt approx scene.toml --method emission -o emission.exr
 //! ```
 
-use super::ApproxMethod;
-use crate::error::{PgtError, Result};
-use crate::scene::{RenderMode, Scene};
+use super::{ApproxMethod, Computes};
+use crate::optics::models;
 
 /// The `emission` method (see the module docs).
 pub struct Emission;
@@ -31,12 +31,7 @@ impl ApproxMethod for Emission {
     fn wgsl(&self) -> &'static str {
         include_str!("../../../shaders/emission.wgsl")
     }
-    fn check_scene(&self, scene: &Scene) -> Result<()> {
-        if scene.render.mode == RenderMode::Opaque {
-            return Err(PgtError::Usage(
-                "the emission method renders gas (volume mode); this scene is in opaque mode: use --method opaque or --mode volume".into(),
-            ));
-        }
-        Ok(())
+    fn computes(&self) -> Computes {
+        Computes::Volume(&[models::EMISSION])
     }
 }

@@ -9,9 +9,36 @@
 //! they are [`super::Method::User`].
 
 use super::param_spec::ParamSpec;
-use crate::error::Result;
-use crate::scene::{RenderMode, Scene};
+use crate::error::{PgtError, Result};
+use crate::scene::{Model, RenderMode, Scene};
 use std::fmt::Write as _;
+
+/// What a method computes (docs/design.md §2), as each method declares it.
+///
+/// The rule, the same for every method: a scene outside what its method computes is refused
+/// by name (exit 2), before any GPU work, with the flag that makes the choice explicit. A
+/// method never computes something else silently, and never with only a warning: a warning
+/// scrolls past in a script or a sweep, while the image it leaves behind is compared with the
+/// scene's reference and scores as if the method were poor at the scene's model. Where the
+/// substitution is what the user wants (what a rasteriser's emission-only blending gives on a
+/// lit molecule), `--model emission` says so, and the image is then exactly what its name says.
+#[derive(Debug, Clone, Copy)]
+pub enum Computes {
+    /// Opaque mode: solid spheres (the optical model plays no part, as in the reference).
+    Opaque,
+    /// Volume mode with these optical models.
+    Volume(&'static [Model]),
+}
+
+impl Computes {
+    /// Whether a scene of this mode and model is what the method computes.
+    pub fn covers(self, mode: RenderMode, model: Model) -> bool {
+        match self {
+            Computes::Opaque => mode == RenderMode::Opaque,
+            Computes::Volume(models) => mode == RenderMode::Volume && models.contains(&model),
+        }
+    }
+}
 
 /// An approximation method: a WGSL `shade` function and what it needs.
 pub trait ApproxMethod: Sync {
@@ -27,10 +54,65 @@ pub trait ApproxMethod: Sync {
     fn params(&self) -> &'static [ParamSpec] {
         &[]
     }
-    /// Refuses scenes the method has no meaning for, with a message that says what to do.
-    fn check_scene(&self, _scene: &Scene) -> Result<()> {
-        Ok(())
+    /// The render mode and optical models it computes (see [`Computes`] for the rule).
+    fn computes(&self) -> Computes;
+    /// Refuses scenes the method does not compute ([`check_computes`]) or has no meaning for,
+    /// with a message that says what to do.
+    fn check_scene(&self, scene: &Scene) -> Result<()> {
+        check_computes(self.name(), self.computes(), scene)
     }
+}
+
+/// The refusal of [`Computes`]: the method `name`, computing `computes`, on `scene`. The
+/// message names the method, the scene's mode or model, and the flag or the methods that fit.
+pub fn check_computes(name: &str, computes: Computes, scene: &Scene) -> Result<()> {
+    let (mode, model) = (scene.render.mode, scene.render.model);
+    if computes.covers(mode, model) {
+        return Ok(());
+    }
+    let message = match (computes, mode) {
+        (Computes::Volume(_), RenderMode::Opaque) => format!(
+            "the {name} method renders gas (volume mode); this scene is in opaque mode: use --method opaque or --mode volume"
+        ),
+        (Computes::Opaque, _) => format!(
+            "the {name} method draws solid spheres (opaque mode); this scene is in volume mode: use --mode opaque to draw it solid, or a volume method ({})",
+            methods_for(|c| matches!(c, Computes::Volume(_))).join(", ")
+        ),
+        (Computes::Volume(models), RenderMode::Volume) => {
+            let implemented: Vec<&str> = models.iter().map(|m| m.name()).collect();
+            // The last is the fullest (the registry lists emission, lit, …).
+            let nearest = implemented.last().copied().unwrap_or("emission");
+            let others = methods_for(|c| c.covers(RenderMode::Volume, model));
+            let instead = if others.is_empty() {
+                format!(
+                    "; no built-in method implements {} (a user shader can: --shader FILE.wgsl)",
+                    model.name()
+                )
+            } else {
+                format!(
+                    ", or use a method that implements {}: {}",
+                    model.name(),
+                    others.join(", ")
+                )
+            };
+            format!(
+                "the {name} method implements the {} model{}, not {}, this scene's model: pass --model {nearest} to approximate it with the {nearest} model{instead}",
+                implemented.join(" and "),
+                if implemented.len() == 1 { "" } else { "s" },
+                model.name(),
+            )
+        }
+    };
+    Err(PgtError::Usage(message))
+}
+
+/// The registered methods whose [`Computes`] satisfies `keep`, by name.
+fn methods_for(keep: impl Fn(Computes) -> bool) -> Vec<&'static str> {
+    METHODS
+        .iter()
+        .filter(|m| keep(m.computes()))
+        .map(|m| m.name())
+        .collect()
 }
 
 /// Declares the method modules and the registry from one list: one line per method.
@@ -117,6 +199,57 @@ mod tests {
             assert_eq!(find_method(n).map(|m| m.name()), Some(*n));
         }
         assert!(find_method("no-such-method").is_none());
+    }
+
+    /// Every method on every mode and model: what it declares runs, anything else is refused
+    /// by name (the method, and the scene's mode or model).
+    #[test]
+    fn a_scene_outside_what_a_method_computes_is_refused_by_name() {
+        let text = "[[particles]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\n";
+        let mut refused = 0;
+        for mode in [RenderMode::Opaque, RenderMode::Volume] {
+            for &model in crate::optics::models::ALL {
+                let options = crate::scene::SceneLoadOptions {
+                    mode: Some(mode),
+                    model: Some(model),
+                    ..Default::default()
+                };
+                let scene =
+                    Scene::from_toml_str(text, std::path::Path::new("s.toml"), &options).unwrap();
+                for m in METHODS {
+                    let r = m.check_scene(&scene);
+                    if m.computes().covers(mode, model) {
+                        assert!(
+                            r.is_ok(),
+                            "{} on {mode:?} {}: {r:?}",
+                            m.name(),
+                            model.name()
+                        );
+                        continue;
+                    }
+                    refused += 1;
+                    let e = r.expect_err("refused").to_string();
+                    assert!(e.contains(&format!("the {} method", m.name())), "{e}");
+                    let named = match (m.computes(), mode) {
+                        (Computes::Volume(_), RenderMode::Volume) => model.name(),
+                        (_, RenderMode::Opaque) => "opaque mode",
+                        (_, RenderMode::Volume) => "volume mode",
+                    };
+                    assert!(e.contains(named), "{e}");
+                }
+            }
+        }
+        // The lit model is not the emission methods' (issue 31: sorted-blend with --model lit
+        // gave the emission image without a word).
+        assert!(refused >= 2 * crate::optics::models::ALL.len());
+        let lit = Computes::Volume(&[crate::optics::models::EMISSION]);
+        assert!(!lit.covers(RenderMode::Volume, crate::optics::models::LIT));
+        for name in ["emission", "sorted-blend"] {
+            let m = find_method(name).unwrap();
+            assert!(!m
+                .computes()
+                .covers(RenderMode::Volume, crate::optics::models::LIT));
+        }
     }
 
     #[test]

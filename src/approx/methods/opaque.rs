@@ -2,8 +2,8 @@
 //!
 //! docs/design.md §2 "Opaque mode" as `src/reference/opaque.rs` defines it, in f32
 //! (`shaders/opaque.wgsl`): the first sphere hit, Lambertian C/π plus normalised Blinn–Phong,
-//! one shadow ray per light through the BVH, plus the scene's `ambient`·C. Any scene: every
-//! particle is drawn opaque.
+//! one shadow ray per light through the BVH, plus the scene's `ambient`·C. Opaque mode; a
+//! volume-mode scene is refused (`--mode opaque` draws it solid on purpose).
 //!
 //! Parameters: none.
 //!
@@ -11,7 +11,7 @@
 //! pgt approx examples/shadows.toml --method opaque -o opaque.png
 //! ```
 
-use super::ApproxMethod;
+use super::{ApproxMethod, Computes};
 
 /// The `opaque` method (see the module docs).
 pub struct Opaque;
@@ -28,5 +28,8 @@ impl ApproxMethod for Opaque {
     }
     fn wgsl(&self) -> &'static str {
         include_str!("../../../shaders/opaque.wgsl")
+    }
+    fn computes(&self) -> Computes {
+        Computes::Opaque
     }
 }

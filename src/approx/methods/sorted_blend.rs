@@ -6,8 +6,9 @@
 //! back to front, with the emission model's closed form over its own chord,
 //! L = L_behind·T + C·(1 − T) (`shaders/sorted_blend.wgsl`). It equals the exact emission model
 //! where particles are disjoint and centre order is entry order (e.g. spheres in separate slabs
-//! along the view axis); overlaps and large particles behind small ones show its error. The
-//! scene's optical model is ignored (the emission model is used). Volume mode only.
+//! along the view axis); overlaps and large particles behind small ones show its error. It
+//! implements the emission model in volume mode; a scene of another mode or model is refused
+//! (`--model emission` approximates a lit scene's emission model on purpose).
 //!
 //! Parameters: none.
 //!
@@ -15,9 +16,8 @@
 //! pgt approx scene.toml --method sorted-blend -o sorted.exr
 //! ```
 
-use super::ApproxMethod;
-use crate::error::{PgtError, Result};
-use crate::scene::{RenderMode, Scene};
+use super::{ApproxMethod, Computes};
+use crate::optics::models;
 
 /// The `sorted-blend` method (see the module docs).
 pub struct SortedBlend;
@@ -35,12 +35,7 @@ impl ApproxMethod for SortedBlend {
     fn wgsl(&self) -> &'static str {
         include_str!("../../../shaders/sorted_blend.wgsl")
     }
-    fn check_scene(&self, scene: &Scene) -> Result<()> {
-        if scene.render.mode == RenderMode::Opaque {
-            return Err(PgtError::Usage(
-                "the sorted-blend method renders gas (volume mode); this scene is in opaque mode: use --method opaque or --mode volume".into(),
-            ));
-        }
-        Ok(())
+    fn computes(&self) -> Computes {
+        Computes::Volume(&[models::EMISSION])
     }
 }

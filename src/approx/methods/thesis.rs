@@ -17,11 +17,9 @@
 //! pgt approx scene.toml --method thesis --samples 100 --n-exact 5 -o thesis.exr
 //! ```
 
-use super::ApproxMethod;
+use super::{ApproxMethod, Computes};
 use crate::approx::param_spec::{ParamSpec, N_EXACT_ALL};
-use crate::error::{PgtError, Result};
 use crate::optics::models;
-use crate::scene::{RenderMode, Scene};
 
 /// The `thesis` method (see the module docs).
 pub struct Thesis;
@@ -61,19 +59,7 @@ impl ApproxMethod for Thesis {
     fn params(&self) -> &'static [ParamSpec] {
         PARAMS
     }
-    fn check_scene(&self, scene: &Scene) -> Result<()> {
-        if scene.render.mode == RenderMode::Opaque {
-            return Err(PgtError::Usage(
-                "the thesis method renders gas (volume mode); this scene is in opaque mode: use --method opaque or --mode volume".into(),
-            ));
-        }
-        let model = scene.render.model;
-        if model != models::EMISSION && model != models::LIT {
-            return Err(PgtError::Usage(format!(
-                "the thesis method implements the emission and lit models; this scene uses {}: use --model lit or a user shader",
-                model.name()
-            )));
-        }
-        Ok(())
+    fn computes(&self) -> Computes {
+        Computes::Volume(&[models::EMISSION, models::LIT])
     }
 }

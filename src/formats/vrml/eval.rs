@@ -387,6 +387,7 @@ impl Ctx<'_> {
             radius,
             color,
             opacity,
+            sigma: None,
             location: Location::Line(geom.line),
         });
         Ok(())
