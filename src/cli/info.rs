@@ -3,8 +3,10 @@
 //! validated with [`Scene::load`], so its includes count too).
 
 use super::Outcome;
+use crate::formats::frames::{open_frames, FrameInfo};
+use crate::formats::topology::{trajectory_format_of, trajectory_summary};
 use crate::formats::{format_of, load_bytes, read_input, Format, IncludeSpec, FORMATS};
-use crate::scene::{Scene, SceneLoadOptions};
+use crate::scene::{SceneFrames, SceneLoadOptions};
 use clap::Args;
 use glam::DVec3;
 use std::collections::HashMap;
@@ -62,6 +64,11 @@ pub struct Info {
     /// Facts of the format: PDB/mmCIF `models` and `chains` (atom records per chain in the
     /// first model, before alternate locations are resolved); MMPLD `version` and `frames`.
     pub details: serde_json::Map<String, serde_json::Value>,
+    /// Frames (docs/design.md §10): their count, the atoms per frame where every frame has as
+    /// many and the time step in ps where the file says; absent for a file or scene of one
+    /// frame. For a scene, the frames it plays; for a trajectory (`.dcd`, `.xtc`) alone, its
+    /// own (the particles are then its atoms at frame 0, as points).
+    pub frames: Option<FrameInfo>,
 }
 
 /// An axis-aligned box.
@@ -161,6 +168,7 @@ pub fn summarize(
         },
         warnings,
         details: serde_json::Map::new(),
+        frames: None,
     }
 }
 
@@ -174,12 +182,27 @@ pub fn info_of(path: &std::path::Path) -> crate::Result<Info> {
         .is_some_and(|e| e.eq_ignore_ascii_case("toml"));
     let name = path.display().to_string();
     if is_toml {
-        let scene = Scene::load(path, &SceneLoadOptions::default())?;
+        let frames = SceneFrames::load(path, &SceneLoadOptions::default())?;
+        let scene = frames.first();
         let it = scene
             .particles
             .iter()
             .map(|p| (p.center, p.radius, Some(p.color)));
-        return Ok(summarize(name, "scene".into(), it, scene.warnings.clone()));
+        let mut info = summarize(name, "scene".into(), it, scene.warnings.clone());
+        info.frames = frames.frame_info();
+        return Ok(info);
+    }
+    if let Some(format) = trajectory_format_of(path) {
+        let (frames, first, warnings) = trajectory_summary(path)?;
+        let mut info = summarize(
+            name,
+            format.name.to_string(),
+            first.iter().map(|&c| (c, 0.0, None)),
+            warnings,
+        );
+        info.radius = None;
+        info.frames = Some(frames);
+        return Ok(info);
     }
     let spec = IncludeSpec::bare(path);
     let format: &Format = format_of(&spec)?;
@@ -189,6 +212,10 @@ pub fn info_of(path: &std::path::Path) -> crate::Result<Info> {
     let mut info = summarize(name, format.name.to_string(), it, loaded.warnings);
     if let Some(details) = format.details {
         info.details = details(path, &bytes)?;
+    }
+    if format.frames.is_some() {
+        let frames = open_frames(&spec)?.info();
+        info.frames = (frames.count > 1).then_some(frames);
     }
     Ok(info)
 }
@@ -223,6 +250,17 @@ pub fn run(args: InfoArgs) -> anyhow::Result<Outcome> {
     }
     for (k, v) in &info.details {
         println!("{:<10} {v}", format!("{k}:"));
+    }
+    if let Some(f) = &info.frames {
+        let atoms = f
+            .atoms_per_frame
+            .map_or("atoms per frame vary or unknown".to_string(), |n| {
+                format!("{n} atoms per frame")
+            });
+        let step = f.time_step_ps.map_or("no time step".to_string(), |dt| {
+            format!("time step {dt} ps")
+        });
+        println!("frames:    {} ({atoms}, {step})", f.count);
     }
     for w in &info.warnings {
         println!("warning:   {w}");
