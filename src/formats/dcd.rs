@@ -203,7 +203,7 @@ pub fn open(source: ByteSource) -> Result<Box<dyn Trajectory>> {
     };
     let (has_cell, has_4d) = (charmm && icntrl(10) != 0, charmm && icntrl(11) != 0);
     let (_, at) = record(&source, enc, at, None, "the title record")?;
-    let (natom_rec, mut at) = record(&source, enc, at, Some(4), "the atom-count record")?;
+    let (natom_rec, at) = record(&source, enc, at, Some(4), "the atom-count record")?;
     let atoms = enc.i32(&natom_rec, 0);
     if atoms < 1 {
         return Err(PgtError::at_byte(
@@ -220,27 +220,7 @@ pub fn open(source: ByteSource) -> Result<Box<dyn Trajectory>> {
             format!("the header says {namnf} fixed atoms, but there are {atoms} atoms"),
         ));
     }
-    let free = if namnf > 0 {
-        let n = atoms - namnf as usize;
-        let (list, next) = record(&source, enc, at, Some(4 * n as u64), "the free-atom list")?;
-        let list_at = at + enc.marker;
-        at = next;
-        let mut free = Vec::with_capacity(n);
-        for k in 0..n {
-            let i = enc.i32(&list, 4 * k);
-            if !(1..=atoms as i64).contains(&i64::from(i)) {
-                return Err(PgtError::at_byte(
-                    &path,
-                    list_at + 4 * k as u64,
-                    format!("free atom {k} has index {i}, outside 1..={atoms}"),
-                ));
-            }
-            free.push(i as usize - 1);
-        }
-        Some(free)
-    } else {
-        None
-    };
+    let (free, at) = free_atoms(&source, enc, at, atoms, namnf as usize)?;
     let coordinates = |n: usize| 3 * (4 * n as u64 + 2 * enc.marker);
     let extra = |n: usize| {
         (if has_cell {
@@ -306,6 +286,36 @@ pub fn open(source: ByteSource) -> Result<Box<dyn Trajectory>> {
         warnings,
         fixed: Mutex::new(None),
     }))
+}
+
+/// The free-atom list at `at` (where `fixed` > 0 atoms are fixed): 0-based indices, checked to
+/// lie in 1..=N in the file, and the offset after the record.
+fn free_atoms(
+    source: &ByteSource,
+    enc: Encoding,
+    at: u64,
+    atoms: usize,
+    fixed: usize,
+) -> Result<(Option<Vec<usize>>, u64)> {
+    if fixed == 0 {
+        return Ok((None, at));
+    }
+    let n = atoms - fixed;
+    let (list, next) = record(source, enc, at, Some(4 * n as u64), "the free-atom list")?;
+    let list_at = at + enc.marker;
+    let mut free = Vec::with_capacity(n);
+    for k in 0..n {
+        let i = enc.i32(&list, 4 * k);
+        if !(1..=atoms as i64).contains(&i64::from(i)) {
+            return Err(PgtError::at_byte(
+                source.path(),
+                list_at + 4 * k as u64,
+                format!("free atom {k} has index {i}, outside 1..={atoms}"),
+            ));
+        }
+        free.push(i as usize - 1);
+    }
+    Ok((Some(free), next))
 }
 
 impl Dcd {
