@@ -553,3 +553,61 @@ fn trajectory_keys_are_checked_with_the_include_line() {
         assert!(e.contains("k.toml") && e.contains(expected), "{text}: {e}");
     }
 }
+
+/// A reader that counts the bytes read through it.
+struct Counting {
+    inner: std::io::Cursor<Vec<u8>>,
+    read: std::sync::Arc<std::sync::atomic::AtomicU64>,
+}
+
+impl std::io::Read for Counting {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        self.read
+            .fetch_add(n as u64, std::sync::atomic::Ordering::Relaxed);
+        Ok(n)
+    }
+}
+
+impl std::io::Seek for Counting {
+    fn seek(&mut self, pos: std::io::SeekFrom) -> std::io::Result<u64> {
+        self.inner.seek(pos)
+    }
+}
+
+#[test]
+fn opening_and_reading_a_frame_reads_that_frame_not_the_trajectory() {
+    use std::sync::atomic::Ordering;
+    for (rel, frame) in [
+        ("trajectories/ngl_md.xtc", 37usize),
+        ("trajectories/ala3.dcd", 200),
+    ] {
+        let path = shared_or_skip!(rel);
+        let bytes = std::fs::read(&path).expect("read");
+        let len = bytes.len() as u64;
+        let read = std::sync::Arc::new(std::sync::atomic::AtomicU64::new(0));
+        let reader = Counting {
+            inner: std::io::Cursor::new(bytes),
+            read: read.clone(),
+        };
+        let source = pgt::formats::frames::ByteSource::from_reader(&path, len, Box::new(reader));
+        let format = pgt::formats::topology::trajectory_format_of(&path).expect("a trajectory");
+        let t = (format.open)(source).expect("opens");
+        let at_open = read.load(Ordering::Relaxed);
+        let frames = t.frames() as u64;
+        // Opening reads headers: at most 100 bytes a frame (XTC's scan) or the DCD header.
+        assert!(
+            at_open <= 100 * frames.max(4),
+            "{rel}: {at_open} bytes read at open"
+        );
+        let mut p = Vec::new();
+        t.read_positions(frame, &mut p).expect("frame");
+        let for_frame = read.load(Ordering::Relaxed) - at_open;
+        // One frame is at most twice the mean frame size of the file.
+        assert!(
+            for_frame <= 2 * len / frames,
+            "{rel}: {for_frame} bytes for one frame of {len}"
+        );
+        assert!(for_frame > 0);
+    }
+}

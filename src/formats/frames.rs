@@ -282,6 +282,15 @@ impl ByteSource {
         })
     }
 
+    /// Any seekable stream of `len` bytes, named `path` in messages.
+    pub fn from_reader(path: &Path, len: u64, reader: Box<dyn ReadSeek>) -> ByteSource {
+        ByteSource {
+            path: path.to_path_buf(),
+            len,
+            inner: Mutex::new(reader),
+        }
+    }
+
     /// Bytes in memory, named `path` in messages.
     pub fn from_bytes(path: &Path, bytes: Vec<u8>) -> ByteSource {
         ByteSource {

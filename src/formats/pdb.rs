@@ -97,6 +97,7 @@ fn read_atoms_from(
 pub fn open_frames(spec: &IncludeSpec, source: ByteSource) -> Result<Box<dyn FrameSource>> {
     let mut text = TextFrames::default();
     scan_lines(&source, |line, at, raw| {
+        let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
         if raw.starts_with(b"MODEL") && (raw.len() == 5 || raw.get(5) == Some(&b' ')) {
             if text.starts.is_empty() {
                 text.starts.push(0);
@@ -273,6 +274,26 @@ mod tests {
             .expect_err("short")
             .to_string();
         assert!(e.contains("t.pdb:2") && e.contains("y coordinate"), "{e}");
+    }
+
+    #[test]
+    fn models_are_frames_with_file_lines_also_with_crlf() {
+        let text = format!(
+            "HEADER x\r\nMODEL        1\r\n{LINE}\r\nENDMDL\r\nMODEL        2\r\n{}\r\nENDMDL\r\n",
+            LINE.replace("63.914", "99.000")
+        );
+        let spec = IncludeSpec::bare(Path::new("m.pdb"));
+        let source = ByteSource::from_bytes(Path::new("m.pdb"), text.into_bytes());
+        let frames = open_frames(&spec, source).expect("opens");
+        assert_eq!(frames.info().count, 2);
+        let f = frames.read_frame(1).expect("frame 1");
+        assert_eq!(f.particles.records[0].center.x, 99.0);
+        assert_eq!(
+            f.particles.records[0].location,
+            crate::error::Location::Line(6)
+        );
+        let e = frames.read_frame(2).unwrap_err().to_string();
+        assert!(e.contains("frame 2") && e.contains("2 frame"), "{e}");
     }
 
     #[test]

@@ -159,12 +159,15 @@ impl CameraPath {
             }
         };
         let forward = l - p;
-        if !(forward.length() > 0.0) {
+        if forward.length() == 0.0 || !forward.is_finite() {
             return Err(format!(
                 "the camera's look_at equals its position at frame {frame}"
             ));
         }
-        if !(u.length() > 0.0) || forward.normalize().cross(u.normalize()).length() < 1e-9 {
+        if u.length() == 0.0
+            || !u.is_finite()
+            || forward.normalize().cross(u.normalize()).length() < 1e-9
+        {
             return Err(format!(
                 "the camera's up is zero or parallel to the viewing direction at frame {frame}"
             ));

@@ -28,6 +28,8 @@ struct Playing {
     selection: FrameSelection,
     /// Its particles' range in frame 0's particle list (replaced per frame).
     range: std::ops::Range<usize>,
+    /// The file the records' locations point into (a trajectory's topology, else the source).
+    record_path: std::path::PathBuf,
 }
 
 /// A scene file (or bare particle file) as a sequence of frames.
@@ -170,7 +172,7 @@ impl SceneFrames {
             let source_index = p.selection.source_index(index).unwrap_or(p.selection.start);
             let frame = p.source.read_frame(source_index)?;
             for rec in &frame.particles.records {
-                particles.push(self.maker.particle(p.source.path(), rec)?);
+                particles.push(self.maker.particle(&p.record_path, rec)?);
             }
             warnings.extend(frame.particles.warnings);
         }
@@ -207,9 +209,14 @@ fn open_playing(scene: &Scene, group: &IncludeGroup) -> Result<Option<Playing>> 
     };
     let source = open_frames(spec).map_err(at)?;
     let selection = FrameSelection::of(spec, source.as_ref())?;
+    let record_path = match &spec.trajectory {
+        Some(_) => spec.path.clone(),
+        None => source.path().to_path_buf(),
+    };
     Ok((selection.len() > 1).then(|| Playing {
         source,
         selection,
         range: group.range.clone(),
+        record_path,
     }))
 }

@@ -230,10 +230,9 @@ pub(super) fn load_toml(text: &str, path: &Path, options: &SceneLoadOptions) -> 
         })?;
         warnings.extend(loaded.warnings);
         let start = particles.len();
-        let record_path = spec.trajectory.as_deref().unwrap_or(&spec.path);
         for rec in &loaded.records {
             particles.push(record_particle(
-                record_path,
+                &spec.path,
                 rec,
                 &resolved_defaults,
                 render.lambda,
