@@ -5,7 +5,7 @@ use super::file::{
     CameraTable, LightKind, LightTable, ParticleDefaults, ParticleTable, RenderTable, SceneFile,
 };
 use super::framing::{default_camera, thesis_lights, DEFAULT_FOV_Y, DEFAULT_SIZE};
-use super::{IncludeSpec, ParticleRecord, RenderSettings, Scene, SceneLoadOptions};
+use super::{IncludeSpec, ParticleInput, ParticleRecord, RenderSettings, Scene, SceneLoadOptions};
 use crate::error::{line_of, toml_error, Location, PgtError, Result};
 use crate::geometry::Camera;
 use crate::optics::extinction::Extinction;
@@ -77,6 +77,19 @@ pub(super) fn scene_from_toml(
     path: &Path,
     options: &SceneLoadOptions,
 ) -> Result<Scene> {
+    scene_from_toml_and_particles(text, path, options, std::iter::empty(), false)
+}
+
+/// [`scene_from_toml`] plus `given` particles, each checked as an inline `[[particles]]` table
+/// (and numbered after them in messages); with `default_lights`, settings without `[[lights]]`
+/// get the thesis's two lights, as a bare particle file does.
+pub(super) fn scene_from_toml_and_particles(
+    text: &str,
+    path: &Path,
+    options: &SceneLoadOptions,
+    given: impl Iterator<Item = ParticleInput>,
+    default_lights: bool,
+) -> Result<Scene> {
     let file: SceneFile = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
     let at = |span: std::ops::Range<usize>| At {
         path,
@@ -113,6 +126,17 @@ pub(super) fn scene_from_toml(
             &at(p.span()),
             i,
             p.get_ref(),
+            &resolved_defaults,
+            render.lambda,
+        )?);
+    }
+    let first = particles.len();
+    for (k, p) in given.enumerate() {
+        let table = given_table(p);
+        particles.push(inline_particle(
+            &whole,
+            first + k,
+            &table,
             &resolved_defaults,
             render.lambda,
         )?);
@@ -155,6 +179,11 @@ pub(super) fn scene_from_toml(
         .enumerate()
         .map(|(i, l)| light(&at(l.span()), i, l.get_ref()))
         .collect::<Result<Vec<_>>>()?;
+    let lights = if lights.is_empty() && default_lights {
+        thesis_lights()
+    } else {
+        lights
+    };
 
     let camera = camera(&file.camera, &at, &whole, options, &particles)?;
     if particles.is_empty() {
@@ -171,6 +200,20 @@ pub(super) fn scene_from_toml(
         particles,
         warnings,
     })
+}
+
+/// A particle given by a program as the inline table it stands for.
+fn given_table(p: ParticleInput) -> ParticleTable {
+    ParticleTable {
+        center: p.center,
+        radius: p.radius,
+        color: p.color,
+        opacity: p.opacity,
+        kappa: p.kappa,
+        albedo: None,
+        ks: None,
+        shininess: None,
+    }
 }
 
 /// A bare particle file with the default scene of docs/design.md §1.
@@ -254,15 +297,20 @@ fn apply_overrides(
         r.model = m;
     }
     if let Some(t) = o.tol {
-        if !(t.is_finite() && t > 0.0) {
-            return Err(PgtError::Usage(format!(
-                "--tol must be a finite number > 0, got {t}"
-            )));
-        }
-        r.tol = t;
+        r.tol = checked_tol_override(t)?;
     }
     let _ = whole;
     Ok(r)
+}
+
+/// A tolerance given on the command line (`--tol`), or to the Python package's `render`.
+pub fn checked_tol_override(t: f64) -> Result<f64> {
+    if !(t.is_finite() && t > 0.0) {
+        return Err(PgtError::Usage(format!(
+            "--tol must be a finite number > 0, got {t}"
+        )));
+    }
+    Ok(t)
 }
 
 /// `[defaults]` with each field checked once.
