@@ -6,6 +6,9 @@
 //! Under `CI=true` a Slurm that cannot start fails the test (`.ci/run` installs the packages);
 //! elsewhere the test says why it skipped.
 
+#[path = "common/skip.rs"]
+mod skip;
+
 use std::collections::BTreeMap;
 use std::path::Path;
 use std::process::Command;
@@ -66,7 +69,7 @@ fn local_slurm(work: &Path, pgt: &Path) -> Option<(Option<i32>, String)> {
             std::env::var("CI").as_deref() != Ok("true"),
             "CI=true: Slurm must start here: {reason}\n{log}"
         );
-        println!("skipping: {reason}");
+        skip::skipped(reason);
         return None;
     }
     Some((out.status.code(), log))

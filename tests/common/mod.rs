@@ -37,7 +37,7 @@ pub fn shared(rel: &str) -> Option<PathBuf> {
         "CI=true and the test data {} is absent (CI must provide ../shared/data)",
         p.display()
     );
-    eprintln!("skipping: {} is absent (CI is not set)", p.display());
+    skipped(&format!("{} is absent (CI is not set)", p.display()));
     None
 }
 
@@ -99,3 +99,7 @@ pub fn lin(hex: u32) -> [f64; 3] {
 pub fn close3(a: glam::DVec3, b: [f64; 3], tol: f64) -> bool {
     (a.x - b[0]).abs() <= tol && (a.y - b[1]).abs() <= tol && (a.z - b[2]).abs() <= tol
 }
+
+
+pub mod skip;
+pub use skip::skipped;

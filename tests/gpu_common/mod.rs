@@ -3,7 +3,11 @@
 //!
 //! A GPU test must FAIL, not skip, when no adapter exists and `CI=true`; elsewhere it skips
 //! with a message.
+
 #![allow(dead_code)]
+
+#[path = "../common/skip.rs"]
+mod skip;
 
 use glam::DVec3;
 use pgt::approx::GpuContext;
@@ -26,7 +30,7 @@ pub fn gpu() -> Option<&'static GpuContext> {
             if std::env::var("CI").is_ok_and(|v| v == "true") {
                 panic!("CI=true and no GPU adapter: {e} (CI must install mesa-vulkan-drivers)");
             }
-            eprintln!("skipping GPU test: {e}");
+            skip::skipped(&format!("no GPU adapter: {e}"));
             None
         }
     })

@@ -2,7 +2,11 @@
 //! serde_json) driving Debian's `chromedriver` + headless `chromium`, for the report's browser
 //! tests. No async runtime and no extra crates: the tests need a handful of commands
 //! (navigate, execute script, pointer actions, find element, click, keys).
+
 #![allow(dead_code)]
+
+#[path = "../common/skip.rs"]
+mod skip;
 
 use serde_json::{json, Value};
 use std::io::{BufRead, BufReader, Read, Write};
@@ -42,7 +46,7 @@ pub fn browser_and_driver() -> Option<(PathBuf, PathBuf)> {
             if in_ci() {
                 panic!("CI is set but {missing} is not installed");
             }
-            eprintln!("skipping: {missing} not installed (CI not set)");
+            skip::skipped(&format!("{missing} not installed (CI not set)"));
             None
         }
     }
