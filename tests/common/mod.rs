@@ -100,6 +100,5 @@ pub fn close3(a: glam::DVec3, b: [f64; 3], tol: f64) -> bool {
     (a.x - b[0]).abs() <= tol && (a.y - b[1]).abs() <= tol && (a.z - b[2]).abs() <= tol
 }
 
-
 pub mod skip;
 pub use skip::skipped;
