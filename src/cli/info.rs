@@ -3,8 +3,10 @@
 //! validated with [`Scene::load`], so its includes count too).
 
 use super::Outcome;
+use crate::formats::frames::{open_frames, FrameInfo};
+use crate::formats::topology::{trajectory_format_of, trajectory_summary};
 use crate::formats::{format_of, load_bytes, read_input, Format, IncludeSpec, FORMATS};
-use crate::scene::{Scene, SceneLoadOptions};
+use crate::scene::{SceneFrames, SceneLoadOptions};
 use clap::Args;
 use glam::DVec3;
 use std::collections::HashMap;
@@ -66,6 +68,11 @@ pub struct Info {
     /// Facts of the format: PDB/mmCIF `models` and `chains` (atom records per chain in the
     /// first model, before alternate locations are resolved); MMPLD `version` and `frames`.
     pub details: serde_json::Map<String, serde_json::Value>,
+    /// Frames (docs/design.md §10): their count, the atoms per frame where every frame has as
+    /// many and the time step in ps where the file says; absent for a file or scene of one
+    /// frame. For a scene, the frames it plays; for a trajectory (`.dcd`, `.xtc`) alone, its
+    /// own (the particles are then its atoms at frame 0, as points).
+    pub frames: Option<FrameInfo>,
 }
 
 /// An axis-aligned box.
@@ -165,6 +172,7 @@ pub fn summarize(
         },
         warnings,
         details: serde_json::Map::new(),
+        frames: None,
     }
 }
 
@@ -183,12 +191,27 @@ pub fn info_of(path: &std::path::Path, format: Option<&'static Format>) -> crate
             format,
             ..SceneLoadOptions::default()
         };
-        let scene = Scene::load(path, &options)?;
+        let frames = SceneFrames::load(path, &options)?;
+        let scene = frames.first();
         let it = scene
             .particles
             .iter()
             .map(|p| (p.center, p.radius, Some(p.color)));
-        return Ok(summarize(name, "scene".into(), it, scene.warnings.clone()));
+        let mut info = summarize(name, "scene".into(), it, scene.warnings.clone());
+        info.frames = frames.frame_info();
+        return Ok(info);
+    }
+    if let Some(format) = trajectory_format_of(path) {
+        let (frames, first, warnings) = trajectory_summary(path)?;
+        let mut info = summarize(
+            name,
+            format.name.to_string(),
+            first.iter().map(|&c| (c, 0.0, None)),
+            warnings,
+        );
+        info.radius = None;
+        info.frames = Some(frames);
+        return Ok(info);
     }
     let spec = IncludeSpec {
         format,
@@ -201,6 +224,10 @@ pub fn info_of(path: &std::path::Path, format: Option<&'static Format>) -> crate
     let mut info = summarize(name, format.name.to_string(), it, loaded.warnings);
     if let Some(details) = format.details {
         info.details = details(path, &bytes)?;
+    }
+    if format.frames.is_some() {
+        let frames = open_frames(&spec)?.info();
+        info.frames = (frames.count > 1).then_some(frames);
     }
     Ok(info)
 }
@@ -248,6 +275,17 @@ fn text_of(info: &Info) -> String {
     }
     for (k, v) in &info.details {
         let _ = writeln!(t, "{:<10} {v}", format!("{k}:"));
+    }
+    if let Some(f) = &info.frames {
+        let atoms = f
+            .atoms_per_frame
+            .map_or("atoms per frame vary or unknown".to_string(), |n| {
+                format!("{n} atoms per frame")
+            });
+        let step = f.time_step_ps.map_or("no time step".to_string(), |dt| {
+            format!("time step {dt} ps")
+        });
+        println!("frames:    {} ({atoms}, {step})", f.count);
     }
     for w in &info.warnings {
         let _ = writeln!(t, "warning:   {w}");

@@ -84,6 +84,47 @@ pub fn infer_element(name: &str, hetatm: bool) -> Option<Element> {
     Element::from_symbol(&first.to_string())
 }
 
+/// Residue names of single-atom ions in CHARMM and GROMACS force fields, with their element.
+const ION_RESIDUES: &[(&str, &str)] = &[
+    ("SOD", "Na"),
+    ("NA+", "Na"),
+    ("CLA", "Cl"),
+    ("CL-", "Cl"),
+    ("POT", "K"),
+    ("K+", "K"),
+    ("CAL", "Ca"),
+    ("CA2+", "Ca"),
+    ("MG2+", "Mg"),
+    ("ZN2", "Zn"),
+    ("ZN2+", "Zn"),
+    ("LIT", "Li"),
+    ("CES", "Cs"),
+    ("RUB", "Rb"),
+    ("BAR", "Ba"),
+    ("CD2", "Cd"),
+];
+
+/// The element of an atom of an MD topology (GRO, PSF), which names atoms without an element
+/// column: a single-atom ion residue ([`ION_RESIDUES`], or an atom named like its residue with a
+/// two-letter element symbol: `NA`/`NA`, `CL`/`CL`), else the atom name as a PDB ATOM record's
+/// ([`infer_element`]: `CA` is the α carbon, `OW` oxygen, `HW1` hydrogen).
+pub fn md_element(atom_name: &str, residue_name: &str) -> Option<Element> {
+    let res = residue_name.trim();
+    let name = atom_name.trim();
+    if let Some((_, e)) = ION_RESIDUES
+        .iter()
+        .find(|(r, _)| r.eq_ignore_ascii_case(res))
+    {
+        return Element::from_symbol(e);
+    }
+    if name.eq_ignore_ascii_case(res) && name.len() == 2 {
+        if let Some(e) = Element::from_symbol(name) {
+            return Some(e);
+        }
+    }
+    infer_element(name, false)
+}
+
 /// Applies the selections of `spec` to `atoms` (all models, all alternate locations) and makes
 /// particles with van der Waals radii; `radius_scale` is applied later by
 /// [`super::load_bytes`]. A file without atoms gives no records (the caller refuses it); a
@@ -262,10 +303,40 @@ fn apply_filters(spec: &IncludeSpec, mut atoms: Vec<Atom>, model: i64) -> Result
     Ok(atoms)
 }
 
+/// The indices (in `atoms`) of the atoms a trajectory include keeps: every atom (a topology has
+/// one model and no alternate locations to resolve), less those the include's `chains`,
+/// `skip_water` and `skip_hydrogen` remove. A chain asked for that is absent, or filters that
+/// remove every atom, are errors naming the selection (as for a PDB include).
+pub fn select_atom_indices(spec: &IncludeSpec, atoms: &[Atom]) -> Result<Vec<usize>> {
+    let model = atoms.first().map_or(1, |a| a.model);
+    check_chains_present(spec, atoms, model)?;
+    let keep = |a: &Atom| {
+        spec.chains.as_ref().is_none_or(|c| c.contains(&a.chain))
+            && !(spec.skip_water && is_water(&a.residue_name))
+            && !(spec.skip_hydrogen && a.element.is_some_and(Element::is_hydrogen))
+    };
+    let kept: Vec<usize> = atoms
+        .iter()
+        .enumerate()
+        .filter(|(_, a)| keep(a))
+        .map(|(i, _)| i)
+        .collect();
+    if kept.is_empty() {
+        return Err(PgtError::in_file(
+            &spec.path,
+            format!(
+                "the include holds no particles: the topology has {} atoms, and its selections (chains, skip_water, skip_hydrogen) remove all of them",
+                atoms.len()
+            ),
+        ));
+    }
+    Ok(kept)
+}
+
 /// Spheres of the selected atoms: van der Waals radius of the element, colour by `color_by`
 /// (chain colours in order of first appearance), with warnings for unknown elements and
 /// elements without a tabulated radius.
-fn make_records(
+pub(crate) fn make_records(
     spec: &IncludeSpec,
     atoms: Vec<Atom>,
     warnings: &mut Vec<String>,

@@ -22,7 +22,81 @@ pub const FORMAT: Format = Format {
     particles: "_atom_site rows",
     read,
     details: Some(details),
+    frames: Some(open_frames),
 };
+
+/// The [`super::OpenFrames`] of mmCIF: one frame per `pdbx_PDB_model_num`, in order of first
+/// appearance. The `_atom_site` loop is tokenised as a whole (CIF has no per-model index and a
+/// row's values may span lines), so the file is parsed once at open and the atoms are kept
+/// grouped by model: fine for NMR ensembles; MD trajectories belong in DCD or XTC.
+pub fn open_frames(
+    spec: &IncludeSpec,
+    source: super::frames::ByteSource,
+) -> Result<Box<dyn super::frames::FrameSource>> {
+    let bytes = source.read_all("the file")?;
+    let (atoms, warnings) = read_atoms(source.path(), &bytes)?;
+    let mut models: Vec<(i64, Vec<Atom>)> = Vec::new();
+    for a in atoms {
+        match models.iter_mut().find(|(m, _)| *m == a.model) {
+            Some((_, group)) => group.push(a),
+            None => models.push((a.model, vec![a])),
+        }
+    }
+    if models.is_empty() {
+        return Err(PgtError::in_file(
+            source.path(),
+            format!(
+                "the file holds no particles: no _atom_site rows ({})",
+                warnings.join("; ")
+            ),
+        ));
+    }
+    Ok(Box::new(CifFrames {
+        spec: spec.clone(),
+        path: source.path().to_path_buf(),
+        models,
+    }))
+}
+
+/// The models of an mmCIF file as frames ([`open_frames`]).
+struct CifFrames {
+    spec: IncludeSpec,
+    path: std::path::PathBuf,
+    models: Vec<(i64, Vec<Atom>)>,
+}
+
+impl super::frames::FrameSource for CifFrames {
+    fn path(&self) -> &Path {
+        &self.path
+    }
+    fn info(&self) -> super::frames::FrameInfo {
+        let sizes: Vec<usize> = self.models.iter().map(|(_, a)| a.len()).collect();
+        super::frames::FrameInfo {
+            count: self.models.len(),
+            atoms_per_frame: sizes
+                .first()
+                .copied()
+                .filter(|&n| sizes.iter().all(|&m| m == n)),
+            time_step_ps: None,
+        }
+    }
+    fn read_frame(&self, index: usize) -> Result<super::frames::Frame> {
+        let (_, atoms) = self
+            .models
+            .get(index)
+            .ok_or_else(|| super::frames::past_the_end(&self.path, index, self.models.len()))?;
+        let mut spec = self.spec.clone();
+        spec.path = self.path.clone();
+        spec.model = None;
+        let loaded = atoms_to_particles(&spec, atoms.clone(), Vec::new())?;
+        let particles = super::frames::finish_frame(&spec, &self.path, index, loaded)?;
+        Ok(super::frames::Frame {
+            index,
+            time_ps: None,
+            particles,
+        })
+    }
+}
 
 /// The [`super::Reader`] of mmCIF: every `_atom_site` row, then the include's selections
 /// ([`atoms_to_particles`]).

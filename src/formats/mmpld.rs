@@ -26,6 +26,7 @@
 //!
 //! Every count is checked against the bytes that remain before anything is allocated.
 
+use super::frames::ByteSource;
 use super::{Format, IncludeSpec, LoadedParticles, ParticleRecord};
 use crate::color::srgb_to_linear;
 use crate::error::{Location, PgtError, Result};
@@ -40,21 +41,38 @@ pub const FORMAT: Format = Format {
     particles: "particles in the frame",
     read,
     details: Some(details),
+    frames: Some(open_frames),
 };
 
 const MAGIC: &[u8; 6] = b"MMPLD\0";
 const HEADER_BYTES: u64 = 60;
 
-/// A little-endian reader over a byte range that reports offsets in errors.
+/// A little-endian reader over a byte range that reports file offsets in errors. `bytes` is a
+/// window of the file that starts at file offset `base` (the whole file, or one frame's bytes).
 struct Cursor<'a> {
     bytes: &'a [u8],
+    /// File offset of `bytes[0]`.
+    base: usize,
+    /// Length of the whole file.
+    file_len: usize,
     pos: usize,
-    /// Reads may not go past this offset (the frame's end).
+    /// Reads may not go past this offset of the window (the frame's end).
     end: usize,
     path: &'a Path,
 }
 
 impl<'a> Cursor<'a> {
+    /// A cursor over a whole file.
+    fn whole(bytes: &'a [u8], path: &'a Path) -> Cursor<'a> {
+        Cursor {
+            bytes,
+            base: 0,
+            file_len: bytes.len(),
+            pos: 0,
+            end: bytes.len(),
+            path,
+        }
+    }
     fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8]> {
         let stop = self.pos.checked_add(n).filter(|&s| s <= self.end);
         match stop.and_then(|s| self.bytes.get(self.pos..s)) {
@@ -64,17 +82,17 @@ impl<'a> Cursor<'a> {
             }
             None => Err(PgtError::at_byte(
                 self.path,
-                self.pos as u64,
+                (self.base + self.pos) as u64,
                 format!(
                     "expected {what} ({n} bytes), but the {} ends at byte {}",
                     self.region(),
-                    self.end
+                    self.base + self.end
                 ),
             )),
         }
     }
     fn region(&self) -> &'static str {
-        if self.end == self.bytes.len() {
+        if self.base + self.end == self.file_len {
             "file"
         } else {
             "frame"
@@ -104,8 +122,9 @@ impl<'a> Cursor<'a> {
     fn f32(&mut self, what: &str) -> Result<f32> {
         Ok(f32::from_le_bytes(self.arr(what)?))
     }
+    /// An error at window offset `at`.
     fn err(&self, at: usize, msg: impl Into<String>) -> PgtError {
-        PgtError::at_byte(self.path, at as u64, msg)
+        PgtError::at_byte(self.path, (self.base + at) as u64, msg)
     }
 }
 
@@ -173,12 +192,13 @@ pub struct Header {
 /// Reads the header and seek table: version, frame count and the frame offsets (frames + 1,
 /// the last being the end of the data).
 fn header_and_table(path: &Path, bytes: &[u8]) -> Result<(Header, Vec<u64>)> {
-    let mut c = Cursor {
-        bytes,
-        pos: 0,
-        end: bytes.len(),
-        path,
-    };
+    header_and_table_of(path, bytes, bytes.len() as u64)
+}
+
+/// [`header_and_table`] from the file's first bytes `bytes` (at least the header and the seek
+/// table, where the file has them) and the file's length.
+fn header_and_table_of(path: &Path, bytes: &[u8], file_len: u64) -> Result<(Header, Vec<u64>)> {
+    let mut c = Cursor::whole(bytes, path);
     let magic = c.arr::<6>("the magic \"MMPLD\\0\"")?;
     if &magic != MAGIC {
         return Err(c.err(
@@ -195,13 +215,13 @@ fn header_and_table(path: &Path, bytes: &[u8]) -> Result<(Header, Vec<u64>)> {
     }
     let frames = c.u32("the frame count")?;
     c.take(48, "the bounding and clip boxes")?;
-    let room = (bytes.len() as u64).saturating_sub(HEADER_BYTES) / 8;
+    let room = file_len.saturating_sub(HEADER_BYTES) / 8;
     if u64::from(frames) >= room {
         return Err(c.err(
             10,
             format!(
                 "the header announces {frames} frames, but the file ({} bytes) has room for a seek table of at most {} entries",
-                bytes.len(),
+                file_len,
                 room
             ),
         ));
@@ -216,16 +236,16 @@ fn header_and_table(path: &Path, bytes: &[u8]) -> Result<(Header, Vec<u64>)> {
     let full = HEADER_BYTES + 8 * n as u64;
     if table.first() == Some(&(full - 8)) {
         table.pop();
-        table.push(bytes.len() as u64);
+        table.push(file_len);
     }
     for (k, w) in table.windows(2).enumerate() {
         if let [a, b] = *w {
-            if a > b || b > bytes.len() as u64 || a < HEADER_BYTES {
+            if a > b || b > file_len || a < HEADER_BYTES {
                 return Err(c.err(
                     60 + 8 * k,
                     format!(
                         "the seek table gives frame {k} the bytes {a}..{b}, outside the file ({} bytes) or backwards",
-                        bytes.len()
+                        file_len
                     ),
                 ));
             }
@@ -280,24 +300,16 @@ pub fn read(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
         (Some(&a), Some(&b)) => (a as usize, b as usize),
         _ => return Err(PgtError::at_byte(path, 60, "the seek table is too short")),
     };
-    let with_ts = h.version >= 102;
-    let first = parse_frame(path, bytes, start, end, h.version, with_ts);
-    let records = match first {
-        Ok(r) => r,
-        Err(e) if h.version == 103 => {
-            match parse_frame(path, bytes, start, end, h.version, false) {
-                Ok(r) => {
-                    warnings.push(format!(
-                    "{}: frame {frame} of this version-1.3 file has no timestamp (a known MegaMol writer bug); read it without",
-                    path.display()
-                ));
-                    r
-                }
-                Err(_) => return Err(e),
-            }
-        }
-        Err(e) => return Err(e),
-    };
+    let window = bytes.get(start..end).unwrap_or_default();
+    let records = frame_records(
+        path,
+        window,
+        start,
+        bytes.len(),
+        h.version,
+        frame,
+        &mut warnings,
+    )?;
     if records.is_empty() {
         let which = if spec.frame.is_some() {
             format!("`frame = {frame}`")
@@ -314,6 +326,133 @@ pub fn read(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
         ));
     }
     Ok(LoadedParticles { records, warnings })
+}
+
+/// The particles of frame `frame`, whose bytes `window` start at file offset `base`. Version 1.3
+/// frames are read with their timestamp and, where that does not end at the frame's end,
+/// without (the writer bug of the module doc, with a warning).
+fn frame_records(
+    path: &Path,
+    window: &[u8],
+    base: usize,
+    file_len: usize,
+    version: u16,
+    frame: usize,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<ParticleRecord>> {
+    let parse = |timestamp: bool| {
+        let mut c = Cursor {
+            bytes: window,
+            base,
+            file_len,
+            pos: 0,
+            end: window.len(),
+            path,
+        };
+        parse_frame_lists(&mut c, version, timestamp)
+    };
+    match parse(version >= 102) {
+        Ok(r) => Ok(r),
+        Err(e) if version == 103 => match parse(false) {
+            Ok(r) => {
+                warnings.push(format!(
+                    "{}: frame {frame} of this version-1.3 file has no timestamp (a known MegaMol writer bug); read it without",
+                    path.display()
+                ));
+                Ok(r)
+            }
+            Err(_) => Err(e),
+        },
+        Err(e) => Err(e),
+    }
+}
+
+/// The [`super::OpenFrames`] of MMPLD: the header and seek table are read at open, each frame's
+/// bytes when it is asked for.
+pub fn open_frames(
+    spec: &IncludeSpec,
+    source: ByteSource,
+) -> Result<Box<dyn super::frames::FrameSource>> {
+    let path = source.path().to_path_buf();
+    let head = source.read_at(0, source.len().min(HEADER_BYTES), "the header")?;
+    let frames = head
+        .get(8..12)
+        .map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+    let table_len = 8 * (u64::from(frames) + 1);
+    let prefix = source.read_at(
+        0,
+        source.len().min(HEADER_BYTES + table_len),
+        "the seek table",
+    )?;
+    let (header, table) = header_and_table_of(&path, &prefix, source.len())?;
+    if header.frames == 0 {
+        return Err(PgtError::at_byte(
+            &path,
+            10,
+            "the file has no frames, so it holds no particles",
+        ));
+    }
+    Ok(Box::new(MmpldFrames {
+        spec: spec.clone(),
+        source,
+        header,
+        table,
+    }))
+}
+
+/// The frames of an MMPLD file ([`open_frames`]).
+struct MmpldFrames {
+    spec: IncludeSpec,
+    source: ByteSource,
+    header: Header,
+    table: Vec<u64>,
+}
+
+impl super::frames::FrameSource for MmpldFrames {
+    fn path(&self) -> &Path {
+        self.source.path()
+    }
+    fn info(&self) -> super::frames::FrameInfo {
+        super::frames::FrameInfo {
+            count: self.header.frames as usize,
+            atoms_per_frame: None,
+            time_step_ps: None,
+        }
+    }
+    fn read_frame(&self, index: usize) -> Result<super::frames::Frame> {
+        let path = self.source.path();
+        let count = self.header.frames as usize;
+        let (Some(&start), Some(&end)) = (self.table.get(index), self.table.get(index + 1)) else {
+            return Err(super::frames::past_the_end(path, index, count));
+        };
+        if index >= count {
+            return Err(super::frames::past_the_end(path, index, count));
+        }
+        let window = self
+            .source
+            .read_at(start, end - start, &format!("frame {index}"))?;
+        let mut warnings = Vec::new();
+        let records = frame_records(
+            path,
+            &window,
+            start as usize,
+            self.source.len() as usize,
+            self.header.version,
+            index,
+            &mut warnings,
+        )?;
+        let particles = super::frames::finish_frame(
+            &self.spec,
+            path,
+            index,
+            LoadedParticles { records, warnings },
+        )?;
+        Ok(super::frames::Frame {
+            index,
+            time_ps: None,
+            particles,
+        })
+    }
 }
 
 /// The header of one particle list: how its particles are laid out and coloured.
@@ -493,7 +632,7 @@ fn read_list_particles(
             color: Some(color),
             opacity: None,
             sigma: None,
-            location: Location::Byte(at as u64),
+            location: Location::Byte((c.base + at) as u64),
         });
     }
     Ok(())
@@ -517,21 +656,14 @@ fn skip_cluster_info(c: &mut Cursor<'_>) -> Result<()> {
     Ok(())
 }
 
-/// Parses the frame in bytes `start..end`: its lists, which must end exactly at `end`.
-fn parse_frame(
-    path: &Path,
-    bytes: &[u8],
-    start: usize,
-    end: usize,
+/// Parses the frame under the cursor (from `c.pos` to `c.end`): its lists, which must end
+/// exactly at `c.end`.
+fn parse_frame_lists(
+    c: &mut Cursor<'_>,
     version: u16,
     timestamp: bool,
 ) -> Result<Vec<ParticleRecord>> {
-    let mut c = Cursor {
-        bytes,
-        pos: start,
-        end,
-        path,
-    };
+    let end = c.end;
     if timestamp {
         c.f32("the frame timestamp")?;
     }
@@ -542,18 +674,19 @@ fn parse_frame(
     }
     let mut out = Vec::new();
     for _ in 0..lists {
-        let h = list_header(&mut c, version)?;
-        read_list_particles(&mut c, &h, &mut out)?;
+        let h = list_header(c, version)?;
+        read_list_particles(c, &h, &mut out)?;
         if version == 101 {
-            skip_cluster_info(&mut c)?;
+            skip_cluster_info(c)?;
         }
     }
     if c.pos != end {
         return Err(c.err(
             c.pos,
             format!(
-                "the frame's lists end at byte {} but the seek table says the frame ends at byte {end}",
-                c.pos
+                "the frame's lists end at byte {} but the seek table says the frame ends at byte {}",
+                c.base + c.pos,
+                c.base + end
             ),
         ));
     }

@@ -14,13 +14,19 @@
 //! refusal of a file that yields no particles (docs/design.md §1), and the check of every record.
 
 pub mod atoms;
+pub mod dcd;
 pub mod elements;
+pub mod frames;
+pub mod gro;
 pub mod mmcif;
 pub mod mmpld;
 pub mod pdb;
+pub mod psf;
 pub mod random;
 pub mod record;
+pub mod topology;
 pub mod vrml;
+pub mod xtc;
 pub mod xyz_csv;
 
 pub use record::{ColorBy, IncludeSpec, ParticleRecord};
@@ -47,6 +53,11 @@ pub type Reader = fn(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles
 pub type Details =
     fn(path: &Path, bytes: &[u8]) -> Result<serde_json::Map<String, serde_json::Value>>;
 
+/// Opens the frames of a particle file of this format ([`frames::FrameSource`]); `spec` carries
+/// the include's selections, `bytes` the file.
+pub type OpenFrames =
+    fn(spec: &IncludeSpec, bytes: frames::ByteSource) -> Result<Box<dyn frames::FrameSource>>;
+
 /// One particle file format: an entry of [`FORMATS`].
 #[derive(Debug)]
 pub struct Format {
@@ -63,6 +74,8 @@ pub struct Format {
     pub read: Reader,
     /// Extra facts for `pgt info`, where the format has any.
     pub details: Option<Details>,
+    /// Its frames, one at a time, where a file of this format may hold several.
+    pub frames: Option<OpenFrames>,
 }
 
 /// Every format pgt reads, in the order messages list them.
@@ -73,6 +86,7 @@ pub static FORMATS: &[&Format] = &[
     &mmpld::FORMAT,
     &xyz_csv::XYZ,
     &xyz_csv::CSV,
+    &gro::FORMAT,
 ];
 
 impl PartialEq for Format {
@@ -178,8 +192,12 @@ pub fn format_of(spec: &IncludeSpec) -> Result<&'static Format> {
 }
 
 /// Loads the particles of an `[[include]]` (or a bare particle file): [`format_of`], then
-/// [`read_input`], then [`load_bytes`].
+/// [`read_input`], then [`load_bytes`]. An include with a `trajectory`, a `sequence` or a
+/// `frames` selection shows one frame of its source ([`frames::load_static_frame`]).
 pub fn load_particles(spec: &IncludeSpec) -> Result<LoadedParticles> {
+    if frames::uses_frames(spec) {
+        return frames::load_static_frame(spec);
+    }
     let format = format_of(spec)?;
     let bytes = read_input(&spec.path)?;
     load_bytes(spec, format, &bytes)
@@ -194,18 +212,23 @@ pub fn load_bytes(spec: &IncludeSpec, format: &Format, bytes: &[u8]) -> Result<L
     if loaded.records.is_empty() {
         return Err(no_particles(spec, format, bytes.len(), &loaded.warnings));
     }
+    apply_include_options(spec, &mut loaded.records);
+    check_records(&spec.path, &loaded.records)?;
+    Ok(loaded)
+}
+
+/// `radius_scale` and `color_by = "uniform"` (no particle keeps a colour of its own).
+pub(crate) fn apply_include_options(spec: &IncludeSpec, records: &mut [ParticleRecord]) {
     if spec.radius_scale != 1.0 {
-        for r in &mut loaded.records {
+        for r in records.iter_mut() {
             r.radius *= spec.radius_scale;
         }
     }
     if spec.color_by == ColorBy::Uniform {
-        for r in &mut loaded.records {
+        for r in records.iter_mut() {
             r.color = None;
         }
     }
-    check_records(&spec.path, &loaded.records)?;
-    Ok(loaded)
 }
 
 /// The error for a file that yields no particles: nearly always a truncated download or a wrong
@@ -230,7 +253,7 @@ fn no_particles(spec: &IncludeSpec, format: &Format, len: usize, warnings: &[Str
 /// Every particle has a finite centre, a finite radius > 0, a colour ≥ 0 and an opacity in
 /// [0, 1] (also for `pgt info`, which does not build a scene); the error points at the
 /// particle's line or byte.
-fn check_records(path: &Path, records: &[ParticleRecord]) -> Result<()> {
+pub(crate) fn check_records(path: &Path, records: &[ParticleRecord]) -> Result<()> {
     for r in records {
         let problem = if !r.center.is_finite() {
             Some(format!("the particle position {} is not finite", r.center))

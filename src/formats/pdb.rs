@@ -11,6 +11,9 @@
 
 use super::atoms::{atoms_to_particles, infer_element, Atom};
 use super::elements::Element;
+use super::frames::{
+    finish_frame, past_the_end, scan_lines, ByteSource, Frame, FrameInfo, FrameSource, TextFrames,
+};
 use super::{Format, IncludeSpec, LoadedParticles};
 use crate::error::{PgtError, Result};
 use glam::DVec3;
@@ -24,6 +27,7 @@ pub const FORMAT: Format = Format {
     particles: "ATOM or HETATM records",
     read,
     details: Some(details),
+    frames: Some(open_frames),
 };
 
 /// The [`super::Reader`] of PDB: every atom record, then the include's selections
@@ -40,11 +44,20 @@ fn details(path: &Path, bytes: &[u8]) -> Result<serde_json::Map<String, serde_js
 
 /// Reads every atom of every model of a PDB file's text.
 pub fn read_atoms(path: &Path, bytes: &[u8]) -> Result<(Vec<Atom>, Vec<String>)> {
+    read_atoms_from(path, bytes, 1)
+}
+
+/// [`read_atoms`] of a piece of a file whose first line is line `first_line` of the file.
+fn read_atoms_from(
+    path: &Path,
+    bytes: &[u8],
+    first_line: usize,
+) -> Result<(Vec<Atom>, Vec<String>)> {
     let mut atoms = Vec::new();
     let warnings = Vec::new();
     let mut model = 1i64;
     for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
-        let line_no = i + 1;
+        let line_no = i + first_line;
         let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
         let record = field(raw, 1, 6);
         match record.trim_end() {
@@ -75,6 +88,77 @@ pub fn read_atoms(path: &Path, bytes: &[u8]) -> Result<(Vec<Atom>, Vec<String>)>
         }
     }
     Ok((atoms, warnings))
+}
+
+/// The [`super::OpenFrames`] of PDB: one frame per `MODEL` record, found by one scan at open
+/// (frame 0 also holds what comes before the first `MODEL`); a file without `MODEL` records is
+/// one frame. Each frame's lines are read and parsed when it is asked for, as a file of one
+/// model ([`atoms_to_particles`] with the include's other selections).
+pub fn open_frames(spec: &IncludeSpec, source: ByteSource) -> Result<Box<dyn FrameSource>> {
+    let mut text = TextFrames::default();
+    scan_lines(&source, |line, at, raw| {
+        let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
+        if raw.starts_with(b"MODEL") && (raw.len() == 5 || raw.get(5) == Some(&b' ')) {
+            if text.starts.is_empty() {
+                text.starts.push(0);
+                text.lines.push(1);
+            } else {
+                text.starts.push(at);
+                text.lines.push(line);
+            }
+        }
+        Ok(true)
+    })?;
+    if text.starts.is_empty() {
+        text.starts.push(0);
+        text.lines.push(1);
+    }
+    Ok(Box::new(PdbFrames {
+        spec: spec.clone(),
+        source,
+        text,
+    }))
+}
+
+/// The models of a PDB file as frames ([`open_frames`]).
+struct PdbFrames {
+    spec: IncludeSpec,
+    source: ByteSource,
+    text: TextFrames,
+}
+
+impl FrameSource for PdbFrames {
+    fn path(&self) -> &Path {
+        self.source.path()
+    }
+    fn info(&self) -> FrameInfo {
+        FrameInfo {
+            count: self.text.starts.len(),
+            atoms_per_frame: None,
+            time_step_ps: None,
+        }
+    }
+    fn read_frame(&self, index: usize) -> Result<Frame> {
+        let path = self.source.path();
+        let (start, end, first_line) = self
+            .text
+            .range(index, self.source.len())
+            .ok_or_else(|| past_the_end(path, index, self.text.starts.len()))?;
+        let bytes = self
+            .source
+            .read_at(start, end - start, &format!("frame {index}"))?;
+        let (atoms, warnings) = read_atoms_from(path, &bytes, first_line)?;
+        let mut spec = self.spec.clone();
+        spec.path = path.to_path_buf();
+        spec.model = None;
+        let loaded = atoms_to_particles(&spec, atoms, warnings)?;
+        let particles = finish_frame(&spec, path, index, loaded)?;
+        Ok(Frame {
+            index,
+            time_ps: None,
+            particles,
+        })
+    }
 }
 
 /// Columns `from..=to` (1-based) of a line, as text; short lines give what is there.
@@ -190,6 +274,26 @@ mod tests {
             .expect_err("short")
             .to_string();
         assert!(e.contains("t.pdb:2") && e.contains("y coordinate"), "{e}");
+    }
+
+    #[test]
+    fn models_are_frames_with_file_lines_also_with_crlf() {
+        let text = format!(
+            "HEADER x\r\nMODEL        1\r\n{LINE}\r\nENDMDL\r\nMODEL        2\r\n{}\r\nENDMDL\r\n",
+            LINE.replace("63.914", "99.000")
+        );
+        let spec = IncludeSpec::bare(Path::new("m.pdb"));
+        let source = ByteSource::from_bytes(Path::new("m.pdb"), text.into_bytes());
+        let frames = open_frames(&spec, source).expect("opens");
+        assert_eq!(frames.info().count, 2);
+        let f = frames.read_frame(1).expect("frame 1");
+        assert_eq!(f.particles.records[0].center.x, 99.0);
+        assert_eq!(
+            f.particles.records[0].location,
+            crate::error::Location::Line(6)
+        );
+        let e = frames.read_frame(2).unwrap_err().to_string();
+        assert!(e.contains("frame 2") && e.contains("2 frame"), "{e}");
     }
 
     #[test]

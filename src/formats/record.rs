@@ -48,7 +48,9 @@ fn one() -> f64 {
 #[derive(Debug, Clone, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct IncludeSpec {
-    /// The particle file (already joined to the scene file's folder once validated).
+    /// The particle file (already joined to the scene file's folder once validated); for a
+    /// `trajectory`, its topology. Empty only where `sequence` names the files instead.
+    #[serde(default)]
     pub path: std::path::PathBuf,
     /// How the particles are coloured.
     #[serde(default)]
@@ -66,10 +68,21 @@ pub struct IncludeSpec {
     /// PDB/mmCIF: drop hydrogens.
     #[serde(default)]
     pub skip_hydrogen: bool,
-    /// MMPLD and XYZ: which frame (0-based); the first by default.
+    /// Which frame (0-based) the include shows in every scene frame, for sources with frames
+    /// other than PDB/mmCIF (MMPLD, XYZ, a trajectory, a sequence); the first by default.
     pub frame: Option<usize>,
+    /// A DCD or XTC trajectory whose frames move the atoms of `path` (its topology: PDB, mmCIF,
+    /// GRO or PSF), docs/design.md §10.
+    pub trajectory: Option<std::path::PathBuf>,
+    /// Numbered particle files, one frame each, instead of `path`: `"traj/frame_%04d.csv"` or
+    /// `"traj/frame_*.csv"` ([`super::frames::SequencePattern`]).
+    pub sequence: Option<std::path::PathBuf>,
+    /// Which frames of the source the scene plays, `"A..B"` (0-based, B excluded) or `"A.."`.
+    pub frames: Option<super::frames::FrameRange>,
+    /// Source frames between two scene frames (≥ 1; 1 by default).
+    pub frame_step: Option<usize>,
     /// Forces a file format whatever the extension: a name of [`super::FORMATS`] (`"pdb"`,
-    /// `"mmcif"`, `"vrml"`, `"mmpld"`, `"xyz"`, `"csv"`).
+    /// `"mmcif"`, `"vrml"`, `"mmpld"`, `"xyz"`, `"csv"`, `"gro"`).
     #[serde(default, deserialize_with = "super::deserialize_format")]
     pub format: Option<&'static super::Format>,
 }
@@ -86,6 +99,10 @@ impl IncludeSpec {
             skip_water: false,
             skip_hydrogen: false,
             frame: None,
+            trajectory: None,
+            sequence: None,
+            frames: None,
+            frame_step: None,
             format: None,
         }
     }

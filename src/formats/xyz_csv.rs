@@ -21,6 +21,9 @@
 //! disagree is refused, naming its line (one of the two was edited without the other).
 
 use super::elements::{element_color, element_radius, Element};
+use super::frames::{
+    finish_frame, past_the_end, scan_lines, ByteSource, Frame, FrameInfo, FrameSource, TextFrames,
+};
 use super::{Format, IncludeSpec, LoadedParticles, ParticleRecord};
 use crate::error::{Location, PgtError, Result};
 use glam::DVec3;
@@ -34,6 +37,7 @@ pub const XYZ: Format = Format {
     particles: "atoms in the frame",
     read: read_xyz,
     details: None,
+    frames: Some(open_xyz_frames),
 };
 
 /// CSV in the table of formats ([`super::FORMATS`]).
@@ -44,12 +48,18 @@ pub const CSV: Format = Format {
     particles: "data rows after the header",
     read: read_csv,
     details: None,
+    frames: None,
 };
 
 fn lines(bytes: &[u8]) -> impl Iterator<Item = (usize, String)> + '_ {
-    bytes.split(|&b| b == b'\n').enumerate().map(|(i, l)| {
+    lines_from(bytes, 1)
+}
+
+/// The lines of a piece of a file whose first line is line `first` of the file.
+fn lines_from(bytes: &[u8], first: usize) -> impl Iterator<Item = (usize, String)> + '_ {
+    bytes.split(|&b| b == b'\n').enumerate().map(move |(i, l)| {
         let l = l.strip_suffix(b"\r").unwrap_or(l);
-        (i + 1, String::from_utf8_lossy(l).into_owned())
+        (i + first, String::from_utf8_lossy(l).into_owned())
     })
 }
 
@@ -71,9 +81,14 @@ fn number(path: &Path, line: usize, what: &str, s: &str) -> Result<f64> {
 
 /// The [`super::Reader`] of XYZ: frame `spec.frame` (0-based, default 0).
 pub fn read_xyz(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
+    read_xyz_from(spec, bytes, 1)
+}
+
+/// [`read_xyz`] of a piece of a file whose first line is line `first_line` of the file.
+fn read_xyz_from(spec: &IncludeSpec, bytes: &[u8], first_line: usize) -> Result<LoadedParticles> {
     let path = spec.path.as_path();
     let frame = spec.frame.unwrap_or(0);
-    let mut it = lines(bytes).peekable();
+    let mut it = lines_from(bytes, first_line).peekable();
     let mut records = Vec::new();
     let mut warnings = Vec::new();
     let mut unknown = 0usize;
@@ -184,6 +199,117 @@ pub fn read_xyz(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
 /// How far a row's `opacity` may be from the opacity its `sigma` gives, 1 − e^{−2rσ}: both
 /// written with a few digits agree this well; an edit of one of them does not.
 pub const SIGMA_OPACITY_AGREEMENT: f64 = 1e-6;
+
+/// Where the scan of an XYZ file is: before a count line, or with lines of a frame to skip.
+enum XyzScan {
+    Count,
+    Skip(usize),
+}
+
+/// The [`super::OpenFrames`] of XYZ: one scan at open finds the count line of every frame
+/// (blank lines between frames are skipped); a frame's lines are parsed when it is asked for. A
+/// count line that is not an integer is an error at open, naming its line; a last frame cut
+/// short is found when it is read.
+pub fn open_xyz_frames(spec: &IncludeSpec, source: ByteSource) -> Result<Box<dyn FrameSource>> {
+    let mut text = TextFrames::default();
+    let mut state = XyzScan::Count;
+    let path = source.path().to_path_buf();
+    let max_atoms = source.len() / 4;
+    scan_lines(&source, |line, at, raw| {
+        match state {
+            XyzScan::Skip(n) => {
+                state = if n <= 1 {
+                    XyzScan::Count
+                } else {
+                    XyzScan::Skip(n - 1)
+                }
+            }
+            XyzScan::Count => {
+                let t = String::from_utf8_lossy(raw);
+                if t.trim().is_empty() {
+                    return Ok(true);
+                }
+                let n: u64 = t.trim().parse().map_err(|_| {
+                    PgtError::at_line(
+                        &path,
+                        line,
+                        format!(
+                            "frame {}: expected the atom count (an integer), found '{}'",
+                            text.starts.len(),
+                            t.trim()
+                        ),
+                    )
+                })?;
+                if n > max_atoms {
+                    return Err(PgtError::at_line(
+                        &path,
+                        line,
+                        format!(
+                            "the atom count {n} is larger than the file can hold ({} bytes)",
+                            source.len()
+                        ),
+                    ));
+                }
+                text.starts.push(at);
+                text.lines.push(line);
+                state = XyzScan::Skip(n as usize + 1);
+            }
+        }
+        Ok(true)
+    })?;
+    if text.starts.is_empty() {
+        return Err(PgtError::in_file(
+            &path,
+            "empty XYZ file: expected an atom count on the first line",
+        ));
+    }
+    Ok(Box::new(XyzFrames {
+        spec: spec.clone(),
+        source,
+        text,
+    }))
+}
+
+/// The frames of an XYZ file ([`open_xyz_frames`]).
+struct XyzFrames {
+    spec: IncludeSpec,
+    source: ByteSource,
+    text: TextFrames,
+}
+
+impl FrameSource for XyzFrames {
+    fn path(&self) -> &Path {
+        self.source.path()
+    }
+    fn info(&self) -> FrameInfo {
+        FrameInfo {
+            count: self.text.starts.len(),
+            atoms_per_frame: None,
+            time_step_ps: None,
+        }
+    }
+    fn read_frame(&self, index: usize) -> Result<Frame> {
+        let path = self.source.path();
+        let (start, end, first_line) = self
+            .text
+            .range(index, self.source.len())
+            .ok_or_else(|| past_the_end(path, index, self.text.starts.len()))?;
+        let bytes = self
+            .source
+            .read_at(start, end - start, &format!("frame {index}"))?;
+        let mut spec = self.spec.clone();
+        spec.path = path.to_path_buf();
+        spec.frame = None;
+        let loaded = read_xyz_from(&spec, &bytes, first_line)
+            .map_err(|e| e.context(format!("frame {index}")))?;
+        let particles = finish_frame(&spec, path, index, loaded)?;
+        Ok(Frame {
+            index,
+            time_ps: None,
+            particles,
+        })
+    }
+}
 
 /// The columns a CSV header names.
 #[derive(Debug, Default)]

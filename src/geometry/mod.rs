@@ -2,11 +2,13 @@
 
 pub mod bvh;
 pub mod camera;
+pub mod camera_path;
 pub mod projection;
 pub mod ray;
 pub mod sphere;
 
 pub use bvh::{Bvh, BvhNode, Hit, Leaf};
 pub use camera::Camera;
+pub use camera_path::{CameraPath, Interpolation, Keyframe};
 pub use ray::Ray;
 pub use sphere::{intersect_sphere, Chord};

@@ -11,6 +11,7 @@ mod flip_math;
 pub mod gate;
 pub mod maps;
 pub mod ssim;
+pub mod temporal;
 
 use crate::error::{PgtError, Result};
 use crate::image_io::RgbImage;

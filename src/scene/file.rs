@@ -4,6 +4,7 @@
 
 use super::{Falloff, LightWeight, Model, RenderMode};
 use crate::formats::IncludeSpec;
+use crate::geometry::Interpolation;
 use serde::Deserialize;
 use toml::Spanned;
 
@@ -31,6 +32,34 @@ pub(super) struct CameraTable {
     pub focal_length: Option<f64>,
     pub width: Option<i64>,
     pub height: Option<i64>,
+    /// `[camera.orbit]`: the camera turns about an axis (docs/design.md §10).
+    pub orbit: Option<Spanned<OrbitTable>>,
+    /// `[[camera.keyframes]]`: the camera follows interpolated keyframes (docs/design.md §10).
+    #[serde(default)]
+    pub keyframes: Vec<Spanned<KeyframeTable>>,
+    /// How keyframes are interpolated: `"linear"` (default) or `"catmull-rom"`.
+    pub interpolation: Option<Interpolation>,
+}
+
+/// `[camera.orbit]`.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct OrbitTable {
+    pub axis: [f64; 3],
+    pub degrees_per_frame: f64,
+    /// The centre of the turn; default the particles' centre at frame 0.
+    pub center: Option<[f64; 3]>,
+}
+
+/// One `[[camera.keyframes]]` table.
+#[derive(Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(super) struct KeyframeTable {
+    pub frame: i64,
+    pub position: [f64; 3],
+    pub look_at: [f64; 3],
+    pub up: Option<[f64; 3]>,
+    pub fov_y: Option<f64>,
 }
 
 #[derive(Debug, Deserialize)]

@@ -3,10 +3,12 @@
 //! `validate` turns it into a [`Scene`], with errors that name the file, line and field.
 
 mod file;
+mod frames;
 mod framing;
 mod validate;
 
 pub use crate::formats::{ColorBy, IncludeSpec, ParticleRecord};
+pub use frames::SceneFrames;
 pub use framing::{bounding_sphere, default_camera, thesis_lights};
 // The light physics, the resolved particle and the optical models live in `optics` (the scene
 // builds on optics, never the reverse); re-exported so that `scene::Light` etc. keep working.

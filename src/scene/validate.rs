@@ -2,12 +2,13 @@
 //! the line and the field (docs/design.md §6 "Bad input").
 
 use super::file::{
-    CameraTable, LightKind, LightTable, ParticleDefaults, ParticleTable, RenderTable, SceneFile,
+    CameraTable, KeyframeTable, LightKind, LightTable, OrbitTable, ParticleDefaults, ParticleTable,
+    RenderTable, SceneFile,
 };
 use super::framing::{default_camera, thesis_lights, DEFAULT_FOV_Y, DEFAULT_SIZE};
 use super::{IncludeSpec, ParticleRecord, RenderSettings, Scene, SceneLoadOptions};
-use crate::error::{toml_error, At, PgtError, Result, SourceText};
-use crate::geometry::Camera;
+use crate::error::{line_of, toml_error, At, Location, PgtError, Result, SourceText};
+use crate::geometry::{Camera, CameraPath, Keyframe};
 use crate::optics::extinction::Extinction;
 use crate::optics::light::{Falloff, Light};
 use crate::optics::particle::Particle;
@@ -15,11 +16,100 @@ use glam::DVec3;
 use std::path::Path;
 use toml::Spanned;
 
+/// A validated scene file with what a sequence of frames needs besides frame 0: the camera of
+/// every frame, where each include's particles sit in `scene.particles`, and the defaults that
+/// turn a file's records into particles.
+pub(super) struct Loaded {
+    /// Frame 0.
+    pub scene: Scene,
+    pub camera_path: CameraPath,
+    /// The particles of each include, in order, as ranges of `scene.particles` (the inline
+    /// particles come first, before every include).
+    pub includes: Vec<IncludeGroup>,
+    pub maker: ParticleMaker,
+}
+
+/// An include and where its frame-0 particles are.
+pub(super) struct IncludeGroup {
+    /// The include, its paths joined to the scene file's folder.
+    pub spec: IncludeSpec,
+    /// The scene file's line of the include (the whole file for a bare particle file).
+    pub location: Location,
+    pub range: std::ops::Range<usize>,
+}
+
+/// Turns a format's records into particles with the scene's `[defaults]` and λ.
+pub(super) struct ParticleMaker {
+    defaults: ResolvedDefaults,
+    lambda: f64,
+}
+
+impl ParticleMaker {
+    /// A particle of the file `path`, checked with the location the format recorded.
+    pub fn particle(&self, path: &Path, rec: &ParticleRecord) -> Result<Particle> {
+        record_particle(path, rec, &self.defaults, self.lambda)
+    }
+}
+
 pub(super) fn scene_from_toml(
     text: &str,
     path: &Path,
     options: &SceneLoadOptions,
 ) -> Result<Scene> {
+    load_toml(text, path, options).map(|l| l.scene)
+}
+
+/// An `[[include]]`'s keys that say where its files are, checked and joined to the scene file's
+/// folder `base` (docs/design.md §10: `path`, `trajectory`, `sequence`, `frame`, `frames`,
+/// `frame_step`).
+fn resolve_include(at: &At, base: &Path, mut spec: IncludeSpec) -> Result<IncludeSpec> {
+    at.in_range(
+        "include.radius_scale",
+        spec.radius_scale,
+        f64::MIN_POSITIVE,
+        f64::MAX,
+        "> 0",
+    )?;
+    let has_path = !spec.path.as_os_str().is_empty();
+    match (has_path, spec.sequence.is_some(), spec.trajectory.is_some()) {
+        (false, false, _) => {
+            return Err(at.err(
+                "include: set `path` (a particle file, or a trajectory's topology) or `sequence` (numbered files)",
+            ))
+        }
+        (true, true, _) => {
+            return Err(at.err("include: set `path` or `sequence`, not both"))
+        }
+        (false, true, true) => {
+            return Err(at.err(
+                "include.trajectory needs `path` (its topology: PDB, mmCIF, GRO or PSF), not `sequence`",
+            ))
+        }
+        _ => {}
+    }
+    if spec.frame.is_some() && spec.frames.is_some() {
+        return Err(at.err(
+            "include: set `frame` (one frame in every scene frame) or `frames` (the frames to play), not both",
+        ));
+    }
+    if spec.model.is_some() && spec.frames.is_some() {
+        return Err(at.err(
+            "include: set `model` (one model in every scene frame) or `frames` (the models to play), not both",
+        ));
+    }
+    if spec.frame_step == Some(0) {
+        return Err(at.err("include.frame_step must be ≥ 1, got 0"));
+    }
+    if has_path {
+        spec.path = base.join(&spec.path);
+    }
+    spec.trajectory = spec.trajectory.map(|t| base.join(t));
+    spec.sequence = spec.sequence.map(|q| base.join(q));
+    Ok(spec)
+}
+
+/// Validates scene TOML into frame 0 and what the other frames need ([`Loaded`]).
+pub(super) fn load_toml(text: &str, path: &Path, options: &SceneLoadOptions) -> Result<Loaded> {
     let file: SceneFile = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
     let source = SourceText { path, text };
     let at = |span: std::ops::Range<usize>| source.at(span);
@@ -51,27 +141,28 @@ pub(super) fn scene_from_toml(
     }
     let mut warnings = Vec::new();
     let base = path.parent().unwrap_or(Path::new("."));
+    let mut includes = Vec::with_capacity(file.include.len());
     for inc in &file.include {
         let spec_at = at(inc.span());
-        let mut spec = inc.get_ref().clone();
-        spec_at.in_range(
-            "include.radius_scale",
-            spec.radius_scale,
-            f64::MIN_POSITIVE,
-            f64::MAX,
-            "> 0",
-        )?;
-        let written = spec.path.clone();
-        spec.path = base.join(&spec.path);
+        let written = inc.get_ref().path.clone();
+        let spec = resolve_include(&spec_at, base, inc.get_ref().clone())?;
         // A file that cannot be read is named with the scene's include line (a typo in the
         // path is the usual cause); errors inside a file that was read name that file's line.
+        // Errors of a frame source (a trajectory, a sequence, a `frames` range) also name the
+        // include's line, since the keys that chose the frames are there.
         let loaded = crate::formats::load_particles(&spec).map_err(|e| match e {
             PgtError::Io { path, source } => {
                 unreadable_include(&spec_at, base, &written, &path, &source)
             }
+            e if crate::formats::frames::uses_frames(&spec) => e.context(format!(
+                "{}:{}: [[include]]",
+                path.display(),
+                line_of(text, inc.span().start)
+            )),
             e => e,
         })?;
         warnings.extend(loaded.warnings);
+        let start = particles.len();
         for rec in &loaded.records {
             particles.push(record_particle(
                 &spec.path,
@@ -80,6 +171,11 @@ pub(super) fn scene_from_toml(
                 render.lambda,
             )?);
         }
+        includes.push(IncludeGroup {
+            spec,
+            location: spec_at.location.clone(),
+            range: start..particles.len(),
+        });
     }
 
     let lights = file
@@ -89,20 +185,48 @@ pub(super) fn scene_from_toml(
         .map(|(i, l)| light(&at(l.span()), i, l.get_ref()))
         .collect::<Result<Vec<_>>>()?;
 
-    let camera = camera(&file.camera, &at, &whole, options, &particles)?;
+    let camera_path = camera(&file.camera, &at, &whole, options, &particles)?;
+    let camera = first_camera(&camera_path, &file.camera, &at, &whole)?;
     if particles.is_empty() {
         warnings.push(format!(
             "{}: the scene has no particles; it renders the background",
             path.display()
         ));
     }
-    Ok(Scene {
-        source: path.to_path_buf(),
-        camera,
-        render,
-        lights,
-        particles,
-        warnings,
+    Ok(Loaded {
+        scene: Scene {
+            source: path.to_path_buf(),
+            camera,
+            render,
+            lights,
+            particles,
+            warnings,
+        },
+        camera_path,
+        includes,
+        maker: ParticleMaker {
+            defaults: resolved_defaults,
+            lambda: render.lambda,
+        },
+    })
+}
+
+/// The camera of frame 0, with a degenerate one named at the camera table's line.
+fn first_camera<'a>(
+    path: &CameraPath,
+    table: &Option<Spanned<CameraTable>>,
+    at: &dyn Fn(std::ops::Range<usize>) -> At<'a>,
+    whole: &At<'a>,
+) -> Result<Camera> {
+    path.camera_at(0).map_err(|m| {
+        let camera_at = table.as_ref().map_or_else(
+            || At {
+                path: whole.path,
+                location: whole.location.clone(),
+            },
+            |t| at(t.span()),
+        );
+        camera_at.err(format!("camera: {m}"))
     })
 }
 
@@ -137,6 +261,11 @@ fn unreadable_include(
 
 /// A bare particle file with the default scene of docs/design.md §1.
 pub(super) fn bare_particle_file(path: &Path, options: &SceneLoadOptions) -> Result<Scene> {
+    load_bare(path, options).map(|l| l.scene)
+}
+
+/// [`bare_particle_file`] with what a sequence of frames needs ([`Loaded`]).
+pub(super) fn load_bare(path: &Path, options: &SceneLoadOptions) -> Result<Loaded> {
     let whole = At::whole(path);
     let render = apply_overrides(RenderSettings::default(), options, &whole)?;
     let defaults = ResolvedDefaults::new(&whole, &ParticleDefaults::default(), render.lambda)?;
@@ -159,13 +288,27 @@ pub(super) fn bare_particle_file(path: &Path, options: &SceneLoadOptions) -> Res
     }
     let (w, h) = options.size.unwrap_or(DEFAULT_SIZE);
     check_size(&whole, w as i64, h as i64)?;
-    Ok(Scene {
-        source: path.to_path_buf(),
-        camera: default_camera(&particles, w, h),
-        render,
-        lights: thesis_lights(),
-        particles,
-        warnings,
+    let camera = default_camera(&particles, w, h);
+    let range = 0..particles.len();
+    Ok(Loaded {
+        scene: Scene {
+            source: path.to_path_buf(),
+            camera,
+            render,
+            lights: thesis_lights(),
+            particles,
+            warnings,
+        },
+        camera_path: CameraPath::Fixed(camera),
+        includes: vec![IncludeGroup {
+            spec: IncludeSpec::bare(path),
+            location: Location::File,
+            range,
+        }],
+        maker: ParticleMaker {
+            defaults,
+            lambda: render.lambda,
+        },
     })
 }
 
@@ -414,29 +557,74 @@ fn check_size(at: &At, w: i64, h: i64) -> Result<(u32, u32)> {
     super::check_image_size(w, h).map_err(|e| at.err(e))
 }
 
+/// The camera of every frame (docs/design.md §1, §10): the `[camera]` table's fixed camera, an
+/// orbit (`[camera.orbit]`) that starts from it, or `[[camera.keyframes]]`.
 fn camera<'a>(
     table: &Option<Spanned<CameraTable>>,
     at: &dyn Fn(std::ops::Range<usize>) -> At<'a>,
     whole: &At<'a>,
     options: &SceneLoadOptions,
     particles: &[Particle],
-) -> Result<Camera> {
+) -> Result<CameraPath> {
     let Some(table) = table else {
         let (w, h) = options.size.unwrap_or(DEFAULT_SIZE);
         check_size(whole, w as i64, h as i64)?;
-        return Ok(default_camera(particles, w, h));
+        return Ok(CameraPath::Fixed(default_camera(particles, w, h)));
     };
-    let at = at(table.span());
     let t = table.get_ref();
+    let table_at = at(table.span());
     let (w, h) = match options.size {
         Some((w, h)) => check_size(whole, w as i64, h as i64)?,
         None => check_size(
-            &at,
+            &table_at,
             t.width.unwrap_or(DEFAULT_SIZE.0 as i64),
             t.height.unwrap_or(DEFAULT_SIZE.1 as i64),
         )?,
     };
-    let fov_y = match (t.fov_y, t.focal_length) {
+    let fov_y = camera_fov(&table_at, t)?;
+    if t.interpolation.is_some() && t.keyframes.is_empty() {
+        return Err(table_at
+            .err("camera.interpolation applies to [[camera.keyframes]], and there are none"));
+    }
+    if !t.keyframes.is_empty() {
+        if t.orbit.is_some() {
+            return Err(
+                table_at.err("camera: set [camera.orbit] or [[camera.keyframes]], not both")
+            );
+        }
+        if let Some(key) = [
+            ("position", t.position.is_some()),
+            ("look_at", t.look_at.is_some()),
+        ]
+        .iter()
+        .find(|(_, set)| *set)
+        {
+            return Err(table_at.err(format!(
+                "camera.{}: the keyframes set the camera's position and look_at; remove one or the other",
+                key.0
+            )));
+        }
+        return keyframe_path(&table_at, at, t, fov_y, (w, h));
+    }
+    let (camera, look_at) = fixed_camera(&table_at, t, particles, fov_y, (w, h))?;
+    match &t.orbit {
+        None => Ok(CameraPath::Fixed(camera)),
+        Some(orbit) => {
+            let start = Keyframe {
+                frame: 0,
+                position: camera.position,
+                look_at,
+                up: table_at.direction("camera.up", t.up.unwrap_or([0.0, 1.0, 0.0]))?,
+                fov_y,
+            };
+            orbit_path(&at(orbit.span()), orbit.get_ref(), start, (w, h), particles)
+        }
+    }
+}
+
+/// `camera.fov_y` or `camera.focal_length` (degrees), [`DEFAULT_FOV_Y`] by default.
+fn camera_fov(at: &At, t: &CameraTable) -> Result<f64> {
+    Ok(match (t.fov_y, t.focal_length) {
         (Some(_), Some(_)) => return Err(at.err("camera: set fov_y or focal_length, not both")),
         (Some(f), None) => {
             let f = at.finite("camera.fov_y", f)?;
@@ -453,7 +641,18 @@ fn camera<'a>(
             Camera::fov_y_from_focal_length(f)
         }
         (None, None) => DEFAULT_FOV_Y,
-    };
+    })
+}
+
+/// The `[camera]` table's own camera (framing the particles where position and look_at are
+/// absent).
+fn fixed_camera(
+    at: &At,
+    t: &CameraTable,
+    particles: &[Particle],
+    fov_y: f64,
+    (w, h): (u32, u32),
+) -> Result<(Camera, DVec3)> {
     let (position, look_at) = match (t.position, t.look_at) {
         (Some(p), Some(l)) => (
             at.vec3("camera.position", p)?,
@@ -476,7 +675,116 @@ fn camera<'a>(
     if forward.normalize().cross(up).length() < 1e-9 {
         return Err(at.err("camera.up must not be parallel to the viewing direction"));
     }
-    Ok(Camera::new(position, look_at, up, fov_y, w, h))
+    Ok((Camera::new(position, look_at, up, fov_y, w, h), look_at))
+}
+
+/// `[camera.orbit]`: the fixed camera turned about `axis` through `center` (the particles'
+/// centre at frame 0 by default), `degrees_per_frame` per frame.
+fn orbit_path(
+    at: &At,
+    orbit: &OrbitTable,
+    start: Keyframe,
+    (width, height): (u32, u32),
+    particles: &[Particle],
+) -> Result<CameraPath> {
+    let axis = at.direction("camera.orbit.axis", orbit.axis)?;
+    let degrees_per_frame = at.finite("camera.orbit.degrees_per_frame", orbit.degrees_per_frame)?;
+    let center = match orbit.center {
+        Some(c) => at.vec3("camera.orbit.center", c)?,
+        None => super::framing::bounding_sphere(particles).0,
+    };
+    Ok(CameraPath::Orbit {
+        start,
+        center,
+        axis,
+        degrees_per_frame,
+        width,
+        height,
+    })
+}
+
+/// `[[camera.keyframes]]`: at least two, frames ≥ 0 and strictly increasing; `up` and `fov_y`
+/// default to the `[camera]` table's. Each keyframe's camera is checked (an error names its
+/// line and key).
+fn keyframe_path<'a>(
+    table_at: &At<'a>,
+    at: &dyn Fn(std::ops::Range<usize>) -> At<'a>,
+    t: &CameraTable,
+    fov_y: f64,
+    (width, height): (u32, u32),
+) -> Result<CameraPath> {
+    if t.keyframes.len() < 2 {
+        return Err(table_at.err(format!(
+            "camera.keyframes: a keyframe path needs at least two keyframes, got {}",
+            t.keyframes.len()
+        )));
+    }
+    let default_up = t.up.unwrap_or([0.0, 1.0, 0.0]);
+    let mut keys: Vec<Keyframe> = Vec::with_capacity(t.keyframes.len());
+    for (i, k) in t.keyframes.iter().enumerate() {
+        let k_at = at(k.span());
+        let key = keyframe(&k_at, i, k.get_ref(), default_up, fov_y)?;
+        if let Some(prev) = keys.last() {
+            if key.frame <= prev.frame {
+                return Err(k_at.err(format!(
+                    "camera.keyframes[{i}].frame = {} must be greater than the previous keyframe's frame {} (keyframes in order)",
+                    key.frame, prev.frame
+                )));
+            }
+        }
+        let single = CameraPath::Keyframes {
+            keys: vec![
+                key,
+                Keyframe {
+                    frame: key.frame + 1,
+                    ..key
+                },
+            ],
+            interpolation: Default::default(),
+            width,
+            height,
+        };
+        single
+            .camera_at(key.frame as usize)
+            .map_err(|m| k_at.err(format!("camera.keyframes[{i}]: {m}")))?;
+        keys.push(key);
+    }
+    Ok(CameraPath::Keyframes {
+        keys,
+        interpolation: t.interpolation.unwrap_or_default(),
+        width,
+        height,
+    })
+}
+
+/// One keyframe's values, checked.
+fn keyframe(
+    at: &At,
+    i: usize,
+    k: &KeyframeTable,
+    default_up: [f64; 3],
+    fov_y: f64,
+) -> Result<Keyframe> {
+    let name = |f: &str| format!("camera.keyframes[{i}].{f}");
+    let frame = u64::try_from(k.frame)
+        .map_err(|_| at.err(format!("{} must be ≥ 0, got {}", name("frame"), k.frame)))?;
+    let fov = match k.fov_y {
+        Some(f) => at.in_range(
+            &name("fov_y"),
+            f,
+            f64::MIN_POSITIVE,
+            179.999_999,
+            "in (0, 180) degrees",
+        )?,
+        None => fov_y,
+    };
+    Ok(Keyframe {
+        frame,
+        position: at.vec3(&name("position"), k.position)?,
+        look_at: at.vec3(&name("look_at"), k.look_at)?,
+        up: at.direction(&name("up"), k.up.unwrap_or(default_up))?,
+        fov_y: fov,
+    })
 }
 
 #[cfg(test)]

@@ -17,6 +17,7 @@ pub const FORMAT: Format = Format {
     particles: "Sphere shapes",
     read,
     details: None,
+    frames: None,
 };
 
 /// The [`super::Reader`] of VRML97: the spheres of the file. The file must start with
