@@ -275,6 +275,7 @@ fn player_section(cmp: &SequenceComparison) -> String {
     let frames: Vec<String> = cmp.frames.iter().map(|f| f.frame.to_string()).collect();
     format!(
         r#"<section id="pgt-player" hidden data-frames="{list}">
+<style>#pgt-player figure img {{ width: 20em; }}</style>
 <h2>Player</h2>
 <div class="controls"><button type="button" data-step="-1">◀ step</button><button type="button" id="pgt-play">play</button><button type="button" data-step="1">step ▶</button>
 <input type="range" id="pgt-slider" min="0" max="{max}" value="0"> <span id="pgt-frame">frame {f0}</span></div>
