@@ -308,7 +308,7 @@ fn frames_table(cmp: &SequenceComparison) -> String {
     for f in &cmp.frames {
         let temporal_img = match &f.temporal {
             Some(_) => format!(
-                "<img loading=\"lazy\" src=\"{}\" alt=\"temporal error of frame {}\" width=\"96\">",
+                "<img src=\"{}\" alt=\"temporal error of frame {}\" width=\"96\">",
                 frame_file("t", f.frame),
                 f.frame
             ),
@@ -316,7 +316,7 @@ fn frames_table(cmp: &SequenceComparison) -> String {
         };
         let _ = writeln!(
             t,
-            "<tr id=\"frame-{n}\"><td><a href=\"#frame-{n}\" data-frame=\"{n}\">{n}</a></td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td><img loading=\"lazy\" src=\"{}\" alt=\"reference of frame {n}\" width=\"96\"></td><td><img loading=\"lazy\" src=\"{}\" alt=\"approximation of frame {n}\" width=\"96\"></td><td>{temporal_img}</td></tr>",
+            "<tr id=\"frame-{n}\"><td><a href=\"#frame-{n}\" data-frame=\"{n}\">{n}</a></td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td><img src=\"{}\" alt=\"reference of frame {n}\" width=\"96\"></td><td><img src=\"{}\" alt=\"approximation of frame {n}\" width=\"96\"></td><td>{temporal_img}</td></tr>",
             opt(f.ssim),
             short(f.rmse),
             opt(f.flip),
