@@ -28,6 +28,7 @@
 use crate::error::{PgtError, Result};
 use crate::image_io::RgbImage;
 use crate::reference::{rows::render_rows, RenderOptions, RenderStats};
+use crate::optics::particle::Particle;
 use crate::scene::Scene;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -66,17 +67,57 @@ pub fn rows_of(part: PartOf, height: u32) -> Vec<u32> {
     (part.index..height).step_by(part.count as usize).collect()
 }
 
-/// 128-bit FNV-1a, fed through `fmt::Write` so that a scene's `Debug` text (exact: floats print
-/// as their shortest round-trip form) is hashed without being held in memory.
+/// A 128-bit FNV-1a-style hash: text (a scene's `Debug` text, exact: floats print as their
+/// shortest round-trip form) is fed a byte at a time through `fmt::Write`, so it is hashed
+/// without being held in memory; the particles are fed a 64-bit word at a time (the bits of
+/// every number), which is what keeps the hash of a large frame cheap.
 struct Fnv128(u128);
+
+const FNV_PRIME: u128 = 0x0000_0000_0100_0000_0000_0000_0000_013B;
 
 impl std::fmt::Write for Fnv128 {
     fn write_str(&mut self, s: &str) -> std::fmt::Result {
-        const PRIME: u128 = 0x0000_0000_0100_0000_0000_0000_0000_013B;
         for &b in s.as_bytes() {
-            self.0 = (self.0 ^ b as u128).wrapping_mul(PRIME);
+            self.0 = (self.0 ^ b as u128).wrapping_mul(FNV_PRIME);
         }
         Ok(())
+    }
+}
+
+impl Fnv128 {
+    fn word(&mut self, w: u64) {
+        self.0 = (self.0 ^ w as u128).wrapping_mul(FNV_PRIME);
+    }
+
+    fn f64(&mut self, v: f64) {
+        self.word(v.to_bits());
+    }
+
+    fn vec3(&mut self, v: glam::DVec3) {
+        self.f64(v.x);
+        self.f64(v.y);
+        self.f64(v.z);
+    }
+
+    /// Every field of `p`, as bits. The pattern names every field (no `..`), so a new field
+    /// of [`Particle`] does not compile until it is hashed here.
+    fn particle(&mut self, p: &Particle) {
+        let Particle {
+            center,
+            radius,
+            color,
+            sigma,
+            albedo,
+            ks,
+            shininess,
+        } = *p;
+        self.vec3(center);
+        self.f64(radius);
+        self.vec3(color);
+        self.f64(sigma);
+        self.vec3(albedo);
+        self.f64(ks);
+        self.f64(shininess);
     }
 }
 
@@ -91,21 +132,30 @@ pub fn render_hash(scene: &Scene, options: &RenderOptions) -> String {
 }
 
 /// The hash of `scene` (as [`render_hash`] sees it) with `what` computes it (the options, or a
-/// GPU method and its parameters): "pgt VERSION | what | scene".
+/// GPU method and its parameters): "pgt VERSION | what | camera | settings | lights", then
+/// every particle's bits.
 pub fn hash_with(scene: &Scene, what: &str) -> String {
     let mut h = Fnv128(0x6c62_272e_07bb_0142_62b8_2175_6295_c58d);
-    let canonical = Scene {
-        source: PathBuf::new(),
-        warnings: Vec::new(),
-        ..scene.clone()
-    };
+    // Every field but the file name and the warnings (the pattern names every field, so a new
+    // one does not compile until it is placed here); the particles follow as bits.
+    let Scene {
+        source: _,
+        camera,
+        render,
+        lights,
+        particles,
+        warnings: _,
+    } = scene;
     // Writing into the hasher cannot fail.
     let _ = write!(
         h,
-        "pgt {} | {what} | {:?}",
+        "pgt {} | {what} | {camera:?} | {render:?} | {lights:?} | {} particles",
         env!("CARGO_PKG_VERSION"),
-        canonical
+        particles.len()
     );
+    for p in particles {
+        h.particle(p);
+    }
     format!("{:032x}", h.0)
 }
 

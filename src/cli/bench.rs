@@ -8,6 +8,7 @@
 //! | `million` | 1,000,000 random spheres (`pgt gen random --count 1000000`), emission model only |
 //! | `million-lit` | the same, lit (not in the default list: minutes on two cores) |
 //! | `1uun-scatter` | 1UUN as `1uun`, single-scatter model, two point lights: one at the centre of the particles' bounding sphere (inside the gas) and one above it (not in the default list) |
+//! | `orbit`, `xtc` | sequences of frames: a frame of a sequence against a single render of it ([`super::bench_frames`]; not in the default list) |
 //!
 //! Every scene is the bare-file default (docs/design.md §1): the camera frames the bounding sphere,
 //! the thesis's two directional lights (green down, blue up), black background, Θmax = 0.5, lit
@@ -65,6 +66,11 @@ pub enum Workload {
     /// 1UUN (or the protein-sized set), single-scatter, point lights inside and above.
     #[value(name = "1uun-scatter")]
     ProteinScatter,
+    /// 1UUN chains A+B, lit, on an orbiting camera: a frame of the sequence against a single
+    /// render.
+    Orbit,
+    /// ngl_md.gro moved by ngl_md.xtc, emission: a frame of the sequence against a single render.
+    Xtc,
 }
 
 /// Options of `pgt bench`.
@@ -90,6 +96,9 @@ pub struct BenchArgs {
     /// the machine's load slowed least.
     #[arg(long, default_value_t = 1, value_parser = clap::value_parser!(u32).range(1..))]
     pub repeat: u32,
+    /// Frames of the sequence workloads (`orbit`: 4; `xtc`: all 51).
+    #[arg(long)]
+    pub frames: Option<usize>,
     /// Folder with `pdb/1uun_opm_oriented.pdb` (default `../shared/data`).
     #[arg(long, default_value = "../shared/data")]
     pub data: PathBuf,
@@ -122,7 +131,16 @@ pub fn run(args: BenchArgs) -> anyhow::Result<Outcome> {
         );
     }
     let mut rows = Vec::new();
+    let mut sequences = Vec::new();
     for &w in &args.workloads {
+        match w {
+            Workload::Orbit => sequences.push("orbit"),
+            Workload::Xtc => sequences.push("xtc"),
+            _ => {}
+        }
+        if matches!(w, Workload::Orbit | Workload::Xtc) {
+            continue;
+        }
         let (name, scene) = workload_scene(w, args.size, &args.data)?;
         eprintln!(
             "bench: {name}, {} spheres, {}x{}",
@@ -132,7 +150,20 @@ pub fn run(args: BenchArgs) -> anyhow::Result<Outcome> {
         );
         rows.extend(bench_scene(&name, &scene, &args)?);
     }
-    super::print_stdout(&table(&rows))?;
+    if !rows.is_empty() {
+        super::print_stdout(&table(&rows))?;
+    }
+    if !sequences.is_empty() {
+        let t = super::bench_frames::bench_frames(
+            &sequences,
+            args.size,
+            args.frames,
+            TOL,
+            args.threads,
+            &args.data,
+        )?;
+        super::print_stdout(&t)?;
+    }
     Ok(Outcome::Success)
 }
 
@@ -264,6 +295,9 @@ fn workload_scene(w: Workload, size: u32, data: &Path) -> anyhow::Result<(String
                 return Ok((format!("{short} scatter"), scene));
             }
             Ok((name, scene))
+        }
+        Workload::Orbit | Workload::Xtc => {
+            anyhow::bail!("{w:?} is a sequence workload, timed by bench_frames")
         }
         Workload::Random => Ok((
             "random 73,642".into(),

@@ -3,6 +3,7 @@
 
 pub mod approx;
 pub mod bench;
+pub mod bench_frames;
 pub mod camera;
 pub mod compare;
 pub mod compare_frames;
