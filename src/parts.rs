@@ -27,8 +27,8 @@
 
 use crate::error::{PgtError, Result};
 use crate::image_io::RgbImage;
-use crate::reference::{rows::render_rows, RenderOptions, RenderStats};
 use crate::optics::particle::Particle;
+use crate::reference::{rows::render_rows, RenderOptions, RenderStats};
 use crate::scene::Scene;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;

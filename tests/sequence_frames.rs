@@ -461,3 +461,41 @@ fn sorted_blend_pops_exactly_where_centre_depths_swap() {
     assert_eq!(files(&report.join("frames"), "t_").len(), POP_FRAMES - 1);
     assert_eq!(files(&report.join("frames"), "r_").len(), POP_FRAMES);
 }
+
+#[test]
+fn camera_and_export_show_one_frame_of_a_moving_scene() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = dir.path().join("pop.toml");
+    std::fs::write(&scene, POP_SCENE).unwrap();
+    // The orbit's camera of frame 5: R_y(5θ)·(0, 0, 10).
+    let out = pgt(&["camera", s(&scene), "--frame", "5", "--json"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let phi = (5.0 * STEP_DEGREES).to_radians();
+    let want = [10.0 * phi.sin(), 0.0, 10.0 * phi.cos()];
+    for (c, w) in want.iter().enumerate() {
+        let got = v["eye"][c].as_f64().unwrap();
+        assert!((got - w).abs() < 1e-9, "eye[{c}] = {got}, want {w}");
+    }
+    // The particles of frame 2 of a trajectory: the XYZ's third frame, shifted by 0.3 a frame.
+    write_xyz(&dir.path().join("traj.xyz"), 4, None);
+    let moving = write_scene(dir.path(), None, "");
+    let csv = dir.path().join("frame2.csv");
+    ok(&["export", s(&moving), "--frame", "2", "-o", s(&csv)]);
+    let text = std::fs::read_to_string(&csv).unwrap();
+    let xs: Vec<f64> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').next().unwrap().parse().unwrap())
+        .collect();
+    assert_eq!(xs, vec![-1.5 + 0.6, 0.0 + 0.6, 1.5 + 0.6]);
+    let err = fails_with(&["export", s(&moving), "--frame", "4", "-o", s(&csv)], 2);
+    assert!(
+        err.contains("frame 4") && err.contains("4 frame(s)"),
+        "{err}"
+    );
+}

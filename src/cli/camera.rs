@@ -22,6 +22,10 @@ pub struct CameraArgs {
     /// format of each include with `format = "…"`).
     #[arg(long, value_name = "NAME", value_parser = super::format_parser())]
     pub format: Option<&'static crate::formats::Format>,
+    /// The frame (from 0) of a scene that moves: its particles and camera, as `pgt render
+    /// --frames` renders it.
+    #[arg(long, value_name = "K")]
+    pub frame: Option<usize>,
     /// Print JSON on stdout instead of text.
     #[arg(long)]
     pub json: bool,
@@ -54,7 +58,7 @@ pub fn run(args: CameraArgs) -> anyhow::Result<Outcome> {
         format: args.format,
         ..SceneLoadOptions::default()
     };
-    let scene = Scene::load(&args.scene, &options)?;
+    let scene = super::frames::scene_at_frame(&args.scene, &options, args.frame)?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }

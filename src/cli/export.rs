@@ -19,7 +19,7 @@ use super::output::{check_outputs, Output, OutputKind};
 use super::Outcome;
 use crate::error::PgtError;
 use crate::image_io::write_atomically;
-use crate::scene::{Particle, Scene, SceneLoadOptions};
+use crate::scene::{Particle, SceneLoadOptions};
 use clap::Args;
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -36,6 +36,10 @@ pub struct ExportArgs {
     /// format of each include with `format = "…"`).
     #[arg(long, value_name = "NAME", value_parser = super::format_parser())]
     pub format: Option<&'static crate::formats::Format>,
+    /// The frame (from 0) of a scene that moves: its particles and camera, as `pgt render
+    /// --frames` renders it.
+    #[arg(long, value_name = "K")]
+    pub frame: Option<usize>,
 }
 
 /// The export formats.
@@ -137,7 +141,7 @@ pub fn run(args: ExportArgs) -> anyhow::Result<Outcome> {
         format: args.format,
         ..SceneLoadOptions::default()
     };
-    let scene = Scene::load(&args.scene, &options)?;
+    let scene = super::frames::scene_at_frame(&args.scene, &options, args.frame)?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }

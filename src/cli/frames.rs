@@ -49,6 +49,20 @@ pub fn open_sequence(
     Ok((frames, list, pattern))
 }
 
+/// The scene of frame `frame` of a scene file (`--frame K` of `pgt camera` and `pgt export`), or
+/// the scene as `pgt render` loads it without one; a frame past the end is an error naming the
+/// scene and its frame count.
+pub fn scene_at_frame(
+    scene: &Path,
+    options: &SceneLoadOptions,
+    frame: Option<usize>,
+) -> anyhow::Result<crate::scene::Scene> {
+    match frame {
+        None => Ok(crate::scene::Scene::load(scene, options)?),
+        Some(k) => Ok(SceneFrames::load(scene, options)?.frame(k)?),
+    }
+}
+
 /// How often a progress line is printed off a terminal.
 const LINE_EVERY: Duration = Duration::from_secs(10);
 
