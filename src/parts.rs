@@ -1,5 +1,5 @@
 //! A reference render cut into parts for a cluster (docs/design.md §7: `pgt render SCENE --part I/N
-//! -o PART.exr` and `pgt merge PART... -o OUT`; issue 12), and their bit-identical merge.
+//! -o PART.exr` and `pgt merge PART... -o OUT`; docs/cluster.md), and their bit-identical merge.
 //!
 //! **Which pixels a part holds.** Part I of N (I 0-based, as Slurm's `$SLURM_ARRAY_TASK_ID` and
 //! Kubernetes' `$JOB_COMPLETION_INDEX` count) holds the image rows y with y mod N = I. Rows are

@@ -1,4 +1,4 @@
-//! Interrupted runs leave nothing behind (issue 13): on SIGINT (Ctrl-C) or SIGTERM, pgt removes
+//! Interrupted runs leave nothing behind (docs/design.md §7): on SIGINT (Ctrl-C) or SIGTERM, pgt removes
 //! every temporary file and folder it is writing, prints one line and exits 130 (SIGINT) or 143
 //! (SIGTERM), the shell's 128 + signal number.
 //!

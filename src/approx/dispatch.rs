@@ -608,7 +608,7 @@ pub fn run_with_limit(
     run_with_progress(ctx, pipeline, scene, frame, limit, &mut |_| {})
 }
 
-/// Where a run stands after a pass (issue 14 item 6: a long approximation on lavapipe runs for
+/// Where a run stands after a pass (a long approximation on lavapipe runs for
 /// minutes in passes; the CLI shows them). The number of passes is not known in advance: the
 /// schedule adapts to each pass's cost.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

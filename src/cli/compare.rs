@@ -161,7 +161,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
                 rel_scale: args.rel_scale,
             },
         };
-        // Written into a temporary folder and moved into place at the end (issue 13): an
+        // Written into a temporary folder and moved into place at the end (docs/design.md §7): an
         // interrupted or failed run leaves no half-written report.
         let page = crate::image_io::write_folder_atomically(dir, |tmp| {
             report::write_report(tmp, &inputs)

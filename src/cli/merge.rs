@@ -1,5 +1,5 @@
 //! `pgt merge PART... -o OUT`: the whole image from the parts of a cluster render (docs/design.md §7,
-//! issue 12), bit-identical to a one-machine `pgt render`, err layer included. The checks and
+//! docs/cluster.md), bit-identical to a one-machine `pgt render`, err layer included. The checks and
 //! the part format are in [`crate::parts`]: a file that is not a part, a missing or duplicated
 //! part, or parts of different renders exit 2 with a message naming the file, and nothing is
 //! written.

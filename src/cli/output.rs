@@ -1,5 +1,5 @@
-//! The one check of every output a command will write, made before any work starts (issue 31:
-//! a bad output path found after an hour of rendering wastes the hour). Every command lists its
+//! The one check of every output a command will write, made before any work starts (a
+//! bad output path found after an hour of rendering wastes the hour). Every command lists its
 //! outputs (`-o`, `--json`, `--report`, …) and calls [`check_outputs`] first.
 //!
 //! For each output: its extension names a format the command writes; it is not a folder where

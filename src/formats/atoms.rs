@@ -267,8 +267,8 @@ fn resolve_alternate_locations(
 }
 
 /// The include's filters in order (`chains`, `skip_water`, `skip_hydrogen`). One that removes
-/// every atom still left is an error naming it (issue 13: an include that yields nothing is
-/// nearly always a mistake), with the count each earlier filter kept.
+/// every atom still left is an error naming it (an include that yields nothing is nearly
+/// always a mistake), with the count each earlier filter kept.
 fn apply_filters(spec: &IncludeSpec, mut atoms: Vec<Atom>, model: i64) -> Result<Vec<Atom>> {
     let atom_s = |n: usize| if n == 1 { "atom" } else { "atoms" };
     let mut story = format!("model {model} has {} {}", atoms.len(), atom_s(atoms.len()));

@@ -273,7 +273,7 @@ fn details(path: &Path, bytes: &[u8]) -> Result<serde_json::Map<String, serde_js
 }
 
 /// The [`super::Reader`] of MMPLD: frame `spec.frame` (0-based, default 0). A file without
-/// frames, or a selected frame without particles, is an error (issue 13).
+/// frames, or a selected frame without particles, is an error (docs/design.md §6 "Bad input").
 pub fn read(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
     let path = spec.path.as_path();
     let (h, table) = header_and_table(path, bytes)?;

@@ -180,7 +180,7 @@ fn read_xyz_from(spec: &IncludeSpec, bytes: &[u8], first_line: usize) -> Result<
         current += 1;
     }
     if records.is_empty() && spec.frame.is_some() {
-        // The selection emptied the include: name it (issue 13).
+        // The selection emptied the include: name it (docs/design.md §6 "Bad input").
         return Err(PgtError::in_file(
             path,
             format!("`frame = {frame}` holds no particles (its atom count is 0)"),

@@ -1,4 +1,4 @@
-//! Folders written atomically (issue 13): a report is written into a temporary folder beside its
+//! Folders written atomically (docs/design.md §7): a report is written into a temporary folder beside its
 //! destination and moved into place at the end, so an interrupted or failed run never leaves a
 //! half-written report folder that looks complete.
 

@@ -44,8 +44,9 @@ pub fn linear_to_srgb8(v: f32, exposure_scale: f32) -> u8 {
 
 /// Writes `image` (and, for EXR, the extra layers, each written as `NAME.R/G/B`) to `path`,
 /// atomically. PNG ignores the extra layers and applies `exposure` in stops. A NaN or infinite
-/// value in any layer is refused before anything is written (issue 13: nothing non-finite is
-/// ever written; it would be a bug, and must not pass a user's CI silently).
+/// value in any layer is refused before anything is written (docs/design.md §6
+/// "Bad input": nothing non-finite is ever written; it would be a bug, and must not pass a
+/// user's CI silently).
 pub fn write_image(
     path: &Path,
     image: &RgbImage,

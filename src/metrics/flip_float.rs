@@ -11,7 +11,7 @@
 //! products then sums), and the cube root and powers of the per-pixel finish are
 //! [`super::flip_math`]'s vectorisable ones (within 10⁻⁶ of libm's).
 //!
-//! Structure (issue 14 item 5: a 4K pair in about a second): the image is cut into work items of
+//! Structure (a 4K pair in about a second): the image is cut into work items of
 //! [`ROWS`] rows by at most [`STRIP`] columns. An item converts each input row it reads (its own,
 //! and the filters' [`Filters::reach`] beyond, clamped to the image) to YCxCz through a caller's
 //! per-pixel transform (clamping for LDR, tone mapping at one exposure for HDR), filters it along

@@ -1,7 +1,7 @@
 //! The cube root and powers of FLIP's per-pixel finish ([`super::flip_float`]) without libm
 //! calls: branch-free f32 code that the compiler vectorises across a row of pixels, where
 //! `f32::cbrt` and `f32::powf` are one library call per value and cost more than all of FLIP's
-//! filtering together (profile of a 4K compare, issue 14 item 5).
+//! filtering together (a profile of a 4K compare).
 //!
 //! Accuracy (tests below, against the std functions over their whole domain in FLIP): [`cbrt`]
 //! within 3 ulp; [`pow`] within 2·10⁻⁷ + 10⁻⁷·|e·log₂ x| relative (the second term is the f32

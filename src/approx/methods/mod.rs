@@ -239,8 +239,8 @@ mod tests {
                 }
             }
         }
-        // The lit model is not the emission methods' (issue 31: sorted-blend with --model lit
-        // gave the emission image without a word).
+        // The lit model is not the emission methods' (sorted-blend with --model lit must not
+        // give the emission image without a word).
         assert!(refused >= 2 * crate::optics::models::ALL.len());
         let lit = Computes::Volume(&[crate::optics::models::EMISSION]);
         assert!(!lit.covers(RenderMode::Volume, crate::optics::models::LIT));
