@@ -9,7 +9,7 @@ use numpy::ndarray::{Ix1, Ix2};
 use numpy::{PyUntypedArray, PyUntypedArrayMethods};
 use pgt::geometry::projection::GraphicsApi;
 use pgt::scene::Light;
-use pgt::scene::{OpticalModel, ParticleInput, RenderMode, SceneLoadOptions};
+use pgt::scene::{Model, ParticleInput, RenderMode, SceneLoadOptions};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use std::path::{Path, PathBuf};
@@ -32,8 +32,8 @@ fn parse_mode(py: Python<'_>, s: &str) -> PyResult<RenderMode> {
     RenderMode::deserialize(d).map_err(|e| input_error(py, format!("mode: {e}")))
 }
 
-fn parse_model(py: Python<'_>, s: &str) -> PyResult<OpticalModel> {
-    s.parse::<OpticalModel>()
+fn parse_model(py: Python<'_>, s: &str) -> PyResult<Model> {
+    s.parse::<Model>()
         .map_err(|e| input_error(py, format!("model: {e}")))
 }
 
@@ -67,10 +67,24 @@ fn warn_all(py: Python<'_>, scene: &pgt::Scene, stacklevel: i32) -> PyResult<()>
     Ok(())
 }
 
+/// A `format=` argument: the name of a particle format, as `--format` takes it.
+fn parse_format(py: Python<'_>, name: &str) -> PyResult<&'static pgt::formats::Format> {
+    pgt::formats::Format::named(name).ok_or_else(|| {
+        let names: Vec<&str> = pgt::formats::FORMATS.iter().map(|f| f.name).collect();
+        input_error(
+            py,
+            format!(
+                "format: unknown format '{name}'; expected one of {}",
+                names.join(", ")
+            ),
+        )
+    })
+}
+
 /// Loads a scene file (.toml) or a bare particle file with the overrides of `pgt render`'s
-/// `--size`, `--mode`, `--model`, `--tol`.
+/// `--size`, `--mode`, `--model`, `--tol` and `--format`.
 #[pyfunction]
-#[pyo3(signature = (path, *, size=None, mode=None, model=None, tol=None))]
+#[pyo3(signature = (path, *, size=None, mode=None, model=None, tol=None, format=None))]
 pub fn load_scene(
     py: Python<'_>,
     path: PathBuf,
@@ -78,12 +92,14 @@ pub fn load_scene(
     mode: Option<&str>,
     model: Option<&str>,
     tol: Option<f64>,
+    format: Option<&str>,
 ) -> PyResult<Scene> {
     let options = SceneLoadOptions {
         size: parse_size(py, size)?,
         mode: mode.map(|m| parse_mode(py, m)).transpose()?,
         model: model.map(|m| parse_model(py, m)).transpose()?,
         tol,
+        format: format.map(|f| parse_format(py, f)).transpose()?,
     };
     let scene = py.detach(|| pgt::Scene::load(&path, &options)).py_err(py)?;
     warn_all(py, &scene, 2)?;

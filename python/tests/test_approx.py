@@ -23,7 +23,7 @@ def scene(example):
 def gpu(scene):
     """Skips (fails under CI=true) without a GPU adapter."""
     try:
-        pgt.approx(scene, "sorted-blend")
+        pgt.approx(pgt.load_scene(scene.source, size=(4, 4)))
     except pgt.NoAdapterError as e:
         if in_ci():
             pytest.fail(f"CI=true and no GPU adapter: {e}")
@@ -39,21 +39,23 @@ def test_methods_are_listed():
 
 
 @pytest.mark.parametrize(
-    "method, params, flags",
+    "model, method, params, flags",
     [
-        (None, {}, []),
-        ("thesis", {"samples": 8, "n_exact": "all"}, ["--method", "thesis", "--samples", "8", "--n-exact", "all"]),
-        ("sorted-blend", {}, ["--method", "sorted-blend"]),
+        (None, None, {}, []),
+        (None, "thesis", {"samples": 8, "n_exact": "all"}, ["--method", "thesis", "--samples", "8", "--n-exact", "all"]),
+        ("emission", "sorted-blend", {}, ["--model", "emission", "--method", "sorted-blend"]),
     ],
 )
-def test_bit_identical_to_the_cli(gpu, scene, example, tmp_path, run_cli, method, params, flags):
+def test_bit_identical_to_the_cli(gpu, example, tmp_path, run_cli, model, method, params, flags):
     out = tmp_path / "cli.exr"
     run_cli("approx", example("disjoint_lit.toml"), "--size", "40x32", "-o", out, *flags)
+    scene = pgt.load_scene(example("disjoint_lit.toml"), size=(40, 32), model=model)
     result = pgt.approx(scene, method, **params)
     assert result.image.shape == (32, 40, 3) and result.image.dtype == np.float32
     np.testing.assert_array_equal(bits(result.image), bits(pgt.read_image(out)))
     assert result.method == (method or "thesis")
     assert result.gpu_seconds > 0 and result.passes >= 1 and result.adapter
+    assert result.image.max() > 0, "the particles are lit, so the image is not black"
     if method == "thesis":
         assert dict(result.params) == {"samples": 8, "n_exact": pgt._pgt.N_EXACT_ALL}
 

@@ -40,13 +40,15 @@ def test_png_is_srgb_of_the_linear_image_with_exposure(tmp_path):
 def test_image_file_errors(tmp_path):
     with pytest.raises(pgt.InputError, match="output must end in .exr or .png"):
         pgt.write_image(tmp_path / "a.tiff", np.zeros((2, 2, 3), np.float32))
-    with pytest.raises(pgt.FileError) as e:
-        pgt.write_image(tmp_path / "no" / "such" / "dir" / "a.exr", np.zeros((2, 2, 3), np.float32))
-    assert isinstance(e.value, OSError)
+    # A folder that cannot be made (a file stands where it would go): an OSError with errno.
+    (tmp_path / "plain").write_text("a file, not a folder")
+    with pytest.raises(pgt.FileError, match="plain") as e:
+        pgt.write_image(tmp_path / "plain" / "a.exr", np.zeros((2, 2, 3), np.float32))
+    assert isinstance(e.value, OSError) and e.value.errno is not None
     broken = tmp_path / "broken.exr"
     broken.write_bytes(b"not an exr at all")
     with pytest.raises(pgt.InputError, match="broken.exr: cannot read EXR"):
         pgt.read_image(broken)
     with pytest.raises(pgt.FileError, match="missing.exr: No such file or directory"):
         pgt.read_image(tmp_path / "missing.exr")
-    assert sorted(p.name for p in tmp_path.iterdir()) == ["broken.exr"], "nothing half-written"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["broken.exr", "plain"], "nothing half-written"
