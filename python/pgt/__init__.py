@@ -83,6 +83,7 @@ def load_scene(
     mode: Optional[str] = None,
     model: Optional[str] = None,
     tol: Optional[float] = None,
+    format: Optional[str] = None,
 ) -> Scene:
     """Load a scene: a scene file (.toml) or a bare particle file (PDB, mmCIF, VRML, MMPLD,
     XYZ, CSV), which gets the default scene (camera framing the particles from -z, the
@@ -94,11 +95,13 @@ def load_scene(
       mode   "volume" or "opaque" (--mode).
       model  "emission", "lit" or "single-scatter" (--model).
       tol    absolute radiance tolerance of the quadrature, per pixel and channel (--tol).
+      format the format of a bare particle file whatever its extension, e.g. "pdb", "xyz"
+             (--format).
 
     The scene's warnings (an empty scene, skipped records) are issued as PgtWarning.
     Raises InputError naming the file, line and field; FileError for a file that cannot be read.
     """
-    return _pgt.load_scene(path, size=size, mode=mode, model=model, tol=tol)
+    return _pgt.load_scene(path, size=size, mode=mode, model=model, tol=tol, format=format)
 
 
 def directional_light(direction: Vec3, irradiance: Vec3) -> Dict[str, Any]:

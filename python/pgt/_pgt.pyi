@@ -213,6 +213,7 @@ def load_scene(
     mode: Optional[str] = None,
     model: Optional[str] = None,
     tol: Optional[float] = None,
+    format: Optional[str] = None,
 ) -> Scene: ...
 def render(
     scene: Scene,

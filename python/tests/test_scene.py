@@ -206,3 +206,17 @@ def test_from_arrays_with_no_particles_warns():
     with warnings.catch_warnings():
         warnings.simplefilter("error")
         pgt.Scene.from_arrays(np.zeros((1, 3)), np.ones(1))
+
+
+def test_load_scene_format_reads_a_file_whatever_its_extension(tmp_path):
+    """format= is --format: a CSV named .dat loads as CSV; without it the extension decides."""
+    data = tmp_path / "particles.dat"
+    data.write_text("x,y,z,radius\n0,0,0,1.0\n2,0,0,0.5\n")
+    scene = pgt.load_scene(data, format="csv", size=(8, 8))
+    np.testing.assert_array_equal(scene.particles()["radius"], [1.0, 0.5])
+    with pytest.raises(pgt.InputError, match="particles.dat"):
+        pgt.load_scene(data, size=(8, 8))
+    with pytest.raises(pgt.InputError, match="format: unknown format 'tiff'; expected one of .*pdb"):
+        pgt.load_scene(data, format="tiff")
+    with pytest.raises(pgt.InputError, match="--format csv applies to a bare particle file"):
+        pgt.load_scene(tmp_path / "scene.toml", format="csv")

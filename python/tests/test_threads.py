@@ -98,26 +98,33 @@ def test_the_interrupted_render_was_a_long_one():
     assert done < total
 
 
-def test_two_threads_render_at_once(small_scene):
-    alone = pgt.render(small_scene)
-    other = pgt.Scene.from_arrays(*random_particles(30, seed=5), size=(40, 40))
-    other_alone = pgt.render(other)
-    results = {}
+def test_two_threads_render_at_once():
+    """Two Python threads render at once: each gets the image it gets alone, and each made
+    progress while the other was rendering (the renders overlap in time)."""
+    first = pgt.Scene.from_arrays(*random_particles(120, seed=5), size=(64, 64), tol=1e-7)
+    second = pgt.Scene.from_arrays(*random_particles(120, seed=6), size=(64, 64), tol=1e-7)
+    alone = {"a": pgt.render(first), "b": pgt.render(second)}
+    results, spans, seen = {}, {}, {"a": [], "b": []}
 
     def work(name, scene):
-        results[name] = pgt.render(scene)
+        start = time.perf_counter()
+        results[name] = pgt.render(
+            scene, threads=1, progress=lambda done, total: seen[name].append((time.perf_counter(), done, total))
+        )
+        spans[name] = (start, time.perf_counter())
 
-    threads = [
-        threading.Thread(target=work, args=("a", small_scene)),
-        threading.Thread(target=work, args=("b", other)),
-    ]
+    threads = [threading.Thread(target=work, args=(n, s)) for n, s in (("a", first), ("b", second))]
     for t in threads:
         t.start()
     for t in threads:
         t.join()
-    np.testing.assert_array_equal(bits(results["a"].image), bits(alone.image))
-    np.testing.assert_array_equal(bits(results["a"].err), bits(alone.err))
-    np.testing.assert_array_equal(bits(results["b"].image), bits(other_alone.image))
+    for name in "ab":
+        np.testing.assert_array_equal(bits(results[name].image), bits(alone[name].image))
+        np.testing.assert_array_equal(bits(results[name].err), bits(alone[name].err))
+    for me, other in (("a", "b"), ("b", "a")):
+        start, end = spans[other]
+        during = [done for t, done, total in seen[me] if start < t < end and 0 < done < total]
+        assert during, f"render {me} made no progress while render {other} ran: {seen[me]}, {spans}"
 
 
 def test_the_gil_is_released_while_rendering():
