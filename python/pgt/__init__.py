@@ -12,7 +12,8 @@ as the ``pgt`` command line: the values are the CLI's, bit for bit.
     assert cmp.gate({"min_ssim": 0.95})
     cmp.write_report("report/")
 
-Scenes: load_scene, Scene.from_arrays, directional_light, point_light.
+Scenes: load_scene, Scene.from_arrays, directional_light, point_light; load_frames -> Frames
+(trajectories, sequences, camera orbits: .frame(t) is a Scene).
 Rendering: render (exact, CPU), approx (GPU methods and WGSL files), approx_methods.
 Measuring: compare -> Comparison (.gate, .summary, .write_report).
 Images: read_image, write_image (EXR with the err layer, PNG).
@@ -34,6 +35,7 @@ from ._errors import Error, FileError, GpuError, InputError, NoAdapterError, Pgt
 from ._pgt import (
     ApproxResult,
     Comparison,
+    Frames,
     GateCheck,
     GateResult,
     PerChannel,
@@ -51,6 +53,7 @@ __all__ = [
     "Comparison",
     "Error",
     "FileError",
+    "Frames",
     "GateCheck",
     "GateResult",
     "GpuError",
@@ -64,6 +67,7 @@ __all__ = [
     "approx_methods",
     "compare",
     "directional_light",
+    "load_frames",
     "load_scene",
     "point_light",
     "read_image",
@@ -102,6 +106,35 @@ def load_scene(
     Raises InputError naming the file, line and field; FileError for a file that cannot be read.
     """
     return _pgt.load_scene(path, size=size, mode=mode, model=model, tol=tol, format=format)
+
+
+def load_frames(
+    path: PathLike,
+    *,
+    size: Optional[Tuple[int, int]] = None,
+    mode: Optional[str] = None,
+    model: Optional[str] = None,
+    tol: Optional[float] = None,
+    format: Optional[str] = None,
+) -> Frames:
+    """Load a scene over frames (docs/design.md §10): a scene file whose includes play frames
+    (MMPLD frames, PDB/mmCIF models, multi-frame XYZ, a numbered ``sequence``, a DCD/XTC
+    ``trajectory`` with its topology) or whose camera moves (``[camera.orbit]``,
+    ``[[camera.keyframes]]``), or a bare particle file with frames.
+
+    Arguments: those of load_scene.
+
+    Returns a Frames: ``.frame_count`` (None when only the camera moves: any frame number
+    goes), ``.time_step_ps``, ``len(frames)``, and ``.frame(t)``, the Scene of frame t (read
+    on demand), to render, export or measure like any other:
+
+        frames = pgt.load_frames("md.toml", size=(256, 256))
+        truths = [pgt.render(frames.frame(t)) for t in range(len(frames))]
+
+    Raises InputError naming the file, line and field (or the frame); FileError for a file
+    that cannot be read.
+    """
+    return _pgt.load_frames(path, size=size, mode=mode, model=model, tol=tol, format=format)
 
 
 def directional_light(direction: Vec3, irradiance: Vec3) -> Dict[str, Any]:

@@ -206,6 +206,25 @@ class Comparison:
         rel_scale: Optional[float] = None,
     ) -> pathlib.Path: ...
 
+class Frames:
+    """A scene whose particles or camera change from frame to frame (pgt.load_frames)."""
+
+    @property
+    def frame_count(self) -> Optional[int]: ...
+    @property
+    def time_step_ps(self) -> Optional[float]: ...
+    def frame(self, index: int) -> Scene: ...
+    def __len__(self) -> int: ...
+
+def load_frames(
+    path: _Path,
+    *,
+    size: Optional[Tuple[int, int]] = None,
+    mode: Optional[str] = None,
+    model: Optional[str] = None,
+    tol: Optional[float] = None,
+    format: Optional[str] = None,
+) -> Frames: ...
 def load_scene(
     path: _Path,
     *,

@@ -1,10 +1,12 @@
-"""What the Python package costs on top of the CLI (issue 33): the same 1UUN 256² lit render
+"""What the Python package costs on top of the CLI (issue 33): the same 1UUN lit render (256² by
+default, --size to change it)
 through `pgt render` and through `pgt.load_scene` + `pgt.render` + `RenderResult.write`, and a
 4K comparison from arrays against `pgt compare` on files. Runs alternate, so both see the same
 machine; the figures are medians and their ratio: wall time of the whole call, the render as the
 library timed it, and CPU time (user + system, the least sensitive to other load).
 
-    python python/scripts/speed.py [--pgt target/release/pgt] [--runs 5] [--shared ../shared/data]
+    python python/scripts/speed.py [--pgt target/release/pgt] [--runs 5] [--size 256]
+        [--shared ../shared/data] [--skip-render] [--skip-compare]
 """
 
 from __future__ import annotations
@@ -36,14 +38,14 @@ def cpu_seconds(who: int) -> float:
     return r.ru_utime + r.ru_stime
 
 
-def render_figures(pgt_bin: Path, pdb: Path, runs: int, out: Path) -> None:
+def render_figures(pgt_bin: Path, pdb: Path, runs: int, size: int, out: Path) -> None:
     cli_wall, cli_render, py_wall, py_render = [], [], [], []
     cli_cpu, py_cpu = [], []
     for _ in range(runs):
         before = cpu_seconds(resource.RUSAGE_CHILDREN)
         seconds, done = timed(
             lambda: subprocess.run(
-                [str(pgt_bin), "render", str(pdb), "--size", "256x256", "-o", str(out / "cli.exr")],
+                [str(pgt_bin), "render", str(pdb), "--size", f"{size}x{size}", "-o", str(out / "cli.exr")],
                 capture_output=True,
                 text=True,
                 check=True,
@@ -55,7 +57,7 @@ def render_figures(pgt_bin: Path, pdb: Path, runs: int, out: Path) -> None:
         cli_render.append(float(done.stderr.split(" in ")[1].split(" s")[0]))
 
         def python_call():
-            scene = pgt.load_scene(pdb, size=(256, 256))
+            scene = pgt.load_scene(pdb, size=(size, size))
             result = pgt.render(scene)
             result.write(out / "py.exr")
             return result
@@ -66,7 +68,7 @@ def render_figures(pgt_bin: Path, pdb: Path, runs: int, out: Path) -> None:
         py_wall.append(seconds)
         py_render.append(result.seconds)
     same = (out / "cli.exr").read_bytes() == (out / "py.exr").read_bytes()
-    print(f"1UUN 256x256 lit, {runs} runs each, alternating (same EXR bytes: {same})")
+    print(f"1UUN {size}x{size} lit, {runs} runs each, alternating (same EXR bytes: {same})")
     figures = (
         ("whole call", cli_wall, py_wall),
         ("render alone", cli_render, py_render),
@@ -117,13 +119,17 @@ def main() -> None:
     parser.add_argument("--pgt", default=str(REPO / "target" / "release" / "pgt"))
     parser.add_argument("--shared", default=str(REPO.parent / "shared" / "data"))
     parser.add_argument("--runs", type=int, default=5)
+    parser.add_argument("--size", type=int, default=256)
     parser.add_argument("--skip-render", action="store_true")
+    parser.add_argument("--skip-compare", action="store_true")
     args = parser.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         out = Path(tmp)
         if not args.skip_render:
-            render_figures(Path(args.pgt), Path(args.shared) / "pdb" / "1uun_opm_oriented.pdb", args.runs, out)
-        compare_figures(Path(args.pgt), args.runs, out)
+            pdb = Path(args.shared) / "pdb" / "1uun_opm_oriented.pdb"
+            render_figures(Path(args.pgt), pdb, args.runs, args.size, out)
+        if not args.skip_compare:
+            compare_figures(Path(args.pgt), args.runs, out)
 
 
 if __name__ == "__main__":

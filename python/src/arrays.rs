@@ -4,11 +4,17 @@
 //! * **Images out** (`render`, `approx`, `read_image`, the comparison's maps): never. The
 //!   library's `Vec<[f32; 3]>` is reinterpreted as a `Vec<f32>` (bytemuck: same allocation) and
 //!   handed to numpy, which keeps the Rust allocation alive as the array's buffer.
-//! * **Images in** (`compare`, `write_image`): one copy, into the library's `RgbImage`, a
-//!   `memcpy` for a C-contiguous float32 array; float64 (and strided) arrays are converted in the
-//!   same single pass. The finiteness check reads the copy.
-//! * **Particles in** (`Scene.from_arrays`): none; the values are read from numpy's buffer
-//!   while the scene's particles are built (the scene itself is the library's own data).
+//! * **Images in** (`compare`, `write_image`, `RenderResult.write`): one copy, into the
+//!   library's `RgbImage`, a `memcpy` for a C-contiguous float32 array; float64 (and strided)
+//!   arrays are converted in the same single pass. The finiteness check reads numpy's buffer
+//!   before the copy; float64 values are checked once more after rounding to float32, where a
+//!   finite value beyond float32's range becomes infinite.
+//! * **The FLIP map out** (`Comparison.flip_map`): one copy, since the comparison keeps its own
+//!   for the gates and the report. The other maps are computed into new arrays on first use.
+//! * **Particles in** (`Scene.from_arrays`): none for float32/float64 arrays in any layout; the
+//!   values are read from numpy's buffer while the scene's particles are built (the scene
+//!   itself is the library's own data). Lists and tuples become one float64 array first
+//!   (`numpy.asarray`).
 //! * **Particles out** (`Scene.particles`): the arrays are filled from the scene's particles
 //!   once and handed to numpy without a further copy.
 
@@ -222,7 +228,11 @@ pub fn image_from_array(name: &str, obj: &Bound<'_, PyAny>) -> PyResult<RgbImage
         height: h as u32,
         pixels,
     };
-    if let Some((x, y, c)) = pgt::metrics::first_non_finite(&image) {
+    let rounded = matches!(values, Floats::F64(_));
+    if let Some((x, y, c)) = rounded
+        .then(|| pgt::metrics::first_non_finite(&image))
+        .flatten()
+    {
         return Err(input_error(
             py,
             format!(

@@ -8,12 +8,14 @@
 //! * [`arrays`]: numpy in and out, and where values are copied.
 //! * [`errors`]: the `pgt.Error` hierarchy.
 //! * [`settings`]: keyword arguments as scene-file and gate-file tables.
-//! * [`scene`], [`render`], [`approx`], [`compare`], [`images`]: one per part of the API.
+//! * [`scene`], [`frames`], [`render`], [`approx`], [`compare`], [`images`]: one per part of
+//!   the API.
 
 mod approx;
 mod arrays;
 mod compare;
 mod errors;
+mod frames;
 mod images;
 mod render;
 mod scene;
@@ -31,6 +33,8 @@ fn _pgt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("N_EXACT_ALL", pgt::approx::N_EXACT_ALL)?;
     m.add_class::<scene::Scene>()?;
     m.add_function(wrap_pyfunction!(scene::load_scene, m)?)?;
+    m.add_class::<frames::Frames>()?;
+    m.add_function(wrap_pyfunction!(frames::load_frames, m)?)?;
     m.add_class::<render::RenderResult>()?;
     m.add_function(wrap_pyfunction!(render::render, m)?)?;
     m.add_class::<approx::ApproxResult>()?;

@@ -60,7 +60,7 @@ fn parse_size(py: Python<'_>, size: Option<&Bound<'_, PyAny>>) -> PyResult<Optio
 }
 
 /// Issues the scene's warnings as `pgt.PgtWarning`s.
-fn warn_all(py: Python<'_>, scene: &pgt::Scene, stacklevel: i32) -> PyResult<()> {
+pub fn warn_all(py: Python<'_>, scene: &pgt::Scene, stacklevel: i32) -> PyResult<()> {
     for w in &scene.warnings {
         warn(py, w, stacklevel)?;
     }
@@ -81,6 +81,24 @@ fn parse_format(py: Python<'_>, name: &str) -> PyResult<&'static pgt::formats::F
     })
 }
 
+/// The overrides of `pgt render`'s `--size`, `--mode`, `--model`, `--tol` and `--format`.
+pub fn scene_load_options(
+    py: Python<'_>,
+    size: Option<&Bound<'_, PyAny>>,
+    mode: Option<&str>,
+    model: Option<&str>,
+    tol: Option<f64>,
+    format: Option<&str>,
+) -> PyResult<SceneLoadOptions> {
+    Ok(SceneLoadOptions {
+        size: parse_size(py, size)?,
+        mode: mode.map(|m| parse_mode(py, m)).transpose()?,
+        model: model.map(|m| parse_model(py, m)).transpose()?,
+        tol,
+        format: format.map(|f| parse_format(py, f)).transpose()?,
+    })
+}
+
 /// Loads a scene file (.toml) or a bare particle file with the overrides of `pgt render`'s
 /// `--size`, `--mode`, `--model`, `--tol` and `--format`.
 #[pyfunction]
@@ -94,13 +112,7 @@ pub fn load_scene(
     tol: Option<f64>,
     format: Option<&str>,
 ) -> PyResult<Scene> {
-    let options = SceneLoadOptions {
-        size: parse_size(py, size)?,
-        mode: mode.map(|m| parse_mode(py, m)).transpose()?,
-        model: model.map(|m| parse_model(py, m)).transpose()?,
-        tol,
-        format: format.map(|f| parse_format(py, f)).transpose()?,
-    };
+    let options = scene_load_options(py, size, mode, model, tol, format)?;
     let scene = py.detach(|| pgt::Scene::load(&path, &options)).py_err(py)?;
     warn_all(py, &scene, 2)?;
     Ok(Scene {
