@@ -91,24 +91,40 @@ def compare_figures(pgt_bin: Path, runs: int, out: Path) -> None:
     pgt.write_image(out / "ref.exr", ref)
     pgt.write_image(out / "approx.exr", approx)
     cli, arrays, files = [], [], []
+    cli_cpu, arrays_cpu, files_cpu = [], [], []
+
+    def cpu_and_wall(f, who):
+        before = cpu_seconds(who)
+        wall = timed(f)[0]
+        return wall, cpu_seconds(who) - before
+
     for _ in range(runs):
-        cli.append(
-            timed(
-                lambda: subprocess.run(
-                    [str(pgt_bin), "compare", str(out / "ref.exr"), str(out / "approx.exr")],
-                    capture_output=True,
-                    check=True,
-                )
-            )[0]
+        wall, cpu = cpu_and_wall(
+            lambda: subprocess.run(
+                [str(pgt_bin), "compare", str(out / "ref.exr"), str(out / "approx.exr")],
+                capture_output=True,
+                check=True,
+            ),
+            resource.RUSAGE_CHILDREN,
         )
-        arrays.append(timed(lambda: pgt.compare(ref, approx))[0])
-        files.append(timed(lambda: pgt.compare(out / "ref.exr", out / "approx.exr"))[0])
-    c = statistics.median(cli)
+        cli.append(wall)
+        cli_cpu.append(cpu)
+        wall, cpu = cpu_and_wall(lambda: pgt.compare(ref, approx), resource.RUSAGE_SELF)
+        arrays.append(wall)
+        arrays_cpu.append(cpu)
+        wall, cpu = cpu_and_wall(lambda: pgt.compare(out / "ref.exr", out / "approx.exr"), resource.RUSAGE_SELF)
+        files.append(wall)
+        files_cpu.append(cpu)
     print(f"4K compare ({w}x{h}), {runs} runs each, alternating")
-    print(f"  CLI on files           median {c:.3f} s  runs {' '.join(f'{v:.3f}' for v in cli)}")
-    for name, values in (("Python from arrays", arrays), ("Python on files", files)):
-        m = statistics.median(values)
-        print(f"  {name:22s} median {m:.3f} s  ratio to CLI {m / c:.4f}  runs {' '.join(f'{v:.3f}' for v in values)}")
+    for what, c_values, rows in (
+        ("wall", cli, (("Python from arrays", arrays), ("Python on files", files))),
+        ("CPU", cli_cpu, (("Python from arrays", arrays_cpu), ("Python on files", files_cpu))),
+    ):
+        c = statistics.median(c_values)
+        print(f"  {what:4s} CLI on files           median {c:.3f} s  runs {' '.join(f'{v:.3f}' for v in c_values)}")
+        for name, values in rows:
+            m = statistics.median(values)
+            print(f"  {what:4s} {name:22s} median {m:.3f} s  ratio to CLI {m / c:.4f}  runs {' '.join(f'{v:.3f}' for v in values)}")
     # The one copy of an array in: what a 4K float32 image costs to copy on this machine.
     copy = statistics.median(timed(lambda: ref.copy())[0] for _ in range(runs))
     print(f"  one copy of one 4K float32 image (numpy): {copy * 1e3:.1f} ms")
