@@ -153,27 +153,14 @@ fn load_toml_and_particles(
     let defaults = file.defaults.as_ref().map_or(&empty, |d| d.get_ref());
     let resolved_defaults = ResolvedDefaults::new(&defaults_at, defaults, render.lambda)?;
 
-    let mut particles = Vec::with_capacity(file.particles.len());
-    for (i, p) in file.particles.iter().enumerate() {
-        particles.push(inline_particle(
-            &at(p.span()),
-            i,
-            p.get_ref(),
-            &resolved_defaults,
-            render.lambda,
-        )?);
-    }
-    let first = particles.len();
-    for (k, p) in given.enumerate() {
-        let table = given_table(p);
-        particles.push(inline_particle(
-            &whole,
-            first + k,
-            &table,
-            &resolved_defaults,
-            render.lambda,
-        )?);
-    }
+    let mut particles = inline_particles(
+        &file.particles,
+        &at,
+        &whole,
+        given,
+        &resolved_defaults,
+        render.lambda,
+    )?;
     let mut warnings = Vec::new();
     let base = path.parent().unwrap_or(Path::new("."));
     let mut includes = Vec::with_capacity(file.include.len());
@@ -297,6 +284,39 @@ fn unreadable_include(
         "include: cannot read {}: {source}{relative}",
         path.display()
     ))
+}
+
+/// The scene file's `[[particles]]` tables, then the `given` particles checked as tables of
+/// the same kind (numbered after them, named with the whole file: no line wrote them).
+fn inline_particles<'a>(
+    tables: &[Spanned<ParticleTable>],
+    at: &dyn Fn(std::ops::Range<usize>) -> At<'a>,
+    whole: &At<'a>,
+    given: impl Iterator<Item = ParticleInput>,
+    defaults: &ResolvedDefaults,
+    lambda: f64,
+) -> Result<Vec<Particle>> {
+    let mut particles = Vec::with_capacity(tables.len());
+    for (i, p) in tables.iter().enumerate() {
+        particles.push(inline_particle(
+            &at(p.span()),
+            i,
+            p.get_ref(),
+            defaults,
+            lambda,
+        )?);
+    }
+    for (k, p) in given.enumerate() {
+        let i = tables.len() + k;
+        particles.push(inline_particle(
+            whole,
+            i,
+            &given_table(p),
+            defaults,
+            lambda,
+        )?);
+    }
+    Ok(particles)
 }
 
 /// A particle given by a program as the inline table it stands for.
