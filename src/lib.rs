@@ -17,6 +17,7 @@ pub mod parts;
 pub mod reference;
 pub mod report;
 pub mod scene;
+pub mod sequence;
 pub mod signals;
 pub mod sweep;
 

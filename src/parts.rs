@@ -84,6 +84,15 @@ impl std::fmt::Write for Fnv128 {
 /// warnings, so the same scene at another path on another node matches) and the options that
 /// change pixels, with pgt's version (another version may compute other bits).
 pub fn render_hash(scene: &Scene, options: &RenderOptions) -> String {
+    hash_with(
+        scene,
+        &format!("spp {} | {:?}", options.spp, options.integrator),
+    )
+}
+
+/// The hash of `scene` (as [`render_hash`] sees it) with `what` computes it (the options, or a
+/// GPU method and its parameters): "pgt VERSION | what | scene".
+pub fn hash_with(scene: &Scene, what: &str) -> String {
     let mut h = Fnv128(0x6c62_272e_07bb_0142_62b8_2175_6295_c58d);
     let canonical = Scene {
         source: PathBuf::new(),
@@ -93,10 +102,8 @@ pub fn render_hash(scene: &Scene, options: &RenderOptions) -> String {
     // Writing into the hasher cannot fail.
     let _ = write!(
         h,
-        "pgt {} | spp {} | {:?} | {:?}",
+        "pgt {} | {what} | {:?}",
         env!("CARGO_PKG_VERSION"),
-        options.spp,
-        options.integrator,
         canonical
     );
     format!("{:032x}", h.0)

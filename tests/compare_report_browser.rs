@@ -560,3 +560,67 @@ fn sweep_viewer_switches_runs_and_probes_the_reference() {
     // No error estimate in a sweep's cached reference: the row says so.
     assert_eq!(s.text("td[data-probe=\"estimate-0\"]"), "—");
 }
+
+/// docs/design.md §10: the committed report of a sequence comparison
+/// (`reports/examples/popping/report`) opens from `file://` with every image, shows its player,
+/// and steps, plays and jumps to a worst frame: the panes show that frame's files.
+#[test]
+fn sequence_report_plays_its_frames() {
+    let Some((browser, driver)) = webdriver::browser_and_driver() else {
+        return;
+    };
+    let page =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("reports/examples/popping/report/index.html");
+    let s = webdriver::Session::start(&browser, &driver, 1200, 900);
+    s.open(
+        &page,
+        "document.body.getAttribute('data-pgt-images') !== 'pending'",
+    );
+    assert_eq!(
+        s.eval("return document.body.getAttribute('data-pgt-images');"),
+        serde_json::json!("ok"),
+        "broken: {}",
+        s.eval("return document.body.getAttribute('data-pgt-broken');")
+    );
+    assert_eq!(
+        s.eval("return document.getElementById('pgt-player').hidden;"),
+        serde_json::json!(false)
+    );
+    assert_eq!(s.text("#pgt-frame"), "frame 0");
+    s.click("[data-step='1']");
+    assert_eq!(s.text("#pgt-frame"), "frame 1");
+    let src = |id: &str| {
+        s.eval(&format!(
+            "return document.getElementById('{id}').getAttribute('src');"
+        ))
+        .as_str()
+        .unwrap_or_default()
+        .to_string()
+    };
+    assert_eq!(src("pgt-r"), "frames/r_000001.png");
+    assert_eq!(src("pgt-a"), "frames/a_000001.png");
+    assert_eq!(src("pgt-t"), "frames/t_000001.png");
+    s.click("[data-step='-1']");
+    assert_eq!(s.text("#pgt-frame"), "frame 0");
+    // Play advances the frames; pause stops them.
+    s.click("#pgt-play");
+    std::thread::sleep(std::time::Duration::from_millis(700));
+    s.click("#pgt-play");
+    let shown = s.text("#pgt-frame");
+    let n: usize = shown.trim_start_matches("frame ").parse().unwrap();
+    assert!(n >= 1, "play did not advance: {shown}");
+    std::thread::sleep(std::time::Duration::from_millis(500));
+    assert_eq!(s.text("#pgt-frame"), shown, "pause did not stop the player");
+    // A worst-frame link of the summary table jumps the player to that frame.
+    let target = s
+        .eval("return document.querySelector('table a[data-frame]').getAttribute('data-frame');")
+        .as_str()
+        .unwrap()
+        .to_string();
+    s.click("table a[data-frame]");
+    assert_eq!(s.text("#pgt-frame"), format!("frame {target}"));
+    assert_eq!(
+        src("pgt-r"),
+        format!("frames/r_{:06}.png", target.parse::<usize>().unwrap())
+    );
+}

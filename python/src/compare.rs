@@ -126,25 +126,34 @@ impl GateResult {
 }
 
 /// The gate of a `gate=` argument: a dict with the keys of a gate file, the path of a gate
-/// file (TOML), or None for no thresholds.
+/// file (TOML), or None for no thresholds. A comparison is of two images, so a threshold on
+/// the temporal error of a sequence is refused, as `pgt compare` refuses it on two images.
 fn gate_from(py: Python<'_>, gate: Option<&Bound<'_, PyAny>>) -> PyResult<Gate> {
     const NAME: &str = "gate";
     let Some(gate) = gate.filter(|g| !g.is_none()) else {
         return Ok(Gate::default());
     };
-    if let Ok(d) = gate.cast::<PyDict>() {
+    let gate = if let Ok(d) = gate.cast::<PyDict>() {
         let text = settings::text(py, &settings::table(d, NAME)?, NAME)?;
-        return Gate::parse(&text, Path::new(NAME))
+        Gate::parse(&text, Path::new(NAME))
             .map_err(|e| settings::without_location(e, NAME))
-            .py_err(py);
-    }
-    let path: PathBuf = gate.extract().map_err(|_| {
-        input_error(
+            .py_err(py)?
+    } else {
+        let path: PathBuf = gate.extract().map_err(|_| {
+            input_error(
+                py,
+                "gate: expected a dict of thresholds or the path of a gate file",
+            )
+        })?;
+        Gate::load(&path).py_err(py)?
+    };
+    if let Some((name, _)) = gate.temporal_keys().first() {
+        return Err(input_error(
             py,
-            "gate: expected a dict of thresholds or the path of a gate file",
-        )
-    })?;
-    Gate::load(&path).py_err(py)
+            format!("gate: {name} gates the temporal error of a sequence of frames; a comparison is of two images"),
+        ));
+    }
+    Ok(gate)
 }
 
 /// One side of a comparison: an image file or an array.

@@ -107,6 +107,8 @@ def test_gate_errors(pair, tmp_path):
         cmp.gate(tmp_path / "missing.toml")
     with pytest.raises(pgt.InputError, match="gate: expected a dict of thresholds or the path"):
         cmp.gate(3)
+    with pytest.raises(pgt.InputError, match="gate: max_temporal_p99 gates the temporal error of a sequence"):
+        cmp.gate({"max_temporal_p99": 0.1})
 
 
 def test_report_is_the_clis(pair, tmp_path, run_cli):

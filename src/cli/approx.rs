@@ -18,9 +18,19 @@ pub struct ApproxArgs {
     /// Scene file (.toml) or a bare particle file.
     #[arg(required_unless_present = "list_methods")]
     pub scene: Option<PathBuf>,
-    /// Output image; the format follows the extension (.exr or .png).
+    /// Output image; the format follows the extension (.exr or .png). With --frames, a printf
+    /// pattern that names each frame's file: out/frame_%04d.exr.
     #[arg(short, long, required_unless_present = "list_methods")]
     pub output: Option<PathBuf>,
+    /// Approximate these frames of the scene, one file each: A..B (A to B−1) or A.. (to the last
+    /// frame), as an include's `frames`. A frame whose EXR already holds this render (same scene, method,
+    /// parameters and adapter) is skipped.
+    #[arg(long, value_name = "RANGE")]
+    pub frames: Option<crate::sequence::FrameRange>,
+    /// With --frames: approximate only part I of N of the frames (every N-th from the I-th; I
+    /// from 0, as job arrays count).
+    #[arg(long, value_parser = crate::parts::parse_part, value_name = "I/N", requires = "frames")]
+    pub part: Option<crate::parts::PartOf>,
     /// Approximation method (see --list-methods) [default: opaque for opaque scenes, thesis
     /// otherwise].
     #[arg(long, value_parser = PossibleValuesParser::new(methods::names()), conflicts_with = "shader")]
@@ -225,7 +235,6 @@ pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
     let (Some(scene_path), Some(output)) = (&args.scene, &args.output) else {
         anyhow::bail!("pgt approx needs a SCENE and -o OUTPUT (or --list-methods)");
     };
-    check_outputs(&[Output::new("--output", output, OutputKind::Image)])?;
     let options = SceneLoadOptions {
         size: args.size,
         mode: args.mode,
@@ -233,6 +242,10 @@ pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
         tol: None,
         format: args.format,
     };
+    if let Some(range) = args.frames {
+        return approx_frames(&args, scene_path, output, &options, range);
+    }
+    check_outputs(&[Output::new("--output", output, OutputKind::Image)])?;
     let scene = super::load_scene_for(scene_path, &options, args.exposure)?;
     let params = args.params()?;
     let spinner = super::stderr_is_terminal().then(|| approx_spinner(&params));
@@ -281,6 +294,70 @@ pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
         },
         rate(pixels / out.gpu_seconds.max(1e-9), "pixels/s")
     );
+    Ok(Outcome::Success)
+}
+
+/// `--frames`: every frame of the range (or of this task's part) with one device and one
+/// compiled pipeline, with a progress bar over the frames and a summary line.
+fn approx_frames(
+    args: &ApproxArgs,
+    scene_path: &std::path::Path,
+    output: &std::path::Path,
+    options: &SceneLoadOptions,
+    range: crate::sequence::FrameRange,
+) -> anyhow::Result<Outcome> {
+    let (frames, list, pattern) =
+        super::frames::open_sequence(scene_path, options, args.exposure, range, args.part, output)?;
+    let params = args.params()?;
+    let progress = super::frames::FrameProgress::new("approx", list.len());
+    let out = crate::sequence::render::approx_frames(
+        &frames,
+        &list,
+        &pattern,
+        &params,
+        args.exposure,
+        &mut |d| progress.done(d),
+    );
+    progress.finish();
+    let out = out?;
+    let (rendered, skipped) = out.summary.counts();
+    let seconds: f64 = out
+        .summary
+        .frames
+        .iter()
+        .map(|f| match f {
+            crate::sequence::render::FrameDone::Rendered { seconds, .. } => *seconds,
+            _ => 0.0,
+        })
+        .sum();
+    eprintln!(
+        "approximated {rendered} frame(s) of {} into {} with {}{} on {}{}: {} s GPU",
+        scene_path.display(),
+        output.display(),
+        out.method.name(),
+        describe_params(&out.method, &out.params),
+        out.adapter_name,
+        if skipped > 0 {
+            format!(", skipped {skipped} already rendered")
+        } else {
+            String::new()
+        },
+        three_digits(seconds),
+    );
+    if out.hit_overflow_pixels > 0 {
+        eprintln!(
+            "warning: {} pixels over the frames crossed more than {} particles; their farthest particles were dropped",
+            out.hit_overflow_pixels,
+            approx::MAX_HITS
+        );
+    }
+    if out.loop_limited_pixels > 0 {
+        eprintln!(
+            "warning: {} pixels over the frames reached lavapipe's limit of {} loop iterations per pixel; these pixels are wrong (use fewer samples or a real GPU)",
+            out.loop_limited_pixels,
+            approx::contract::LOOP_LIMIT
+        );
+    }
     Ok(Outcome::Success)
 }
 

@@ -17,9 +17,10 @@ use std::time::Instant;
 
 #[derive(Debug, Args)]
 pub struct CompareArgs {
-    /// The reference image (.exr or .png), or a scene (.toml) rendered on the fly.
+    /// The reference image (.exr or .png), or a scene (.toml) rendered on the fly; or a
+    /// sequence of frames: a folder, or a printf pattern such as ref/frame_%04d.exr.
     pub reference: PathBuf,
-    /// The approximation (.exr or .png).
+    /// The approximation (.exr or .png), or a sequence of frames as the reference.
     pub approximation: PathBuf,
     /// EXR layer to compare (channels LAYER.R/G/B) in both files, e.g. `err`.
     #[arg(long)]
@@ -57,6 +58,14 @@ pub struct CompareArgs {
     /// HDR-FLIP exposure range START,STOP in stops (default: chosen from the reference).
     #[arg(long, value_parser = parse_exposures, allow_hyphen_values = true)]
     pub flip_exposures: Option<(f32, f32)>,
+    /// Sequences: the temporal error above which a pixel pops (radiance units, as the images;
+    /// default 0.05 × the data range).
+    #[arg(long)]
+    pub pop_threshold: Option<f64>,
+    /// Sequences: fail unless every frame's 99th percentile of the temporal error (mean over
+    /// R, G, B) is at most this.
+    #[arg(long)]
+    pub max_temporal_p99: Option<f64>,
     /// FLIP's viewing condition in pixels per degree.
     #[arg(long, default_value_t = crate::metrics::flip::DEFAULT_PIXELS_PER_DEGREE)]
     pub ppd: f32,
@@ -90,8 +99,11 @@ pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
     gate.min_ssim = args.min_ssim.or(gate.min_ssim);
     gate.max_rmse = args.max_rmse.or(gate.max_rmse);
     gate.max_flip = args.max_flip.or(gate.max_flip);
+    gate.max_temporal_p99 = args.max_temporal_p99.or(gate.max_temporal_p99);
     gate.validate().map_err(anyhow::Error::msg)?;
-
+    if let Some(outcome) = compare_sequences(&args, &gate)? {
+        return Ok(outcome);
+    }
     // The reference's error estimate is a second read of its EXR: done beside the pair's.
     let (pair, estimate) = rayon::join(
         || load_pair(&args.reference, &args.approximation, args.layer.as_deref()),
@@ -146,6 +158,63 @@ pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
         Some(false) => Outcome::GateFailed,
         _ => Outcome::Success,
     })
+}
+
+/// Two sequences of frames: their comparison ([`super::compare_frames`]), `None` for two
+/// images; a sequence against an image, or a sequence's option on two images, is an error.
+fn compare_sequences(args: &CompareArgs, gate: &Gate) -> anyhow::Result<Option<Outcome>> {
+    if args
+        .pop_threshold
+        .is_some_and(|t| !(t.is_finite() && t >= 0.0))
+    {
+        anyhow::bail!("--pop-threshold must be a finite number ≥ 0");
+    }
+    let sequences =
+        [&args.reference, &args.approximation].map(|p| crate::sequence::compare::is_sequence(p));
+    match sequences {
+        [true, true] => {
+            if args.layer.is_some() {
+                anyhow::bail!(
+                    "--layer compares one layer of two images; it does not apply to sequences"
+                );
+            }
+            let seq = super::compare_frames::SequenceArgs {
+                reference: &args.reference,
+                approximation: &args.approximation,
+                options: CompareOptions {
+                    data_range: args.data_range,
+                    flip: !args.no_flip,
+                    pixels_per_degree: args.ppd,
+                    flip_exposures: args.flip_exposures,
+                },
+                pop_threshold: args.pop_threshold,
+                json: args.json.as_deref(),
+                report: args.report.as_deref(),
+            };
+            return super::compare_frames::run(&seq, gate).map(Some);
+        }
+        [true, false] | [false, true] => {
+            let (seq, one) = if sequences[0] {
+                (&args.reference, &args.approximation)
+            } else {
+                (&args.approximation, &args.reference)
+            };
+            anyhow::bail!(
+                "{} is a sequence of frames (a folder or a %d pattern) but {} is one image: compare two sequences or two images",
+                seq.display(),
+                one.display()
+            );
+        }
+        _ => {}
+    }
+    if let Some((name, _)) = gate.temporal_keys().first() {
+        anyhow::bail!("{name} gates the temporal error of a sequence; {} and {} are single images (compare two folders or %d patterns of frames)", args.reference.display(), args.approximation.display());
+    }
+    if args.pop_threshold.is_some() {
+        anyhow::bail!("--pop-threshold applies to sequences of frames, not to single images");
+    }
+
+    Ok(None)
 }
 
 /// Parses `START,STOP` (stops, finite, START <= STOP).

@@ -21,9 +21,16 @@ pub enum IntegratorName {
 pub struct RenderArgs {
     /// Scene file (.toml) or a bare particle file.
     pub scene: PathBuf,
-    /// Output image; the format follows the extension (.exr or .png).
+    /// Output image; the format follows the extension (.exr or .png). With --frames, a printf
+    /// pattern that names each frame's file: out/frame_%04d.exr.
     #[arg(short, long)]
     pub output: PathBuf,
+    /// Render these frames of the scene, one file each: A..B (A to B−1) or A.. (to the last
+    /// frame), as an include's `frames`. A frame whose EXR already holds this render (same render hash) is
+    /// skipped, so an interrupted sequence resumes; with --part I/N, this task renders every
+    /// N-th frame of the range from the I-th.
+    #[arg(long, value_name = "RANGE")]
+    pub frames: Option<crate::sequence::FrameRange>,
     /// Image size WIDTHxHEIGHT, overriding the scene.
     #[arg(long, value_parser = super::parse_size)]
     pub size: Option<(u32, u32)>,
@@ -57,6 +64,7 @@ pub struct RenderArgs {
     pub samples: u32,
     /// Render only part I of N (I from 0, as job arrays count; the part holds the rows y with
     /// y mod N = I) into an EXR part file, to be joined by `pgt merge` (see `pgt::parts`).
+    /// With --frames, part I of N is every N-th frame from the I-th, written whole.
     #[arg(long, value_parser = crate::parts::parse_part, value_name = "I/N")]
     pub part: Option<PartOf>,
     /// The former name of `--part`: still accepted, with a warning.
@@ -65,6 +73,36 @@ pub struct RenderArgs {
 }
 
 impl RenderArgs {
+    fn load_options(&self) -> SceneLoadOptions {
+        SceneLoadOptions {
+            size: self.size,
+            mode: self.mode,
+            model: self.model,
+            tol: self.tol,
+            format: self.format,
+        }
+    }
+
+    fn render_options(&self) -> anyhow::Result<RenderOptions> {
+        let integrator = match self.integrator {
+            IntegratorName::Adaptive => Integrator::Adaptive,
+            IntegratorName::Riemann => {
+                if self.samples == 0 {
+                    anyhow::bail!("--samples must be at least 1");
+                }
+                Integrator::Riemann {
+                    samples: self.samples,
+                }
+            }
+        };
+        Ok(RenderOptions {
+            spp: self.spp,
+            threads: self.threads,
+            progress: super::stderr_is_terminal(),
+            integrator,
+        })
+    }
+
     /// `--part`, or the deprecated `--tile` with a one-line warning.
     fn part(&self) -> Option<PartOf> {
         if self.tile.is_some() {
@@ -76,36 +114,16 @@ impl RenderArgs {
 
 pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
     let part = args.part();
+    if let Some(range) = args.frames {
+        return render_frames(&args, range, part);
+    }
     let kind = match part {
         Some(_) => OutputKind::Part,
         None => OutputKind::Image,
     };
     check_outputs(&[Output::new("--output", &args.output, kind)])?;
-    let options = SceneLoadOptions {
-        size: args.size,
-        mode: args.mode,
-        model: args.model,
-        tol: args.tol,
-        format: args.format,
-    };
-    let scene = super::load_scene_for(&args.scene, &options, args.exposure)?;
-    let integrator = match args.integrator {
-        IntegratorName::Adaptive => Integrator::Adaptive,
-        IntegratorName::Riemann => {
-            if args.samples == 0 {
-                anyhow::bail!("--samples must be at least 1");
-            }
-            Integrator::Riemann {
-                samples: args.samples,
-            }
-        }
-    };
-    let render_options = RenderOptions {
-        spp: args.spp,
-        threads: args.threads,
-        progress: super::stderr_is_terminal(),
-        integrator,
-    };
+    let scene = super::load_scene_for(&args.scene, &args.load_options(), args.exposure)?;
+    let render_options = args.render_options()?;
     if let Some(part) = part {
         return render_part(&args, &scene, &render_options, part);
     }
@@ -167,5 +185,59 @@ fn render_part(
         s.primary_rays,
         s.shadow_rays
     );
+    Ok(Outcome::Success)
+}
+
+/// `--frames`: every frame of the range (or of this task's part of it) into the output pattern,
+/// with a progress bar over the frames and a summary line.
+fn render_frames(
+    args: &RenderArgs,
+    range: crate::sequence::FrameRange,
+    part: Option<PartOf>,
+) -> anyhow::Result<Outcome> {
+    let render_options = args.render_options()?;
+    let (frames, list, pattern) = super::frames::open_sequence(
+        &args.scene,
+        &args.load_options(),
+        args.exposure,
+        range,
+        part,
+        &args.output,
+    )?;
+    let progress = super::frames::FrameProgress::new("render", list.len());
+    let summary = crate::sequence::render::render_frames(
+        &frames,
+        &list,
+        &pattern,
+        &render_options,
+        args.exposure,
+        &|d| progress.done(d),
+    );
+    progress.finish();
+    let summary = summary?;
+    let (rendered, skipped) = summary.counts();
+    let t = summary.totals();
+    eprintln!(
+        "rendered {rendered} frame(s) of {} into {} ({}x{}){}: {:.2} s of rendering, {} primary + {} shadow rays",
+        args.scene.display(),
+        args.output.display(),
+        frames.first().camera.width,
+        frames.first().camera.height,
+        if skipped > 0 {
+            format!(", skipped {skipped} already rendered")
+        } else {
+            String::new()
+        },
+        t.seconds,
+        t.primary_rays,
+        t.shadow_rays,
+    );
+    if let Some((frame, n)) = summary.worst_unconverged() {
+        eprintln!(
+            "warning: {} pixel(s) over the frames did not reach tol {:e}; frame {frame} has the most ({n}; its err layer says how far off they may be)",
+            t.unconverged,
+            frames.first().render.tol
+        );
+    }
     Ok(Outcome::Success)
 }

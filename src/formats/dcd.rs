@@ -31,8 +31,8 @@
 //! **Time.** The time step is DELTA · NSAVC · 0.04888821 ps (the AKMA time unit, as MDAnalysis
 //! and VMD convert it); frame k is at k times that, from the first frame.
 
-use super::frames::ByteSource;
-use super::topology::{Trajectory, TrajectoryFormat};
+use super::frame_source::ByteSource;
+use super::frame_source::{Trajectory, TrajectoryFormat};
 use crate::error::{PgtError, Result};
 use glam::DVec3;
 use std::path::Path;
@@ -175,7 +175,7 @@ fn encoding(source: &ByteSource) -> Result<Encoding> {
     ))
 }
 
-/// The [`super::topology::OpenTrajectory`] of DCD: the header records, the free-atom list and the
+/// The [`super::frame_source::OpenTrajectory`] of DCD: the header records, the free-atom list and the
 /// frame count from the file's length.
 pub fn open(source: ByteSource) -> Result<Box<dyn Trajectory>> {
     let enc = encoding(&source)?;
@@ -430,7 +430,11 @@ impl Trajectory for Dcd {
     }
     fn read_positions(&self, index: usize, out: &mut Vec<DVec3>) -> Result<Option<f64>> {
         if index >= self.frames {
-            return Err(super::frames::past_the_end(self.path(), index, self.frames));
+            return Err(super::frame_source::past_the_end(
+                self.path(),
+                index,
+                self.frames,
+            ));
         }
         out.clear();
         match (&self.free, index) {

@@ -21,50 +21,13 @@
 //! * `frame = k` (or `model = m` for PDB/mmCIF): the include shows that one frame in every scene
 //!   frame (the static selection it always was).
 
+pub use super::frame_source::{
+    finish_frame, past_the_end, scan_lines, ByteSource, Frame, FrameInfo, FrameSource, ReadSeek,
+    TextFrames,
+};
 use super::{format_of, Format, IncludeSpec, LoadedParticles};
 use crate::error::{PgtError, Result};
-use std::io::{Read, Seek, SeekFrom};
 use std::path::{Path, PathBuf};
-use std::sync::Mutex;
-
-/// What `pgt info` and the scene need to know of a source's frames.
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
-pub struct FrameInfo {
-    /// Number of frames.
-    pub count: usize,
-    /// Particles (atoms) per frame where every frame has the same number; `None` where frames
-    /// differ or the count is only known by reading every frame.
-    pub atoms_per_frame: Option<usize>,
-    /// Time between frames in picoseconds, where the file says (XTC, DCD).
-    pub time_step_ps: Option<f64>,
-}
-
-/// One frame of a source.
-#[derive(Debug, Clone)]
-pub struct Frame {
-    /// Its index in the source (0-based).
-    pub index: usize,
-    /// Its time in picoseconds, where the file gives one.
-    pub time_ps: Option<f64>,
-    /// The particles, with the include's `radius_scale`, `color_by = "uniform"` and the record
-    /// checks applied ([`finish_frame`]).
-    pub particles: LoadedParticles,
-}
-
-/// A particle source with frames, read one frame at a time (see the module doc).
-pub trait FrameSource: Send + Sync {
-    /// The file that messages name (the trajectory, the sequence pattern, the particle file).
-    fn path(&self) -> &Path;
-    /// Frame count, atoms per frame and time step.
-    fn info(&self) -> FrameInfo;
-    /// Remarks found when the source was opened (a header that disagrees with the file length).
-    fn warnings(&self) -> Vec<String> {
-        Vec::new()
-    }
-    /// Frame `index` (0-based); an index past the end, a truncated or corrupt frame is an error
-    /// that names the file and the frame.
-    fn read_frame(&self, index: usize) -> Result<Frame>;
-}
 
 /// Opens the frames of an include: a trajectory with its topology, a numbered sequence, or the
 /// frames of the particle file itself (its [`Format::frames`]); a format without frames gives a
@@ -223,193 +186,6 @@ impl<'de> serde::Deserialize<'de> for FrameRange {
     }
 }
 
-/// Applies what every frame shares with a whole-file load ([`super::load_bytes`]):
-/// `radius_scale`, `color_by = "uniform"`, the refusal of an empty frame (naming it) and the
-/// record checks.
-pub fn finish_frame(
-    spec: &IncludeSpec,
-    path: &Path,
-    index: usize,
-    mut loaded: LoadedParticles,
-) -> Result<LoadedParticles> {
-    if loaded.records.is_empty() {
-        return Err(PgtError::in_file(
-            path,
-            format!("frame {index} holds no particles"),
-        ));
-    }
-    super::apply_include_options(spec, &mut loaded.records);
-    super::check_records(path, &loaded.records)?;
-    Ok(loaded)
-}
-
-/// A seekable byte stream (a file, or bytes in memory for tests and fuzzing).
-pub trait ReadSeek: Read + Seek + Send {}
-impl<T: Read + Seek + Send> ReadSeek for T {}
-
-/// A file read in pieces: every read names its offset and is checked against the length before
-/// anything is allocated. The handle sits behind a mutex so that sources are `Sync`.
-pub struct ByteSource {
-    path: PathBuf,
-    len: u64,
-    inner: Mutex<Box<dyn ReadSeek>>,
-}
-
-impl std::fmt::Debug for ByteSource {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("ByteSource")
-            .field("path", &self.path)
-            .field("len", &self.len)
-            .finish()
-    }
-}
-
-impl ByteSource {
-    /// Opens a file (a directory is refused).
-    pub fn open(path: &Path) -> Result<ByteSource> {
-        let file = std::fs::File::open(path).map_err(|e| PgtError::io(path, e))?;
-        let meta = file.metadata().map_err(|e| PgtError::io(path, e))?;
-        if meta.is_dir() {
-            return Err(PgtError::in_file(
-                path,
-                "is a directory, not a particle file",
-            ));
-        }
-        Ok(ByteSource {
-            path: path.to_path_buf(),
-            len: meta.len(),
-            inner: Mutex::new(Box::new(file)),
-        })
-    }
-
-    /// Any seekable stream of `len` bytes, named `path` in messages.
-    pub fn from_reader(path: &Path, len: u64, reader: Box<dyn ReadSeek>) -> ByteSource {
-        ByteSource {
-            path: path.to_path_buf(),
-            len,
-            inner: Mutex::new(reader),
-        }
-    }
-
-    /// Bytes in memory, named `path` in messages.
-    pub fn from_bytes(path: &Path, bytes: Vec<u8>) -> ByteSource {
-        ByteSource {
-            path: path.to_path_buf(),
-            len: bytes.len() as u64,
-            inner: Mutex::new(Box::new(std::io::Cursor::new(bytes))),
-        }
-    }
-
-    /// The file's name for messages.
-    pub fn path(&self) -> &Path {
-        &self.path
-    }
-
-    /// Length in bytes.
-    pub fn len(&self) -> u64 {
-        self.len
-    }
-
-    /// Whether the file is empty.
-    pub fn is_empty(&self) -> bool {
-        self.len == 0
-    }
-
-    /// `len` bytes from `offset`; past the end of the file it is an error naming `what` (and the
-    /// caller's context, such as the frame) at that offset.
-    pub fn read_at(&self, offset: u64, len: u64, what: &str) -> Result<Vec<u8>> {
-        let end = offset.checked_add(len).filter(|&e| e <= self.len);
-        let Some(_) = end else {
-            return Err(PgtError::at_byte(
-                &self.path,
-                offset,
-                format!(
-                    "expected {what} ({len} bytes), but the file ends at byte {}",
-                    self.len
-                ),
-            ));
-        };
-        let mut buf = vec![0u8; len as usize];
-        let mut inner = self.inner.lock().unwrap_or_else(|e| e.into_inner());
-        inner
-            .seek(SeekFrom::Start(offset))
-            .and_then(|_| inner.read_exact(&mut buf))
-            .map_err(|e| PgtError::io(&self.path, e))?;
-        Ok(buf)
-    }
-
-    /// The whole file (for formats parsed whole at open).
-    pub fn read_all(&self, what: &str) -> Result<Vec<u8>> {
-        if self.len > super::MAX_FILE_BYTES {
-            return Err(PgtError::in_file(
-                &self.path,
-                format!(
-                    "the file is {} bytes; pgt reads particle files of at most {} bytes",
-                    self.len,
-                    super::MAX_FILE_BYTES
-                ),
-            ));
-        }
-        self.read_at(0, self.len, what)
-    }
-}
-
-/// Byte ranges of text frames found by one scan (PDB models, XYZ frames): frame k is the bytes
-/// `starts[k]..starts[k+1]` (the last ends at the end of the file), beginning on line
-/// `lines[k]`.
-#[derive(Debug, Clone, Default)]
-pub struct TextFrames {
-    pub starts: Vec<u64>,
-    pub lines: Vec<usize>,
-}
-
-impl TextFrames {
-    /// The byte range and first line of frame `index`.
-    pub fn range(&self, index: usize, file_len: u64) -> Option<(u64, u64, usize)> {
-        let start = *self.starts.get(index)?;
-        let end = self.starts.get(index + 1).copied().unwrap_or(file_len);
-        Some((start, end, *self.lines.get(index)?))
-    }
-}
-
-/// Calls `f(line_number, byte_offset, line)` for every line of a file (1-based numbers, the line
-/// without its `\n`), reading it in blocks so that a large file is never in memory at once.
-/// `f` returns `false` to stop.
-pub fn scan_lines(
-    source: &ByteSource,
-    mut f: impl FnMut(usize, u64, &[u8]) -> Result<bool>,
-) -> Result<()> {
-    const BLOCK: u64 = 1 << 20;
-    let mut carry: Vec<u8> = Vec::new();
-    let mut carry_at = 0u64;
-    let mut line_no = 1usize;
-    let mut offset = 0u64;
-    while offset < source.len() {
-        let n = BLOCK.min(source.len() - offset);
-        let block = source.read_at(offset, n, "text")?;
-        offset += n;
-        carry.extend_from_slice(&block);
-        let mut start = 0usize;
-        while let Some(rel) = carry
-            .get(start..)
-            .and_then(|s| s.iter().position(|&b| b == b'\n'))
-        {
-            let line = carry.get(start..start + rel).unwrap_or_default();
-            if !f(line_no, carry_at + start as u64, line)? {
-                return Ok(());
-            }
-            line_no += 1;
-            start += rel + 1;
-        }
-        carry.drain(..start);
-        carry_at += start as u64;
-    }
-    if !carry.is_empty() {
-        f(line_no, carry_at, &carry)?;
-    }
-    Ok(())
-}
-
 /// A format without frames: its one frame, loaded at open.
 struct SingleFrame {
     path: PathBuf,
@@ -448,14 +224,6 @@ impl FrameSource for SingleFrame {
             particles: self.particles.clone(),
         })
     }
-}
-
-/// The error for a frame index past the end of a source.
-pub fn past_the_end(path: &Path, index: usize, count: usize) -> PgtError {
-    PgtError::in_file(
-        path,
-        format!("frame {index} requested, but the file has {count} frame(s) (0-based)"),
-    )
 }
 
 /// `sequence = "…"`: numbered particle files, one frame each (see [`SequencePattern`]).
@@ -519,6 +287,9 @@ pub struct SequencePattern {
     suffix: String,
     /// The minimum digit count of `%0Nd` (zero-padded), if the pattern pads.
     zero_padded: Option<usize>,
+    /// Why the pattern cannot name a file to write (`*`, or space padding `%Nd`), if it
+    /// cannot.
+    not_for_output: Option<&'static str>,
 }
 
 impl SequencePattern {
@@ -537,6 +308,7 @@ impl SequencePattern {
         let expected =
             "expected one `%d`, `%0Nd` or `*` in the file name (`frame_%04d.csv`, `frame_*.csv`)";
         let mut found: Option<(String, usize, Option<usize>)> = None;
+        let mut not_for_output = None;
         let mut literal = String::new();
         let chars: Vec<char> = name.chars().collect();
         let mut i = 0;
@@ -547,6 +319,9 @@ impl SequencePattern {
                 continue;
             }
             let conversion = if c == '*' {
+                not_for_output = Some(
+                    "a `*` matches files to read; a pattern of files to write needs %d or %0Nd",
+                );
                 Some((1usize, None))
             } else if c == '%' {
                 let digits: String = chars[i + 1..]
@@ -561,6 +336,10 @@ impl SequencePattern {
                 let pad = digits
                     .starts_with('0')
                     .then(|| digits.parse::<usize>().unwrap_or(0));
+                if !digits.is_empty() && pad.is_none() {
+                    not_for_output =
+                        Some("%Nd pads with spaces; a pattern of files to write takes %d or %0Nd");
+                }
                 Some((digits.len() + 2, pad))
             } else {
                 None
@@ -591,27 +370,32 @@ impl SequencePattern {
             prefix,
             suffix: literal,
             zero_padded,
+            not_for_output,
         })
     }
 
-    /// The number a file name stands for, if it matches.
-    pub fn number_of(&self, name: &str) -> Option<u64> {
-        let digits = name
-            .strip_prefix(&self.prefix)?
-            .strip_suffix(&self.suffix)?;
-        if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
-            return None;
+    /// The file of number `n` (a pattern of files to write: `%d` or `%0Nd`), or why the
+    /// pattern cannot name one.
+    pub fn path_for(&self, n: usize) -> std::result::Result<PathBuf, String> {
+        if let Some(why) = self.not_for_output {
+            return Err(format!("{}: {why}", self.pattern.display()));
         }
-        if let Some(width) = self.zero_padded {
-            if digits.len() < width || (digits.len() > width && digits.starts_with('0')) {
-                return None;
-            }
-        }
-        digits.parse().ok()
+        let width = self.zero_padded.unwrap_or(0);
+        Ok(self
+            .folder_as_written()
+            .join(format!("{}{n:0width$}{}", self.prefix, self.suffix)))
     }
 
-    /// The matching files in the order of their numbers (see the type's doc).
-    pub fn files(&self) -> Result<Vec<PathBuf>> {
+    /// The folder as the pattern writes it (empty for a bare file name).
+    fn folder_as_written(&self) -> PathBuf {
+        self.pattern
+            .parent()
+            .map(Path::to_path_buf)
+            .unwrap_or_default()
+    }
+
+    /// The matching files with their numbers, sorted; two files of one number are an error.
+    pub fn numbered_files(&self) -> Result<Vec<(u64, PathBuf)>> {
         let entries = std::fs::read_dir(&self.folder).map_err(|e| PgtError::io(&self.folder, e))?;
         let mut numbered: Vec<(u64, PathBuf)> = Vec::new();
         for entry in entries {
@@ -642,6 +426,28 @@ impl SequencePattern {
                 ),
             ));
         }
+        Ok(numbered)
+    }
+
+    /// The number a file name stands for, if it matches.
+    pub fn number_of(&self, name: &str) -> Option<u64> {
+        let digits = name
+            .strip_prefix(&self.prefix)?
+            .strip_suffix(&self.suffix)?;
+        if digits.is_empty() || !digits.bytes().all(|b| b.is_ascii_digit()) {
+            return None;
+        }
+        if let Some(width) = self.zero_padded {
+            if digits.len() < width || (digits.len() > width && digits.starts_with('0')) {
+                return None;
+            }
+        }
+        digits.parse().ok()
+    }
+
+    /// The matching files in the order of their numbers, evenly spaced (see the type's doc).
+    pub fn files(&self) -> Result<Vec<PathBuf>> {
+        let numbered = self.numbered_files()?;
         check_even_spacing(&self.pattern, &numbered)?;
         Ok(numbered.into_iter().map(|(_, p)| p).collect())
     }

@@ -31,8 +31,8 @@ pub const FORMAT: Format = Format {
 /// grouped by model: fine for NMR ensembles; MD trajectories belong in DCD or XTC.
 pub fn open_frames(
     spec: &IncludeSpec,
-    source: super::frames::ByteSource,
-) -> Result<Box<dyn super::frames::FrameSource>> {
+    source: super::frame_source::ByteSource,
+) -> Result<Box<dyn super::frame_source::FrameSource>> {
     let bytes = source.read_all("the file")?;
     let (atoms, warnings) = read_atoms(source.path(), &bytes)?;
     let mut models: Vec<(i64, Vec<Atom>)> = Vec::new();
@@ -65,13 +65,13 @@ struct CifFrames {
     models: Vec<(i64, Vec<Atom>)>,
 }
 
-impl super::frames::FrameSource for CifFrames {
+impl super::frame_source::FrameSource for CifFrames {
     fn path(&self) -> &Path {
         &self.path
     }
-    fn info(&self) -> super::frames::FrameInfo {
+    fn info(&self) -> super::frame_source::FrameInfo {
         let sizes: Vec<usize> = self.models.iter().map(|(_, a)| a.len()).collect();
-        super::frames::FrameInfo {
+        super::frame_source::FrameInfo {
             count: self.models.len(),
             atoms_per_frame: sizes
                 .first()
@@ -80,17 +80,16 @@ impl super::frames::FrameSource for CifFrames {
             time_step_ps: None,
         }
     }
-    fn read_frame(&self, index: usize) -> Result<super::frames::Frame> {
-        let (_, atoms) = self
-            .models
-            .get(index)
-            .ok_or_else(|| super::frames::past_the_end(&self.path, index, self.models.len()))?;
+    fn read_frame(&self, index: usize) -> Result<super::frame_source::Frame> {
+        let (_, atoms) = self.models.get(index).ok_or_else(|| {
+            super::frame_source::past_the_end(&self.path, index, self.models.len())
+        })?;
         let mut spec = self.spec.clone();
         spec.path = self.path.clone();
         spec.model = None;
         let loaded = atoms_to_particles(&spec, atoms.clone(), Vec::new())?;
-        let particles = super::frames::finish_frame(&spec, &self.path, index, loaded)?;
-        Ok(super::frames::Frame {
+        let particles = super::frame_source::finish_frame(&spec, &self.path, index, loaded)?;
+        Ok(super::frame_source::Frame {
             index,
             time_ps: None,
             particles,

@@ -26,7 +26,7 @@
 //!
 //! Every count is checked against the bytes that remain before anything is allocated.
 
-use super::frames::ByteSource;
+use super::frame_source::ByteSource;
 use super::{Format, IncludeSpec, LoadedParticles, ParticleRecord};
 use crate::color::srgb_to_linear;
 use crate::error::{Location, PgtError, Result};
@@ -372,7 +372,7 @@ fn frame_records(
 pub fn open_frames(
     spec: &IncludeSpec,
     source: ByteSource,
-) -> Result<Box<dyn super::frames::FrameSource>> {
+) -> Result<Box<dyn super::frame_source::FrameSource>> {
     let path = source.path().to_path_buf();
     let head = source.read_at(0, source.len().min(HEADER_BYTES), "the header")?;
     let frames = head
@@ -408,25 +408,25 @@ struct MmpldFrames {
     table: Vec<u64>,
 }
 
-impl super::frames::FrameSource for MmpldFrames {
+impl super::frame_source::FrameSource for MmpldFrames {
     fn path(&self) -> &Path {
         self.source.path()
     }
-    fn info(&self) -> super::frames::FrameInfo {
-        super::frames::FrameInfo {
+    fn info(&self) -> super::frame_source::FrameInfo {
+        super::frame_source::FrameInfo {
             count: self.header.frames as usize,
             atoms_per_frame: None,
             time_step_ps: None,
         }
     }
-    fn read_frame(&self, index: usize) -> Result<super::frames::Frame> {
+    fn read_frame(&self, index: usize) -> Result<super::frame_source::Frame> {
         let path = self.source.path();
         let count = self.header.frames as usize;
         let (Some(&start), Some(&end)) = (self.table.get(index), self.table.get(index + 1)) else {
-            return Err(super::frames::past_the_end(path, index, count));
+            return Err(super::frame_source::past_the_end(path, index, count));
         };
         if index >= count {
-            return Err(super::frames::past_the_end(path, index, count));
+            return Err(super::frame_source::past_the_end(path, index, count));
         }
         let window = self
             .source
@@ -441,13 +441,13 @@ impl super::frames::FrameSource for MmpldFrames {
             index,
             &mut warnings,
         )?;
-        let particles = super::frames::finish_frame(
+        let particles = super::frame_source::finish_frame(
             &self.spec,
             path,
             index,
             LoadedParticles { records, warnings },
         )?;
-        Ok(super::frames::Frame {
+        Ok(super::frame_source::Frame {
             index,
             time_ps: None,
             particles,

@@ -16,6 +16,7 @@
 pub mod atoms;
 pub mod dcd;
 pub mod elements;
+pub mod frame_source;
 pub mod frames;
 pub mod gro;
 pub mod mmcif;

@@ -11,7 +11,7 @@
 
 use super::atoms::{atoms_to_particles, infer_element, Atom};
 use super::elements::Element;
-use super::frames::{
+use super::frame_source::{
     finish_frame, past_the_end, scan_lines, ByteSource, Frame, FrameInfo, FrameSource, TextFrames,
 };
 use super::{Format, IncludeSpec, LoadedParticles};

@@ -13,47 +13,12 @@
 //! atoms in order; a topology with another count is refused, naming both files and both counts.
 
 use super::atoms::{select_atom_indices, Atom};
-use super::frames::{finish_frame, past_the_end, ByteSource, Frame, FrameInfo, FrameSource};
+use super::frame_source::{finish_frame, past_the_end, ByteSource, Frame, FrameInfo, FrameSource};
+pub use super::frame_source::{OpenTrajectory, Trajectory, TrajectoryFormat};
 use super::{IncludeSpec, LoadedParticles, ParticleRecord};
 use crate::error::{PgtError, Result};
 use glam::DVec3;
 use std::path::Path;
-
-/// A trajectory file: positions per frame, without elements or names.
-pub trait Trajectory: Send + Sync {
-    /// The file, for messages.
-    fn path(&self) -> &Path;
-    /// Atoms per frame.
-    fn atoms(&self) -> usize;
-    /// Number of frames (a truncated last frame counts; reading it is the error).
-    fn frames(&self) -> usize;
-    /// Time between frames in picoseconds, where the file says.
-    fn time_step_ps(&self) -> Option<f64>;
-    /// Remarks found at open (a header frame count that disagrees with the file's length).
-    fn warnings(&self) -> Vec<String> {
-        Vec::new()
-    }
-    /// The positions of frame `index` in Å, into `out` (cleared first; [`Trajectory::atoms`]
-    /// entries), and the frame's time in ps where the file gives one. A truncated or corrupt
-    /// frame is an error that names the file, the frame and the byte.
-    fn read_positions(&self, index: usize, out: &mut Vec<DVec3>) -> Result<Option<f64>>;
-}
-
-/// Opens a trajectory from its bytes (header read, frames found).
-pub type OpenTrajectory = fn(source: ByteSource) -> Result<Box<dyn Trajectory>>;
-
-/// One trajectory format: an entry of [`TRAJECTORY_FORMATS`].
-#[derive(Debug)]
-pub struct TrajectoryFormat {
-    /// Its name (`"xtc"`).
-    pub name: &'static str,
-    /// File name extensions, lower case, without the dot.
-    pub extensions: &'static [&'static str],
-    /// One line for people.
-    pub description: &'static str,
-    /// The reader.
-    pub open: OpenTrajectory,
-}
 
 /// Every trajectory format pgt reads.
 pub static TRAJECTORY_FORMATS: &[&TrajectoryFormat] = &[&super::dcd::FORMAT, &super::xtc::FORMAT];

@@ -34,9 +34,9 @@
 //! a last frame cut short counts, and reading it is the error. The time step is the time of frame
 //! 1 minus that of frame 0.
 
-use super::frames::ByteSource;
+use super::frame_source::ByteSource;
+use super::frame_source::{Trajectory, TrajectoryFormat};
 use super::gro::ANGSTROM_PER_NM;
-use super::topology::{Trajectory, TrajectoryFormat};
 use crate::error::{PgtError, Result};
 use glam::DVec3;
 use std::path::Path;
@@ -111,7 +111,7 @@ struct Xtc {
     warnings: Vec<String>,
 }
 
-/// The [`super::topology::OpenTrajectory`] of XTC: one scan of the frame headers.
+/// The [`super::frame_source::OpenTrajectory`] of XTC: one scan of the frame headers.
 pub fn open(source: ByteSource) -> Result<Box<dyn Trajectory>> {
     let path = source.path().to_path_buf();
     let len = source.len();
@@ -238,7 +238,7 @@ impl Trajectory for Xtc {
         let f = *self
             .frames
             .get(index)
-            .ok_or_else(|| super::frames::past_the_end(path, index, self.frames.len()))?;
+            .ok_or_else(|| super::frame_source::past_the_end(path, index, self.frames.len()))?;
         if f.offset.saturating_add(f.size) > self.source.len() {
             return Err(PgtError::at_byte(
                 path,

@@ -21,7 +21,7 @@
 //! disagree is refused, naming its line (one of the two was edited without the other).
 
 use super::elements::{element_color, element_radius, Element};
-use super::frames::{
+use super::frame_source::{
     finish_frame, past_the_end, scan_lines, ByteSource, Frame, FrameInfo, FrameSource, TextFrames,
 };
 use super::{Format, IncludeSpec, LoadedParticles, ParticleRecord};

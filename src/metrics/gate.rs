@@ -12,6 +12,11 @@
 //! max_mean_rel = 0.05
 //! max_flip = 0.05          # mean LDR-FLIP
 //!
+//! # Sequences only (docs/design.md §10): the worst frame's temporal error, mean over channels.
+//! max_temporal_p99 = 0.02  # 99th percentile of e_t
+//! max_temporal_mean = 0.002
+//! max_pops = 0             # pixels above the pop threshold
+//!
 //! # Per-channel thresholds, [R, G, B].
 //! [channels]
 //! min_ssim = [0.98, 0.99, 0.99]
@@ -52,6 +57,13 @@ pub struct Gate {
     pub max_mean_abs: Option<f64>,
     pub max_mean_rel: Option<f64>,
     pub max_flip: Option<f64>,
+    /// Sequences only: the largest mean-over-channels 99th percentile of any frame's temporal
+    /// error.
+    pub max_temporal_p99: Option<f64>,
+    /// Sequences only: the largest mean temporal error of any frame.
+    pub max_temporal_mean: Option<f64>,
+    /// Sequences only: the most pops of any frame.
+    pub max_pops: Option<f64>,
     pub channels: Option<ChannelGate>,
     #[serde(default)]
     pub percentiles: Vec<PercentileGate>,
@@ -175,6 +187,9 @@ impl Gate {
             self.max_mean_abs,
             self.max_mean_rel,
             self.max_flip,
+            self.max_temporal_p99,
+            self.max_temporal_mean,
+            self.max_pops,
         ]
         .iter()
         .all(Option::is_none)
@@ -199,6 +214,9 @@ impl Gate {
             ("max_mean_abs", self.max_mean_abs),
             ("max_mean_rel", self.max_mean_rel),
             ("max_flip", self.max_flip),
+            ("max_temporal_p99", self.max_temporal_p99),
+            ("max_temporal_mean", self.max_temporal_mean),
+            ("max_pops", self.max_pops),
         ];
         for (name, v) in scalars {
             if let Some(v) = v {
@@ -239,6 +257,28 @@ impl Gate {
             }
         }
         None
+    }
+
+    /// The thresholds that only a sequence has (the temporal error), by name, where set.
+    pub fn temporal_keys(&self) -> Vec<(&'static str, f64)> {
+        [
+            ("max_temporal_p99", self.max_temporal_p99),
+            ("max_temporal_mean", self.max_temporal_mean),
+            ("max_pops", self.max_pops),
+        ]
+        .into_iter()
+        .filter_map(|(n, v)| v.map(|v| (n, v)))
+        .collect()
+    }
+
+    /// This gate without the temporal thresholds (what each frame of a sequence is held to).
+    pub fn per_frame(&self) -> Gate {
+        Gate {
+            max_temporal_p99: None,
+            max_temporal_mean: None,
+            max_pops: None,
+            ..self.clone()
+        }
     }
 
     /// Evaluates every threshold: the lower bounds (SSIM, PSNR), the upper bounds (errors,

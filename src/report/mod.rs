@@ -18,6 +18,7 @@ pub mod summary;
 pub use html::{write_report, ReportInputs, ReportOptions};
 pub use summary::Summary;
 pub mod plot;
+pub mod sequence_page;
 pub mod sweep_page;
 pub mod text;
 pub mod viewer;

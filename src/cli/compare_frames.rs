@@ -1,0 +1,234 @@
+//! `pgt compare REF_SEQUENCE APPROX_SEQUENCE` (docs/design.md §10): both arguments folders or
+//! printf patterns of frames. Per frame the metrics of docs/design.md §5, the temporal error of
+//! every frame after the first, the gate (the per-image thresholds held by every frame, the
+//! temporal ones by the worst frame), a JSON summary and a report that plays the sequences.
+
+use super::Outcome;
+use crate::metrics::gate::{Gate, GateCheck};
+use crate::metrics::CompareOptions;
+use crate::report::sequence_page::{write_frame_images, write_sequence_page, SequencePage};
+use crate::report::summary::short;
+use crate::sequence::compare::{compare_sequences, pair_sequences, SequenceComparison};
+use std::path::Path;
+
+/// The per-image checks of each frame: (frame, its checks).
+type FrameChecks = Vec<(usize, Vec<GateCheck>)>;
+
+/// The JSON summary of a sequence comparison.
+#[derive(Debug, serde::Serialize)]
+struct SequenceSummary<'a> {
+    reference: String,
+    approximation: String,
+    #[serde(flatten)]
+    comparison: &'a SequenceComparison,
+    checks: &'a [GateCheck],
+    /// Frames that failed a per-image threshold.
+    failed_frames: Vec<usize>,
+    passed: Option<bool>,
+}
+
+/// What `pgt compare` hands over when both its arguments are sequences.
+pub struct SequenceArgs<'a> {
+    pub reference: &'a Path,
+    pub approximation: &'a Path,
+    pub options: CompareOptions,
+    pub pop_threshold: Option<f64>,
+    pub json: Option<&'a Path>,
+    pub report: Option<&'a Path>,
+}
+
+pub fn run(args: &SequenceArgs, gate: &Gate) -> anyhow::Result<Outcome> {
+    let pairs = pair_sequences(args.reference, args.approximation)?;
+    let options = args.options;
+    let frame_gate = gate.per_frame();
+    let mut frame_checks: FrameChecks = Vec::new();
+    let run_compare = |dir: Option<&Path>| -> crate::Result<(SequenceComparison, FrameChecks)> {
+        let mut checks_of_frames = Vec::new();
+        let mut pop_threshold = args.pop_threshold;
+        let cmp = compare_sequences(&pairs, &options, args.pop_threshold, &mut |view| {
+            if !frame_gate.is_empty() {
+                let checks =
+                    frame_gate.evaluate(view.comparison, view.reference, view.approximation)?;
+                checks_of_frames.push((view.figures.frame, checks));
+            }
+            if let Some(dir) = dir {
+                let threshold = *pop_threshold.get_or_insert(
+                    crate::sequence::compare::POP_THRESHOLD_SHARE * view.comparison.data_range,
+                );
+                write_frame_images(dir, &view, threshold)?;
+            }
+            Ok(())
+        })?;
+        Ok((cmp, checks_of_frames))
+    };
+    let mut report_page = None;
+    let cmp = match args.report {
+        None => {
+            let (cmp, checks) = run_compare(None)?;
+            frame_checks = checks;
+            cmp
+        }
+        Some(dir) => {
+            let mut out = None;
+            let page = crate::image_io::write_folder_atomically(dir, |tmp| {
+                let (cmp, per_frame) = run_compare(Some(tmp))?;
+                let (checks, failed) = evaluate(gate, &cmp, &per_frame);
+                frame_checks = per_frame;
+                let verdict = verdict(&cmp, &checks, &failed);
+                let page = write_sequence_page(
+                    tmp,
+                    &cmp,
+                    &SequencePage {
+                        reference: &args.reference.display().to_string(),
+                        approximation: &args.approximation.display().to_string(),
+                        verdict: &verdict,
+                        checks: &checks,
+                    },
+                )?;
+                out = Some(cmp);
+                Ok(page)
+            })?;
+            report_page = Some(dir.join(page.file_name().unwrap_or_default()));
+            out.ok_or_else(|| anyhow::anyhow!("the report was written without a comparison"))?
+        }
+    };
+    let (checks, failed_frames) = evaluate(gate, &cmp, &frame_checks);
+    let verdict = verdict(&cmp, &checks, &failed_frames);
+    if let Some(page) = report_page {
+        eprintln!("report: {}", page.display());
+    }
+    let passed =
+        (!gate.is_empty()).then(|| checks.iter().all(|c| c.passed) && failed_frames.is_empty());
+    let summary = SequenceSummary {
+        reference: args.reference.display().to_string(),
+        approximation: args.approximation.display().to_string(),
+        comparison: &cmp,
+        checks: &checks,
+        failed_frames,
+        passed,
+    };
+    match args.json {
+        Some(path) if path.as_os_str() == "-" => {
+            super::print_stdout(&(serde_json::to_string_pretty(&summary)? + "\n"))?;
+            eprintln!("{verdict}");
+        }
+        Some(path) => {
+            crate::report::text::write_text(
+                path,
+                &(serde_json::to_string_pretty(&summary)? + "\n"),
+            )?;
+            super::print_stdout(&format!("{verdict}\n"))?;
+        }
+        None => super::print_stdout(&format!("{verdict}\n"))?,
+    }
+    Ok(match passed {
+        Some(false) => Outcome::GateFailed,
+        _ => Outcome::Success,
+    })
+}
+
+/// The gate's checks: each per-image threshold at its worst frame, then the temporal ones at
+/// theirs; and the frames that failed a per-image threshold.
+fn evaluate(
+    gate: &Gate,
+    cmp: &SequenceComparison,
+    frame_checks: &[(usize, Vec<GateCheck>)],
+) -> (Vec<GateCheck>, Vec<usize>) {
+    let mut checks: Vec<GateCheck> = Vec::new();
+    let mut failed = Vec::new();
+    for (frame, list) in frame_checks {
+        if list.iter().any(|c| !c.passed) {
+            failed.push(*frame);
+        }
+        for c in list {
+            let named = GateCheck {
+                name: format!("{} (worst frame: {frame})", c.name),
+                ..c.clone()
+            };
+            match checks
+                .iter_mut()
+                .find(|k| k.name.starts_with(&format!("{} (", c.name)))
+            {
+                None => checks.push(named),
+                Some(k) => {
+                    // The worst frame: the one furthest on the failing side of the threshold.
+                    let lower_bound = c.name.starts_with("min_") || c.name.contains(">=");
+                    let worse = if lower_bound {
+                        c.value < k.value
+                    } else {
+                        c.value > k.value
+                    };
+                    if worse {
+                        *k = named;
+                    }
+                }
+            }
+        }
+    }
+    for (name, threshold) in gate.temporal_keys() {
+        let value = cmp
+            .frames
+            .iter()
+            .filter_map(|f| f.temporal.as_ref())
+            .map(|t| match name {
+                "max_temporal_p99" => t.p99.mean,
+                "max_temporal_mean" => t.mean.mean,
+                _ => t.pops as f64,
+            })
+            .fold(0.0, f64::max);
+        checks.push(GateCheck {
+            name: name.to_string(),
+            value,
+            threshold,
+            passed: value <= threshold,
+        });
+    }
+    (checks, failed)
+}
+
+/// The one-line verdict: frames, the worst figures, the gate.
+fn verdict(cmp: &SequenceComparison, checks: &[GateCheck], failed: &[usize]) -> String {
+    let mut line = format!("{} frames", cmp.frames.len());
+    if let Some(f) = cmp.worst_ssim() {
+        line += &format!(
+            ", lowest SSIM {} (frame {})",
+            short(f.ssim.unwrap_or(f64::NAN)),
+            f.frame
+        );
+    }
+    if let Some(f) = cmp.worst_temporal() {
+        let t = f.temporal.as_ref().map_or(0.0, |t| t.p99.mean);
+        line += &format!(", largest temporal p99 {} (frame {})", short(t), f.frame);
+    }
+    let pops: usize = cmp
+        .frames
+        .iter()
+        .filter_map(|f| f.temporal.as_ref().map(|t| t.pops))
+        .sum();
+    line += &format!(", {pops} pops above {}", short(cmp.pop_threshold));
+    if checks.is_empty() {
+        return line;
+    }
+    let failing: Vec<&GateCheck> = checks.iter().filter(|c| !c.passed).collect();
+    if failing.is_empty() {
+        format!("PASS: {line}")
+    } else {
+        let names: Vec<String> = failing
+            .iter()
+            .map(|c| {
+                format!(
+                    "{} = {} (threshold {})",
+                    c.name,
+                    short(c.value),
+                    short(c.threshold)
+                )
+            })
+            .collect();
+        let frames = if failed.is_empty() {
+            String::new()
+        } else {
+            format!("; {} frame(s) failed a per-frame threshold", failed.len())
+        };
+        format!("FAIL: {line}; {}{frames}", names.join(", "))
+    }
+}
