@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import pgt
+from conftest import bits
 
 
 def write_xyz(path, frames):
@@ -79,3 +80,16 @@ def test_an_orbiting_camera_has_an_open_frame_count(tmp_path):
     assert abs(eye[1][2]) < 1e-9 and abs(abs(eye[1][0]) - 6.0) < 1e-9
     np.testing.assert_allclose(eye[2], [0, 0, 6], atol=1e-9)
     assert len(frames.frame(1)) == 1
+
+
+def test_each_frame_renders_as_pgt_render_frames_writes_it(moving, tmp_path, run_cli):
+    """frames.frame(t) rendered from Python is the CLI's frame t (pgt render --frames), bit
+    for bit, image and err layer."""
+    out = tmp_path / "frames"
+    run_cli("render", moving, "--size", "16x12", "--frames", "0..3", "-o", out / "f_%d.exr")
+    frames = pgt.load_frames(moving, size=(16, 12))
+    for t in range(3):
+        result = pgt.render(frames.frame(t))
+        cli = out / f"f_{t}.exr"
+        np.testing.assert_array_equal(bits(result.image), bits(pgt.read_image(cli)))
+        np.testing.assert_array_equal(bits(result.err), bits(pgt.read_image(cli, layer="err")))
