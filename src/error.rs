@@ -36,6 +36,10 @@ pub enum PgtError {
     /// The GPU side failed (no adapter, shader errors, limits).
     #[error("{0}")]
     Gpu(String),
+    /// The work was stopped on request before it finished (a reference render whose
+    /// `RenderControl` was stopped: Ctrl-C in Python); nothing was produced.
+    #[error("interrupted")]
+    Interrupted,
     /// An error of one step of a longer job, prefixed with the step (e.g. a sweep's run label).
     #[error("{context}: {source}")]
     Context {

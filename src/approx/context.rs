@@ -10,7 +10,7 @@ use std::sync::{Arc, Mutex};
 
 /// The message docs/design.md §4 asks for when no adapter exists.
 pub const NO_ADAPTER: &str =
-    "no GPU adapter found: install mesa-vulkan-drivers (lavapipe) or a GPU driver";
+    "no GPU adapter found: install mesa-vulkan-drivers and libvulkan1 (lavapipe, Vulkan on the CPU) or a GPU driver";
 
 /// One adapter as the user can name it with `--adapter`.
 #[derive(Debug, Clone, PartialEq, Eq)]

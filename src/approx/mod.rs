@@ -62,6 +62,28 @@ pub struct ApproxOutput {
     pub passes: u32,
 }
 
+impl ApproxOutput {
+    /// What the user must be told about this image: pixels whose farthest particles were
+    /// dropped, pixels that lavapipe's loop limit may have cut short.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        if self.hit_overflow_pixels > 0 {
+            out.push(format!(
+                "{} pixels crossed more than {} particles; their farthest particles were dropped",
+                self.hit_overflow_pixels, MAX_HITS
+            ));
+        }
+        if self.loop_limited_pixels > 0 {
+            out.push(format!(
+                "{} pixels reached lavapipe's limit of {} loop iterations per pixel; lavapipe cuts such loops short, so these pixels are wrong (use fewer samples or a real GPU)",
+                self.loop_limited_pixels,
+                contract::LOOP_LIMIT
+            ));
+        }
+        out
+    }
+}
+
 /// Opens a GPU context ([`GpuContext::new`] with `params.adapter`) and renders the scene.
 /// The method's WGSL is checked first, so a broken shader is reported even without a GPU.
 pub fn render_approx(scene: &Scene, params: &ApproxParams) -> Result<ApproxOutput> {

@@ -264,19 +264,8 @@ pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
     }
     let out = out?;
     write_image(output, &out.image, &[], args.exposure)?;
-    if out.hit_overflow_pixels > 0 {
-        eprintln!(
-            "warning: {} pixels crossed more than {} particles; their farthest particles were dropped",
-            out.hit_overflow_pixels,
-            approx::MAX_HITS
-        );
-    }
-    if out.loop_limited_pixels > 0 {
-        eprintln!(
-            "warning: {} pixels reached lavapipe's limit of {} loop iterations per pixel; lavapipe cuts such loops short, so these pixels are wrong (use fewer samples or a real GPU)",
-            out.loop_limited_pixels,
-            approx::contract::LOOP_LIMIT
-        );
+    for w in out.warnings() {
+        eprintln!("warning: {w}");
     }
     let passes = if out.passes == 1 {
         "1 pass".to_string()

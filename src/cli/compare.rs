@@ -8,8 +8,8 @@ use super::output::{check_outputs, Output, OutputKind};
 use super::Outcome;
 use crate::image_io::{read_image_layer, ReadImage, RgbImage};
 use crate::metrics::gate::Gate;
-use crate::metrics::{compare, CompareOptions, DataRangeSource};
-use crate::report::{self, ReportInputs, ReportOptions, Summary};
+use crate::metrics::{CompareOptions, DataRangeSource};
+use crate::report::{self, Compared, ReportOptions};
 use anyhow::Context;
 use clap::Args;
 use std::path::{Path, PathBuf};
@@ -81,17 +81,17 @@ pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
         outputs.push(Output::new("--report", report, OutputKind::Folder));
     }
     check_outputs(&outputs)?;
-    for (name, v) in [
-        ("--error-scale", args.error_scale),
-        ("--rel-scale", args.rel_scale),
-    ] {
-        if v.is_some_and(|v| !(v.is_finite() && v > 0.0)) {
-            anyhow::bail!("{name} must be a finite number > 0");
-        }
-    }
-    if !(args.ppd.is_finite() && args.ppd > 0.0) {
-        anyhow::bail!("--ppd must be a finite number > 0");
-    }
+    let options = CompareOptions {
+        data_range: args.data_range,
+        flip: !args.no_flip,
+        pixels_per_degree: args.ppd,
+        flip_exposures: args.flip_exposures,
+    };
+    let report_options = ReportOptions {
+        error_scale: args.error_scale,
+        rel_scale: args.rel_scale,
+    };
+    crate::report::compared::check_options(&options, &report_options)?;
     let mut gate = match &args.gate {
         Some(path) => Gate::load(path)?,
         None => Gate::default(),
@@ -107,40 +107,29 @@ pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
     // The reference's error estimate is a second read of its EXR: done beside the pair's.
     let (pair, estimate) = rayon::join(
         || load_pair(&args.reference, &args.approximation, args.layer.as_deref()),
-        || reference_estimate(&args.reference, args.layer.as_deref()),
+        || crate::image_io::read_reference_estimate(&args.reference, args.layer.as_deref()),
     );
     let (reference, approximation) = pair?;
-    let options = CompareOptions {
-        data_range: args.data_range,
-        flip: !args.no_flip,
-        pixels_per_degree: args.ppd,
-        flip_exposures: args.flip_exposures,
-    };
-    let cmp = compare(&reference, &approximation, &options).with_context(|| {
-        format!(
-            "comparing {} with {}",
-            args.reference.display(),
-            args.approximation.display()
-        )
-    })?;
+    let labels = (
+        args.reference.display().to_string(),
+        args.approximation.display().to_string(),
+    );
+    let compared = Compared::new(reference, approximation, estimate, labels, &options)
+        .with_context(|| {
+            format!(
+                "comparing {} with {}",
+                args.reference.display(),
+                args.approximation.display()
+            )
+        })?;
+    let cmp = &compared.comparison;
     if cmp.data_range_source == DataRangeSource::Derived {
         eprintln!(
             "note: HDR input (values above 1); data range for SSIM/PSNR derived from the reference: {} (pass --data-range to fix it)",
             cmp.data_range
         );
     }
-    let checks = gate.evaluate(&cmp, &reference, &approximation)?;
-    let mut summary = Summary::new(
-        &args.reference.display().to_string(),
-        &args.approximation.display().to_string(),
-        &cmp,
-        checks,
-        start.elapsed().as_secs_f64(),
-    );
-    let estimate = estimate.filter(|e| (e.width, e.height) == (reference.width, reference.height));
-    summary.reference_uncertainty = estimate
-        .as_ref()
-        .map(|e| crate::metrics::errors::reference_uncertainty(&reference, &approximation, e));
+    let summary = compared.summary(&gate, start.elapsed().as_secs_f64())?;
     if let Some(u) = &summary.reference_uncertainty {
         eprintln!(
             "reference error estimate: max {:.3e}, mean {:.3e}; the difference exceeds it at {:.3}% of pixel-channels",
@@ -150,23 +139,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
         );
     }
     if let Some(dir) = &args.report {
-        let inputs = ReportInputs {
-            reference: &reference,
-            approximation: &approximation,
-            estimate: estimate.as_ref(),
-            comparison: &cmp,
-            summary: &summary,
-            options: ReportOptions {
-                error_scale: args.error_scale,
-                rel_scale: args.rel_scale,
-            },
-        };
-        // Written into a temporary folder and moved into place at the end (docs/design.md §7): an
-        // interrupted or failed run leaves no half-written report.
-        let page = crate::image_io::write_folder_atomically(dir, |tmp| {
-            report::write_report(tmp, &inputs)
-        })?;
-        let page = dir.join(page.file_name().unwrap_or_default());
+        let page = compared.write_report(dir, &summary, report_options)?;
         eprintln!("report: {}", page.display());
     }
     let verdict = summary.verdict();
@@ -242,19 +215,6 @@ fn compare_sequences(args: &CompareArgs, gate: &Gate) -> anyhow::Result<Option<O
     }
 
     Ok(None)
-}
-
-/// The reference's per-pixel error estimate: the `err` layer of a reference EXR (docs/design.md §3,
-/// §7), when the whole image is compared (no `--layer`) and the file has one.
-fn reference_estimate(reference: &Path, layer: Option<&str>) -> Option<RgbImage> {
-    let is_exr = reference
-        .extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
-    if !is_exr || layer.is_some_and(|l| !l.is_empty()) {
-        return None;
-    }
-    crate::image_io::read_exr_layer(reference, "err").ok()
 }
 
 /// Parses `START,STOP` (stops, finite, START <= STOP).

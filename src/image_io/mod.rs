@@ -7,7 +7,7 @@ mod read;
 mod write;
 
 pub use folder::write_folder_atomically;
-pub use read::{read_exr_layer, read_image, read_image_layer, ReadImage};
+pub use read::{read_exr_layer, read_image, read_image_layer, read_reference_estimate, ReadImage};
 pub use write::{
     linear_to_srgb8, write_atomically, write_exr_with_header, write_image, ImageFormat,
 };

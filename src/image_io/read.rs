@@ -46,7 +46,16 @@ pub fn read_image_layer(path: &Path, layer: Option<&str>) -> Result<ReadImage> {
     }
 }
 
+/// A file that cannot be opened (missing, a folder, no permission) is an I/O error naming it,
+/// not a malformed image.
+fn check_readable(path: &Path) -> Result<()> {
+    std::fs::File::open(path)
+        .map(drop)
+        .map_err(|e| PgtError::io(path, e))
+}
+
 fn read_png(path: &Path) -> Result<ReadImage> {
+    check_readable(path)?;
     let img =
         image::open(path).map_err(|e| PgtError::in_file(path, format!("cannot read PNG: {e}")))?;
     let (width, height) = (img.width(), img.height());
@@ -99,6 +108,7 @@ fn decode_through_table(samples: impl Iterator<Item = [usize; 3]>, bits: u32) ->
 /// lists the channels the file has.
 pub fn read_exr_layer(path: &Path, layer: &str) -> Result<RgbImage> {
     use exr::prelude::*;
+    check_readable(path)?;
     let img = read_all_flat_layers_from_file(path)
         .map_err(|e| PgtError::in_file(path, format!("cannot read EXR: {e}")))?;
     if img.layer_data.is_empty() {
@@ -162,6 +172,20 @@ pub fn read_exr_layer(path: &Path, layer: &str) -> Result<RgbImage> {
         height: h as u32,
         pixels,
     })
+}
+
+/// The reference's per-pixel error estimate (docs/design.md §3, §7): the `err` layer of a
+/// reference EXR, when the whole image is compared (no layer chosen) and the file has one;
+/// `None` for a PNG, a scene, or an EXR without it.
+pub fn read_reference_estimate(reference: &Path, layer: Option<&str>) -> Option<RgbImage> {
+    let is_exr = reference
+        .extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("exr"));
+    if !is_exr || layer.is_some_and(|l| !l.is_empty()) {
+        return None;
+    }
+    read_exr_layer(reference, "err").ok()
 }
 
 #[cfg(test)]

@@ -14,6 +14,7 @@ use crate::image_io::RgbImage;
 use crate::scene::{RenderMode, Scene};
 use glam::DVec3;
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 use std::time::Instant;
 
 /// Radiance along one camera ray.
@@ -99,8 +100,49 @@ pub struct RenderOutput {
 
 /// Renders the scene with the renderer its mode and model call for.
 pub fn render(scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
+    render_controlled(scene, options, &RenderControl::default())
+}
+
+/// [`render`] with a [`RenderControl`] that another thread uses to follow the render and to
+/// stop it (the Python package's progress and Ctrl-C).
+pub fn render_controlled(
+    scene: &Scene,
+    options: &RenderOptions,
+    control: &RenderControl,
+) -> Result<RenderOutput> {
     let estimator = estimator_for(scene, options)?;
-    render_with(&scene.camera, estimator.as_ref(), options)
+    render_with_control(&scene.camera, estimator.as_ref(), options, control)
+}
+
+/// Shared between a running render and the thread that waits for it: how many blocks of how
+/// many are done, and a flag that stops the render. The render looks at the flag before each
+/// block of 16×16 pixels, so a stop takes effect within one block per worker; the stopped
+/// render returns [`PgtError::Interrupted`] and no image.
+#[derive(Debug, Default)]
+pub struct RenderControl {
+    stop: AtomicBool,
+    blocks_done: AtomicU64,
+    blocks_total: AtomicU64,
+}
+
+impl RenderControl {
+    /// Asks the render to stop.
+    pub fn stop(&self) {
+        self.stop.store(true, Ordering::Relaxed);
+    }
+
+    /// Whether [`RenderControl::stop`] was called.
+    pub fn is_stopped(&self) -> bool {
+        self.stop.load(Ordering::Relaxed)
+    }
+
+    /// (blocks done, blocks in the image); (0, 0) before the render has started.
+    pub fn progress(&self) -> (u64, u64) {
+        (
+            self.blocks_done.load(Ordering::Relaxed),
+            self.blocks_total.load(Ordering::Relaxed),
+        )
+    }
 }
 
 /// The estimator the scene's mode and model call for, after checking the options that every
@@ -144,6 +186,16 @@ pub fn render_with(
     estimator: &dyn RadianceEstimator,
     options: &RenderOptions,
 ) -> Result<RenderOutput> {
+    render_with_control(camera, estimator, options, &RenderControl::default())
+}
+
+/// [`render_with`], reporting to and stopped by `control`.
+pub fn render_with_control(
+    camera: &Camera,
+    estimator: &dyn RadianceEstimator,
+    options: &RenderOptions,
+    control: &RenderControl,
+) -> Result<RenderOutput> {
     let start = Instant::now();
     let (w, h) = (camera.width, camera.height);
     let blocks_x = w.div_ceil(BLOCK);
@@ -151,6 +203,9 @@ pub fn render_with(
     let blocks: Vec<(u32, u32)> = (0..blocks_y)
         .flat_map(|ty| (0..blocks_x).map(move |tx| (tx, ty)))
         .collect();
+    control
+        .blocks_total
+        .store(blocks.len() as u64, Ordering::Relaxed);
     let bar = if options.progress {
         let bar = indicatif::ProgressBar::new(blocks.len() as u64);
         bar.set_style(
@@ -170,6 +225,9 @@ pub fn render_with(
             .map(|&(tx, ty)| {
                 let mut out = Vec::with_capacity((BLOCK * BLOCK) as usize);
                 let mut shadow_rays = 0u64;
+                if control.is_stopped() {
+                    return (out, shadow_rays);
+                }
                 for py in ty * BLOCK..((ty + 1) * BLOCK).min(h) {
                     for px in tx * BLOCK..((tx + 1) * BLOCK).min(w) {
                         let (radiance, error, rays, unconverged) =
@@ -181,6 +239,7 @@ pub fn render_with(
                 if let Some(bar) = &bar {
                     bar.inc(1);
                 }
+                control.blocks_done.fetch_add(1, Ordering::Relaxed);
                 (out, shadow_rays)
             })
             .collect::<Vec<_>>()
@@ -188,6 +247,9 @@ pub fn render_with(
     let results = with_threads(options.threads, run)?;
     if let Some(bar) = &bar {
         bar.finish_and_clear();
+    }
+    if control.is_stopped() {
+        return Err(PgtError::Interrupted);
     }
     let mut image = RgbImage::new(w, h);
     let mut err_image = RgbImage::new(w, h);

@@ -6,9 +6,11 @@ pub mod attribution;
 pub mod colorbar;
 pub mod colormap;
 mod colormap_data;
+pub mod compared;
 pub mod heatmap;
 
 pub use colormap::{ColorMap, Scale};
+pub use compared::Compared;
 pub use heatmap::{heatmap, Srgb8Image};
 pub mod html;
 pub mod summary;

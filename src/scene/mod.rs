@@ -10,6 +10,7 @@ mod validate;
 pub use crate::formats::{ColorBy, IncludeSpec, ParticleRecord};
 pub use frames::SceneFrames;
 pub use framing::{bounding_sphere, default_camera, thesis_lights};
+pub use validate::checked_tol_override;
 // The light physics, the resolved particle and the optical models live in `optics` (the scene
 // builds on optics, never the reverse); re-exported so that `scene::Light` etc. keep working.
 pub use crate::optics::light::{Falloff, Incident, Light, LightWeight};
@@ -92,6 +93,19 @@ pub struct SceneLoadOptions {
     pub format: Option<&'static crate::formats::Format>,
 }
 
+/// One particle given by a program rather than a file (the Python package's
+/// `Scene.from_arrays`): the fields of an inline `[[particles]]` table, checked as that is.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ParticleInput {
+    pub center: [f64; 3],
+    pub radius: f64,
+    /// Linear RGB; `None`: `[defaults]`' colour.
+    pub color: Option<[f64; 3]>,
+    /// Θmax; set this or `kappa` or neither (then `[defaults]`' or 0.5).
+    pub opacity: Option<f64>,
+    pub kappa: Option<f64>,
+}
+
 /// Largest image side pgt accepts; beyond it a typo (`--size 5120000x512`) would allocate
 /// gigabytes before anything useful happens.
 pub const MAX_IMAGE_SIDE: u32 = 32768;
@@ -142,6 +156,27 @@ impl Scene {
     /// Parses and validates scene TOML text; `path` names it in messages and anchors includes.
     pub fn from_toml_str(text: &str, path: &Path, options: &SceneLoadOptions) -> Result<Scene> {
         validate::scene_from_toml(text, path, options)
+    }
+
+    /// A scene from settings and particles given by a program (the Python package's
+    /// `Scene.from_arrays`): `settings` is scene-file TOML (camera, render, lights, defaults),
+    /// `name` names it in messages, `particles` are checked as inline `[[particles]]` tables
+    /// are, and with `default_lights` settings without `[[lights]]` get the thesis's two lights
+    /// of a bare particle file (docs/design.md §1).
+    pub fn from_settings_and_particles(
+        settings: &str,
+        name: &Path,
+        options: &SceneLoadOptions,
+        particles: impl IntoIterator<Item = ParticleInput>,
+        default_lights: bool,
+    ) -> Result<Scene> {
+        validate::scene_from_toml_and_particles(
+            settings,
+            name,
+            options,
+            particles.into_iter(),
+            default_lights,
+        )
     }
 
     /// A BVH over the scene's particles (indices are positions in `particles`).

@@ -6,7 +6,7 @@ use super::file::{
     RenderTable, SceneFile,
 };
 use super::framing::{default_camera, thesis_lights, DEFAULT_FOV_Y, DEFAULT_SIZE};
-use super::{IncludeSpec, ParticleRecord, RenderSettings, Scene, SceneLoadOptions};
+use super::{IncludeSpec, ParticleInput, ParticleRecord, RenderSettings, Scene, SceneLoadOptions};
 use crate::error::{line_of, toml_error, At, Location, PgtError, Result, SourceText};
 use crate::geometry::{Camera, CameraPath, Keyframe};
 use crate::optics::extinction::Extinction;
@@ -110,6 +110,30 @@ fn resolve_include(at: &At, base: &Path, mut spec: IncludeSpec) -> Result<Includ
 
 /// Validates scene TOML into frame 0 and what the other frames need ([`Loaded`]).
 pub(super) fn load_toml(text: &str, path: &Path, options: &SceneLoadOptions) -> Result<Loaded> {
+    load_toml_and_particles(text, path, options, std::iter::empty(), false)
+}
+
+/// [`scene_from_toml`] plus `given` particles, each checked as an inline `[[particles]]` table
+/// (and numbered after them in messages); with `default_lights`, settings without `[[lights]]`
+/// get the thesis's two lights, as a bare particle file does.
+pub(super) fn scene_from_toml_and_particles(
+    text: &str,
+    path: &Path,
+    options: &SceneLoadOptions,
+    given: impl Iterator<Item = ParticleInput>,
+    default_lights: bool,
+) -> Result<Scene> {
+    load_toml_and_particles(text, path, options, given, default_lights).map(|l| l.scene)
+}
+
+/// [`load_toml`] with the particles and lights of [`scene_from_toml_and_particles`].
+fn load_toml_and_particles(
+    text: &str,
+    path: &Path,
+    options: &SceneLoadOptions,
+    given: impl Iterator<Item = ParticleInput>,
+    default_lights: bool,
+) -> Result<Loaded> {
     let file: SceneFile = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
     let source = SourceText { path, text };
     let at = |span: std::ops::Range<usize>| source.at(span);
@@ -129,16 +153,14 @@ pub(super) fn load_toml(text: &str, path: &Path, options: &SceneLoadOptions) -> 
     let defaults = file.defaults.as_ref().map_or(&empty, |d| d.get_ref());
     let resolved_defaults = ResolvedDefaults::new(&defaults_at, defaults, render.lambda)?;
 
-    let mut particles = Vec::with_capacity(file.particles.len());
-    for (i, p) in file.particles.iter().enumerate() {
-        particles.push(inline_particle(
-            &at(p.span()),
-            i,
-            p.get_ref(),
-            &resolved_defaults,
-            render.lambda,
-        )?);
-    }
+    let mut particles = inline_particles(
+        &file.particles,
+        &at,
+        &whole,
+        given,
+        &resolved_defaults,
+        render.lambda,
+    )?;
     let mut warnings = Vec::new();
     let base = path.parent().unwrap_or(Path::new("."));
     let mut includes = Vec::with_capacity(file.include.len());
@@ -184,6 +206,11 @@ pub(super) fn load_toml(text: &str, path: &Path, options: &SceneLoadOptions) -> 
         .enumerate()
         .map(|(i, l)| light(&at(l.span()), i, l.get_ref()))
         .collect::<Result<Vec<_>>>()?;
+    let lights = if lights.is_empty() && default_lights {
+        thesis_lights()
+    } else {
+        lights
+    };
 
     let camera_path = camera(&file.camera, &at, &whole, options, &particles)?;
     let camera = first_camera(&camera_path, &file.camera, &at, &whole)?;
@@ -257,6 +284,53 @@ fn unreadable_include(
         "include: cannot read {}: {source}{relative}",
         path.display()
     ))
+}
+
+/// The scene file's `[[particles]]` tables, then the `given` particles checked as tables of
+/// the same kind (numbered after them, named with the whole file: no line wrote them).
+fn inline_particles<'a>(
+    tables: &[Spanned<ParticleTable>],
+    at: &dyn Fn(std::ops::Range<usize>) -> At<'a>,
+    whole: &At<'a>,
+    given: impl Iterator<Item = ParticleInput>,
+    defaults: &ResolvedDefaults,
+    lambda: f64,
+) -> Result<Vec<Particle>> {
+    let mut particles = Vec::with_capacity(tables.len());
+    for (i, p) in tables.iter().enumerate() {
+        particles.push(inline_particle(
+            &at(p.span()),
+            i,
+            p.get_ref(),
+            defaults,
+            lambda,
+        )?);
+    }
+    for (k, p) in given.enumerate() {
+        let i = tables.len() + k;
+        particles.push(inline_particle(
+            whole,
+            i,
+            &given_table(p),
+            defaults,
+            lambda,
+        )?);
+    }
+    Ok(particles)
+}
+
+/// A particle given by a program as the inline table it stands for.
+fn given_table(p: ParticleInput) -> ParticleTable {
+    ParticleTable {
+        center: p.center,
+        radius: p.radius,
+        color: p.color,
+        opacity: p.opacity,
+        kappa: p.kappa,
+        albedo: None,
+        ks: None,
+        shininess: None,
+    }
 }
 
 /// A bare particle file with the default scene of docs/design.md §1.
@@ -360,15 +434,20 @@ fn apply_overrides(
         r.model = m;
     }
     if let Some(t) = o.tol {
-        if !(t.is_finite() && t > 0.0) {
-            return Err(PgtError::Usage(format!(
-                "--tol must be a finite number > 0, got {t}"
-            )));
-        }
-        r.tol = t;
+        r.tol = checked_tol_override(t)?;
     }
     let _ = whole;
     Ok(r)
+}
+
+/// A tolerance given on the command line (`--tol`), or to the Python package's `render`.
+pub fn checked_tol_override(t: f64) -> Result<f64> {
+    if !(t.is_finite() && t > 0.0) {
+        return Err(PgtError::Usage(format!(
+            "--tol must be a finite number > 0, got {t}"
+        )));
+    }
+    Ok(t)
 }
 
 /// `[defaults]` with each field checked once.
