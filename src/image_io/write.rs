@@ -125,11 +125,13 @@ pub fn write_atomically(
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
     };
-    std::fs::create_dir_all(dir).map_err(|e| PgtError::io(dir, e))?;
     // Registered for removal on SIGINT/SIGTERM (crate::signals) from its creation on, and
     // renamed with the signal cleanup held off, so an interrupt leaves neither it nor half a file.
+    // The folder is made under the same hold: once the cleanup has removed a temporary report
+    // folder, no write may make it again before the process exits.
     let (tmp, guard) = crate::signals::track(
         || {
+            std::fs::create_dir_all(dir)?;
             tempfile::Builder::new()
                 .prefix(".pgt-partial-")
                 .tempfile_in(dir)
