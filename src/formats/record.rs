@@ -24,6 +24,61 @@ pub struct ParticleRecord {
     pub sigma: Option<f64>,
     /// Where in its file the particle was defined (line, or byte offset for binary formats).
     pub location: crate::error::Location,
+    /// An ellipsoid's semi-axes and orientation, where the file gives them (`radius` is then
+    /// its longest semi-axis); `None`: a sphere.
+    pub ellipsoid: Option<EllipsoidRecord>,
+}
+
+/// An ellipsoid as a file gives it (docs/design.md §9), checked by
+/// [`check_records`](super::check_records) and resolved (the quaternion normalised) when the
+/// scene is built.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EllipsoidRecord {
+    /// Semi-axes along the body's x, y, z, in the file's length unit.
+    pub semi_axes: DVec3,
+    /// The orientation (w, x, y, z), body to world, not necessarily of unit length.
+    pub rotation: [f64; 4],
+}
+
+impl EllipsoidRecord {
+    /// What is wrong with it, naming the field (`axes`: the three semi-axes' names, `rotation`:
+    /// the quaternion's), or `None`: every semi-axis finite and > 0, the quaternion finite and
+    /// not zero.
+    pub fn problem(&self, axes: [&str; 3], rotation: &str) -> Option<String> {
+        for (name, v) in axes.iter().zip(self.semi_axes.to_array()) {
+            if !(v.is_finite() && v > 0.0) {
+                return Some(format!(
+                    "{name} (a semi-axis) must be finite and > 0, got {v}"
+                ));
+            }
+        }
+        let q = self.rotation;
+        if !q.iter().all(|v| v.is_finite()) || q.iter().all(|&v| v == 0.0) {
+            return Some(format!(
+                "{rotation} must be a finite, non-zero quaternion (w, x, y, z), got {q:?}"
+            ));
+        }
+        None
+    }
+
+    /// The shape it describes, checked by [`EllipsoidRecord::problem`] first: the radius of the
+    /// particle (the longest semi-axis) and its ellipsoid with the quaternion normalised, or no
+    /// ellipsoid where the three semi-axes are equal (docs/design.md §9: that is the sphere, bit
+    /// for bit, whatever the rotation).
+    pub fn resolve(&self) -> (f64, Option<crate::geometry::Ellipsoid>) {
+        let s = self.semi_axes;
+        if s.x == s.y && s.y == s.z {
+            return (s.x, None);
+        }
+        let [w, x, y, z] = self.rotation;
+        // Scaled first, so that a quaternion of huge or tiny components normalises without
+        // overflow or underflow.
+        let q = glam::DVec4::new(x, y, z, w);
+        let q = q / q.abs().max_element();
+        let q = glam::DQuat::from_vec4(q.normalize());
+        let e = crate::geometry::Ellipsoid::new(s, q);
+        (e.bounding_radius(), Some(e))
+    }
 }
 
 /// How particles read from a file are coloured (PDB/mmCIF; `uniform` applies to every format).

@@ -7,6 +7,7 @@ use super::file::{
 };
 use super::framing::{default_camera, thesis_lights, DEFAULT_FOV_Y, DEFAULT_SIZE};
 use super::{IncludeSpec, ParticleRecord, RenderSettings, Scene, SceneLoadOptions};
+use crate::formats::EllipsoidRecord;
 use crate::error::{line_of, toml_error, At, Location, PgtError, Result, SourceText};
 use crate::geometry::{Camera, CameraPath, Keyframe};
 use crate::optics::extinction::Extinction;
@@ -441,10 +442,44 @@ fn inline_particle(
 ) -> Result<Particle> {
     let name = |f: &str| format!("particles[{i}].{f}");
     let center = at.vec3(&name("center"), p.center)?;
-    let radius = at.finite(&name("radius"), p.radius)?;
-    if radius <= 0.0 {
-        return Err(at.err(format!("{} must be > 0, got {radius}", name("radius"))));
-    }
+    let (radius, ellipsoid) = match (p.radius, p.semi_axes) {
+        (Some(radius), None) => {
+            if p.rotation.is_some() {
+                return Err(at.err(format!(
+                    "{} turns an ellipsoid: give semi_axes = [a, b, c] instead of radius",
+                    name("rotation")
+                )));
+            }
+            let radius = at.finite(&name("radius"), radius)?;
+            if radius <= 0.0 {
+                return Err(at.err(format!("{} must be > 0, got {radius}", name("radius"))));
+            }
+            (radius, None)
+        }
+        (None, Some(semi_axes)) => {
+            let record = EllipsoidRecord {
+                semi_axes: DVec3::from(semi_axes),
+                rotation: p.rotation.unwrap_or([1.0, 0.0, 0.0, 0.0]),
+            };
+            let axes = [0, 1, 2].map(|k| name(&format!("semi_axes[{k}]")));
+            if let Some(problem) = record.problem(axes.each_ref().map(|s| s.as_str()), &name("rotation")) {
+                return Err(at.err(problem));
+            }
+            record.resolve()
+        }
+        (Some(_), Some(_)) => {
+            return Err(at.err(format!(
+                "particles[{i}]: give radius (a sphere) or semi_axes (an ellipsoid), not both"
+            )))
+        }
+        (None, None) => {
+            return Err(at.err(format!(
+                "particles[{i}]: give radius = r (a sphere) or semi_axes = [a, b, c] (an ellipsoid)"
+            )))
+        }
+    };
+    // Θmax is the opacity along the shortest diameter (docs/design.md §9).
+    let sigma_radius = ellipsoid.map_or(radius, |e| e.shortest_semi_axis());
     if p.opacity.is_some() && p.kappa.is_some() {
         return Err(at.err(format!("particles[{i}]: set opacity or kappa, not both")));
     }
@@ -463,7 +498,7 @@ fn inline_particle(
         center,
         radius,
         color,
-        sigma: d.sigma(opacity, kappa, radius, lambda),
+        sigma: d.sigma(opacity, kappa, sigma_radius, lambda),
         albedo: p.albedo.map_or(Ok(d.albedo.unwrap_or(color)), |a| {
             at.non_negative3(&name("albedo"), a)
         })?,
@@ -473,6 +508,7 @@ fn inline_particle(
         shininess: p.shininess.map_or(Ok(d.shininess), |v| {
             at.in_range(&name("shininess"), v, 0.0, f64::MAX, "≥ 0")
         })?,
+        ellipsoid,
     })
 }
 
@@ -488,10 +524,20 @@ fn record_particle(
         location: rec.location.clone(),
     };
     let center = at.vec3("particle position", rec.center.to_array())?;
-    let radius = at.finite("particle radius", rec.radius)?;
+    let (radius, ellipsoid) = match &rec.ellipsoid {
+        Some(e) => {
+            if let Some(problem) = e.problem(["sx", "sy", "sz"], "the rotation qw, qx, qy, qz") {
+                return Err(at.err(format!("the particle's {problem}")));
+            }
+            e.resolve()
+        }
+        None => (at.finite("particle radius", rec.radius)?, None),
+    };
     if radius <= 0.0 {
         return Err(at.err(format!("particle radius must be > 0, got {radius}")));
     }
+    // Θmax is the opacity along the shortest diameter (docs/design.md §9).
+    let sigma_radius = ellipsoid.map_or(radius, |e| e.shortest_semi_axis());
     let color = rec.color.map_or(Ok(d.color), |c| {
         at.non_negative3("particle colour", c.to_array())
     })?;
@@ -506,10 +552,11 @@ fn record_particle(
         // A σ the file gives is the particle's σ exactly (crate::formats::xyz_csv, "σ and opacity").
         sigma: rec
             .sigma
-            .unwrap_or_else(|| d.sigma(opacity, None, radius, lambda)),
+            .unwrap_or_else(|| d.sigma(opacity, None, sigma_radius, lambda)),
         albedo: d.albedo.unwrap_or(color),
         ks: d.ks,
         shininess: d.shininess,
+        ellipsoid,
     })
 }
 

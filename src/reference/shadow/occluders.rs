@@ -28,12 +28,16 @@
 //! camera ray), and each interval's list is *narrowed* from it ([`Occluders::narrow`]: the same
 //! reach-range and half-space tests, no BVH). The narrowed list keeps the wide one's order and
 //! is a superset of the spheres crossed, so the hits are the same, in the same order (tested).
+//!
+//! **Ellipsoids** (docs/design.md §9) are culled as their bounding spheres (a superset of what
+//! their own test would keep) and tested exactly per shadow ray with the ellipsoid's
+//! intersection, the one [`Bvh::all_hits`] uses; their kinks are the ellipsoid's own.
 
 // `!(a > b)` is deliberate: unlike `a <= b` it is also true when a value is NaN, so degenerate
 // input takes the safe branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use crate::geometry::{Bvh, Chord, Hit, Ray};
+use crate::geometry::{Bvh, Chord, Ellipsoid, Hit, Ray, Shape};
 use crate::optics::kinks::{
     axis_approach, for_each_swept_leaf, push_sided_tangencies, solve_quadratic, swept_polygon,
     AxisApproach,
@@ -56,10 +60,33 @@ const RANGE_PADDING: f64 = 1e-6;
 #[derive(Debug, Clone, Copy)]
 struct Candidate {
     center: DVec3,
+    /// The sphere's radius, an ellipsoid's bounding radius.
     radius: f64,
     index: u32,
+    /// [`SPHERE`], or the position of the ellipsoid in the list's `ellipsoids`.
+    shape: u32,
     t_lo: f64,
     t_hi: f64,
+}
+
+/// [`Candidate::shape`] of a sphere.
+const SPHERE: u32 = u32::MAX;
+
+impl Candidate {
+    #[inline]
+    fn shape<'a>(&self, ellipsoids: &'a [Ellipsoid]) -> Shape<'a> {
+        if self.shape == SPHERE {
+            Shape::Sphere {
+                center: self.center,
+                radius: self.radius,
+            }
+        } else {
+            Shape::Ellipsoid {
+                center: self.center,
+                ellipsoid: &ellipsoids[self.shape as usize],
+            }
+        }
+    }
 }
 
 /// A shadow ray of [`Occluders::hits_batch`]: from the camera ray's point x(`t`), along
@@ -81,6 +108,8 @@ pub struct Occluders {
     ta: f64,
     tb: f64,
     candidates: Vec<Candidate>,
+    /// The ellipsoids among the candidates ([`Candidate::shape`]).
+    ellipsoids: Vec<Ellipsoid>,
 }
 
 impl Occluders {
@@ -103,6 +132,7 @@ impl Occluders {
         self.ta = ta;
         self.tb = tb;
         self.candidates.clear();
+        self.ellipsoids.clear();
     }
 
     /// Gathers the spheres of `bvh` whose padded box the polygon swept from [x(ta), x(tb)]
@@ -122,10 +152,10 @@ impl Occluders {
         let (ya, yb) = (camera_ray.at(ta), camera_ray.at(tb));
         let poly = swept_polygon(bvh, light, ya, yb);
         let ahead = AheadOfSegment::new(light, ya, yb);
-        let candidates = &mut self.candidates;
+        let (candidates, ellipsoids) = (&mut self.candidates, &mut self.ellipsoids);
         for_each_swept_leaf(bvh, &poly, |leaf| {
             // The leaf's centres and radii (the particles', in leaf order) lie together.
-            for (i, center, radius) in leaf.spheres() {
+            for (k, (i, center, radius)) in leaf.spheres().enumerate() {
                 let (t_lo, t_hi) = reach_range(camera_ray, light, center, radius, tb);
                 if !(t_lo <= tb && t_hi >= ta) {
                     continue;
@@ -139,10 +169,18 @@ impl Occluders {
                     _ => poly.overlaps_box(center - DVec3::splat(pad), center + DVec3::splat(pad)),
                 };
                 if near {
+                    let shape = match leaf.ellipsoid(k) {
+                        None => SPHERE,
+                        Some(e) => {
+                            ellipsoids.push(*e);
+                            ellipsoids.len() as u32 - 1
+                        }
+                    };
                     candidates.push(Candidate {
                         center,
                         radius,
                         index: i,
+                        shape,
                         t_lo,
                         t_hi,
                     });
@@ -203,7 +241,8 @@ impl Occluders {
             return;
         }
         for c in &self.candidates {
-            push_sided_tangencies(camera_ray, (t_lo, t_hi), light, (c.center, c.radius), out);
+            let shape = c.shape(&self.ellipsoids);
+            push_sided_tangencies(camera_ray, (t_lo, t_hi), light, shape, out);
         }
         out.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
         out.dedup_by(|b, a| {
@@ -244,7 +283,12 @@ impl Occluders {
                 _ => true,
             };
             if keep {
-                self.candidates.push(*c);
+                let mut c = *c;
+                if c.shape != SPHERE {
+                    self.ellipsoids.push(wide.ellipsoids[c.shape as usize]);
+                    c.shape = self.ellipsoids.len() as u32 - 1;
+                }
+                self.candidates.push(c);
             }
         }
     }
@@ -275,7 +319,7 @@ impl Occluders {
             o.clear();
         }
         for (shadow, out) in shadow.chunks(LANES).zip(out.chunks_mut(LANES)) {
-            hits_in_lanes(&self.candidates, shadow, out);
+            hits_in_lanes(&self.candidates, &self.ellipsoids, shadow, out);
         }
     }
 
@@ -300,7 +344,14 @@ const LANES: usize = 8;
 /// instruction, where the loop over one ray at a time waited for each), and kept where its
 /// checks pass. (Compiled for AVX2's four lanes it was no faster: 1UUN lit 128², one thread,
 /// 15 interleaved runs, fastest 1.27 s against 1.26 s.)
-fn hits_in_lanes(candidates: &[Candidate], shadow: &[ShadowRay], out: &mut [Vec<Hit>]) {
+///
+/// An ellipsoid's chords are its own intersection's, one shadow ray at a time.
+fn hits_in_lanes(
+    candidates: &[Candidate],
+    ellipsoids: &[Ellipsoid],
+    shadow: &[ShadowRay],
+    out: &mut [Vec<Hit>],
+) {
     let n = shadow.len().min(LANES);
     let (mut ox, mut oy, mut oz) = ([0.0; LANES], [0.0; LANES], [0.0; LANES]);
     let (mut dx, mut dy, mut dz) = ([0.0; LANES], [0.0; LANES], [0.0; LANES]);
@@ -318,6 +369,23 @@ fn hits_in_lanes(candidates: &[Candidate], shadow: &[ShadowRay], out: &mut [Vec<
     }
     for c in candidates {
         if c.t_hi < t_first || c.t_lo > t_last {
+            continue;
+        }
+        if c.shape != SPHERE {
+            let shape = c.shape(ellipsoids);
+            for (s, o) in shadow[..n].iter().zip(out.iter_mut()) {
+                if s.t < c.t_lo || s.t > c.t_hi {
+                    continue;
+                }
+                if let Some(chord) = shape.intersect(&s.ray) {
+                    if chord.t_exit > 0.0 && chord.t_enter < s.t_max {
+                        o.push(Hit {
+                            index: c.index,
+                            chord,
+                        });
+                    }
+                }
+            }
             continue;
         }
         let (cx, cy, cz, r) = (c.center.x, c.center.y, c.center.z, c.radius);
@@ -600,6 +668,7 @@ mod tests {
         };
         let particles: Vec<Particle> = (0..400)
             .map(|_| Particle {
+                ellipsoid: None,
                 center: v(6.0),
                 radius: 0.3 + 0.5 * v(1.0).x.abs(),
                 color: DVec3::ONE,
