@@ -104,7 +104,10 @@ fn equal_semi_axes_give_the_sphere() {
         .iter()
         .map(|p| {
             let mut e = *p;
-            e.ellipsoid = Some(Ellipsoid::new(DVec3::splat(p.radius), random_rotation(&mut rng)));
+            e.ellipsoid = Some(Ellipsoid::new(
+                DVec3::splat(p.radius),
+                random_rotation(&mut rng),
+            ));
             e
         })
         .collect();
@@ -142,7 +145,10 @@ fn turned(scene: &Scene, g: DQuat) -> Scene {
     for p in &mut s.particles {
         p.center = g * p.center;
         if let Some(e) = p.ellipsoid {
-            p.ellipsoid = Some(Ellipsoid::new(e.semi_axes(), (g * e.rotation()).normalize()));
+            p.ellipsoid = Some(Ellipsoid::new(
+                e.semi_axes(),
+                (g * e.rotation()).normalize(),
+            ));
         }
     }
     for l in &mut s.lights {
@@ -158,7 +164,12 @@ fn turned(scene: &Scene, g: DQuat) -> Scene {
 fn turning_the_particles_equals_turning_the_scene() {
     let mut rng = Rng::new(5);
     let mut particles = random_ellipsoids(&mut rng, 5, 8.0);
-    particles.push(particle(DVec3::new(0.3, -0.4, 0.2), 0.6, DVec3::new(0.2, 0.9, 0.4), 1.5));
+    particles.push(particle(
+        DVec3::new(0.3, -0.4, 0.2),
+        0.6,
+        DVec3::new(0.2, 0.9, 0.4),
+        1.5,
+    ));
     let g = random_rotation(&mut rng);
     for model in MODELS {
         let mut a = scene(model, particles.clone(), two_lights(), SIZE);
@@ -168,7 +179,11 @@ fn turning_the_particles_equals_turning_the_scene() {
         let ray = b.camera.pixel_ray(3, 17);
         let want = g * a.camera.pixel_ray(3, 17).direction;
         assert!((ray.direction - want).length() < 1e-14);
-        let slack = if model == models::EMISSION { 1e-11 } else { 1e-9 };
+        let slack = if model == models::EMISSION {
+            1e-11
+        } else {
+            1e-9
+        };
         agree_within_err(model.name(), &render(&a), &render(&b), slack);
     }
 }
@@ -296,7 +311,11 @@ fn source(
     };
     for light in lights {
         let inc = light.incident_at(x).unwrap();
-        let t_max = if inc.distance.is_finite() { inc.distance } else { 1e3 };
+        let t_max = if inc.distance.is_finite() {
+            inc.distance
+        } else {
+            1e3
+        };
         let medium = Medium::along(quadrics, x, inc.toward, t_max);
         let (radiance, transmittance) = medium.emission(inc.irradiance);
         if model == models::LIT {
@@ -335,7 +354,12 @@ fn oracle_scene(model: Model) -> (Scene, Ray) {
             DQuat::from_rotation_x(1.1) * DQuat::from_rotation_z(0.4),
             0.5,
         ),
-        particle(DVec3::new(0.1, 0.3, 1.0), 0.5, DVec3::new(0.6, 0.6, 0.2), 1.2),
+        particle(
+            DVec3::new(0.1, 0.3, 1.0),
+            0.5,
+            DVec3::new(0.6, 0.6, 0.2),
+            1.2,
+        ),
     ];
     let lights = vec![
         Light::Directional {
@@ -378,7 +402,11 @@ fn monte_carlo_agrees(model: Model) {
     let (s, ray) = oracle_scene(model);
     let quadrics: Vec<Quadric> = s.particles.iter().map(Quadric::of).collect();
     let medium = Medium::along(&quadrics, ray.origin, ray.direction, f64::INFINITY);
-    let lo = medium.chords.iter().map(|c| c.0).fold(f64::INFINITY, f64::min);
+    let lo = medium
+        .chords
+        .iter()
+        .map(|c| c.0)
+        .fold(f64::INFINITY, f64::min);
     let hi = medium.chords.iter().map(|c| c.1).fold(0.0, f64::max);
     let total_depth = medium.depth(hi);
     let f = |t: f64| {
@@ -414,7 +442,10 @@ fn monte_carlo_agrees(model: Model) {
         std_err
     );
     for c in 0..3 {
-        assert!(std_err[c] < 1e-4 * estimate[c], "the estimate is too coarse to say anything");
+        assert!(
+            std_err[c] < 1e-4 * estimate[c],
+            "the estimate is too coarse to say anything"
+        );
         assert!(
             (got.radiance[c] - estimate[c]).abs() <= 4.5 * std_err[c] + got.error[c],
             "{}: channel {c}: reference {} vs Monte Carlo {} ± {}",
@@ -466,9 +497,15 @@ fn check_honest(name: &str, mut s: Scene, min_seen: f64) {
             }
         }
         eprintln!("{name} tol {tol}: {violations} of {channels} channels beyond err, worst {worst:.3}·tol, {unconverged} unconverged");
-        assert!(violations <= channels / 1000, "{name} tol {tol}: {violations} violations");
+        assert!(
+            violations <= channels / 1000,
+            "{name} tol {tol}: {violations} violations"
+        );
         assert!(worst <= 1.0, "{name} tol {tol}: worst error {worst}·tol");
-        assert!(unconverged <= channels / 3000, "{name} tol {tol}: {unconverged} unconverged");
+        assert!(
+            unconverged <= channels / 3000,
+            "{name} tol {tol}: {unconverged} unconverged"
+        );
     }
 }
 
@@ -520,7 +557,12 @@ fn err_is_a_bound_for_thin_ellipsoids_grazing_shadows_and_a_light_inside() {
         })
         .collect();
     particles.push(ellipsoid(
-        particle(DVec3::new(0.2, -0.6, 0.3), 1.0, DVec3::new(0.3, 0.7, 0.9), 1.0),
+        particle(
+            DVec3::new(0.2, -0.6, 0.3),
+            1.0,
+            DVec3::new(0.3, 0.7, 0.9),
+            1.0,
+        ),
         DVec3::new(1.6, 0.08, 0.3),
         DQuat::from_rotation_y(0.3),
         0.9,
@@ -537,9 +579,7 @@ fn err_is_a_bound_for_thin_ellipsoids_grazing_shadows_and_a_light_inside() {
             falloff: Falloff::InverseSquare,
         },
     ];
-    assert!(particles[4]
-        .shape()
-        .contains(DVec3::new(0.6, -0.6, 0.4)));
+    assert!(particles[4].shape().contains(DVec3::new(0.6, -0.6, 0.4)));
     for model in [models::LIT, models::SINGLE_SCATTER] {
         let mut s = honest_scene(model, particles.clone(), lights.clone());
         // From the side, so that the discs (facing the light, along x) are seen at an angle.

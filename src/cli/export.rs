@@ -118,10 +118,11 @@ pub fn row(p: &Particle) -> [f64; 9] {
 
 /// A particle's row, in [`ELLIPSOID_COLUMNS`] order.
 pub fn ellipsoid_row(p: &Particle) -> [f64; 15] {
-    let (s, q) = p.ellipsoid.map_or(
-        (glam::DVec3::splat(p.radius), glam::DQuat::IDENTITY),
-        |e| (e.semi_axes(), e.rotation()),
-    );
+    let (s, q) = p
+        .ellipsoid
+        .map_or((glam::DVec3::splat(p.radius), glam::DQuat::IDENTITY), |e| {
+            (e.semi_axes(), e.rotation())
+        });
     [
         p.center.x,
         p.center.y,

@@ -42,13 +42,15 @@ pub struct EllipsoidRecord {
 
 impl EllipsoidRecord {
     /// What is wrong with it, naming the field (`axes`: the three semi-axes' names, `rotation`:
-    /// the quaternion's), or `None`: every semi-axis finite and > 0, the quaternion finite and
-    /// not zero.
+    /// the quaternion's), or `None`: every semi-axis finite and > 0 (not subnormal), the
+    /// quaternion finite and not zero.
     pub fn problem(&self, axes: [&str; 3], rotation: &str) -> Option<String> {
         for (name, v) in axes.iter().zip(self.semi_axes.to_array()) {
-            if !(v.is_finite() && v > 0.0) {
+            // A subnormal semi-axis has no finite reciprocal: the map to the unit sphere needs it.
+            if !(v.is_finite() && v >= f64::MIN_POSITIVE) {
                 return Some(format!(
-                    "{name} (a semi-axis) must be finite and > 0, got {v}"
+                    "{name} (a semi-axis) must be finite and > 0 (and not below {:e}), got {v}",
+                    f64::MIN_POSITIVE
                 ));
             }
         }

@@ -521,7 +521,9 @@ pub fn read_csv(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
             .map(|[sx, sy, sz]| {
                 let semi_axes = DVec3::new(get(sx, "sx")?, get(sy, "sy")?, get(sz, "sz")?);
                 let rotation = match c.rotation {
-                    Some([w, x, y, z]) => [get(w, "qw")?, get(x, "qx")?, get(y, "qy")?, get(z, "qz")?],
+                    Some([w, x, y, z]) => {
+                        [get(w, "qw")?, get(x, "qx")?, get(y, "qy")?, get(z, "qz")?]
+                    }
                     None => [1.0, 0.0, 0.0, 0.0],
                 };
                 Ok::<_, PgtError>(EllipsoidRecord {

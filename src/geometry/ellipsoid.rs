@@ -124,8 +124,14 @@ impl Ellipsoid {
 /// ellipsoid about a centre. Every geometric question has its answer for each shape here.
 #[derive(Debug, Clone, Copy)]
 pub enum Shape<'a> {
-    Sphere { center: DVec3, radius: f64 },
-    Ellipsoid { center: DVec3, ellipsoid: &'a Ellipsoid },
+    Sphere {
+        center: DVec3,
+        radius: f64,
+    },
+    Ellipsoid {
+        center: DVec3,
+        ellipsoid: &'a Ellipsoid,
+    },
 }
 
 impl Shape<'_> {
@@ -208,8 +214,16 @@ mod tests {
             let ray = Ray::new(o, d);
             let a = e.intersect(&ray, c).unwrap();
             let b = intersect_sphere(&ray, c, 2.0).unwrap();
-            assert_relative_eq!(a.t_enter, b.t_enter, epsilon = 1e-12 * b.t_enter.abs().max(1.0));
-            assert_relative_eq!(a.t_exit, b.t_exit, epsilon = 1e-12 * b.t_exit.abs().max(1.0));
+            assert_relative_eq!(
+                a.t_enter,
+                b.t_enter,
+                epsilon = 1e-12 * b.t_enter.abs().max(1.0)
+            );
+            assert_relative_eq!(
+                a.t_exit,
+                b.t_exit,
+                epsilon = 1e-12 * b.t_exit.abs().max(1.0)
+            );
         }
     }
 

@@ -95,6 +95,7 @@ pub const CROSSES_BELOW: u8 = 2;
 /// double root, the ray touching the cylinder, comes twice and gets both). For a point light
 /// the crossing side is the inside of the tangent cone, where the ray enters or leaves it
 /// ([`cone_roots`]); a root too close to double for that to be certain gets both.
+#[inline]
 pub(crate) fn push_sided_tangencies(
     ray: &Ray,
     (t_lo, t_hi): (f64, f64),
@@ -113,34 +114,43 @@ pub(crate) fn push_sided_tangencies(
 /// The two tangency roots of `shape` for `light` along `ray`, each with its side
 /// ([`push_sided_tangencies`]): a sphere's from [`sided_roots`], an ellipsoid's from the unit
 /// sphere's for the mapped ray and light (see the module documentation).
-#[inline]
+#[inline(always)]
 fn shape_roots(ray: &Ray, light: &Light, shape: Shape) -> ([Option<f64>; 2], [u8; 2]) {
     match shape {
         Shape::Sphere { center, radius } => sided_roots(ray, light, (center, radius)),
-        Shape::Ellipsoid { center, ellipsoid } => {
-            let (unit, k) = ellipsoid.unit_ray(ray, center);
-            let mapped = match *light {
-                Light::Directional {
-                    direction,
-                    irradiance,
-                } => Light::Directional {
-                    direction: ellipsoid.to_unit(DVec3::ZERO, direction).normalize(),
-                    irradiance,
-                },
-                Light::Point {
-                    position,
-                    intensity,
-                    falloff,
-                } => Light::Point {
-                    position: ellipsoid.to_unit(center, position),
-                    intensity,
-                    falloff,
-                },
-            };
-            let (roots, sides) = sided_roots(&unit, &mapped, (DVec3::ZERO, 1.0));
-            (roots.map(|s| s.map(|s| s / k)), sides)
-        }
+        Shape::Ellipsoid { center, ellipsoid } => ellipsoid_roots(ray, light, center, ellipsoid),
     }
+}
+
+/// [`shape_roots`] of an ellipsoid: the unit sphere's for the mapped ray and light.
+#[inline(never)]
+fn ellipsoid_roots(
+    ray: &Ray,
+    light: &Light,
+    center: DVec3,
+    ellipsoid: &crate::geometry::Ellipsoid,
+) -> ([Option<f64>; 2], [u8; 2]) {
+    let (unit, k) = ellipsoid.unit_ray(ray, center);
+    let mapped = match *light {
+        Light::Directional {
+            direction,
+            irradiance,
+        } => Light::Directional {
+            direction: ellipsoid.to_unit(DVec3::ZERO, direction).normalize(),
+            irradiance,
+        },
+        Light::Point {
+            position,
+            intensity,
+            falloff,
+        } => Light::Point {
+            position: ellipsoid.to_unit(center, position),
+            intensity,
+            falloff,
+        },
+    };
+    let (roots, sides) = sided_roots(&unit, &mapped, (DVec3::ZERO, 1.0));
+    (roots.map(|s| s.map(|s| s / k)), sides)
 }
 
 /// The two tangency roots of the sphere (c, r) for `light` along `ray`, each with its side
@@ -470,7 +480,11 @@ mod tests {
                 (unit, k, 1.0)
             }
         };
-        let center = if p.ellipsoid.is_some() { DVec3::ZERO } else { p.center };
+        let center = if p.ellipsoid.is_some() {
+            DVec3::ZERO
+        } else {
+            p.center
+        };
         let f = shadow.origin - center;
         let t_c = -f.dot(shadow.direction);
         let dist = (f + t_c * shadow.direction).length();
@@ -694,19 +708,12 @@ mod tests {
                 };
                 particles
                     .iter()
-                    .map(|p| {
-                        p.shape()
-                            .intersect(&sray)
-                            .is_some_and(|c| c.t_exit > 0.0)
-                    })
+                    .map(|p| p.shape().intersect(&sray).is_some_and(|c| c.t_exit > 0.0))
                     .collect()
             };
             let inside_at = |t: f64| -> Vec<bool> {
                 let x = ray.at(t);
-                particles
-                    .iter()
-                    .map(|p| p.shape().contains(x))
-                    .collect()
+                particles.iter().map(|p| p.shape().contains(x)).collect()
             };
             let n = 4000;
             let mut changes = 0;

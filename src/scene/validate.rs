@@ -7,8 +7,8 @@ use super::file::{
 };
 use super::framing::{default_camera, thesis_lights, DEFAULT_FOV_Y, DEFAULT_SIZE};
 use super::{IncludeSpec, ParticleRecord, RenderSettings, Scene, SceneLoadOptions};
-use crate::formats::EllipsoidRecord;
 use crate::error::{line_of, toml_error, At, Location, PgtError, Result, SourceText};
+use crate::formats::EllipsoidRecord;
 use crate::geometry::{Camera, CameraPath, Keyframe};
 use crate::optics::extinction::Extinction;
 use crate::optics::light::{Falloff, Light};
@@ -462,7 +462,9 @@ fn inline_particle(
                 rotation: p.rotation.unwrap_or([1.0, 0.0, 0.0, 0.0]),
             };
             let axes = [0, 1, 2].map(|k| name(&format!("semi_axes[{k}]")));
-            if let Some(problem) = record.problem(axes.each_ref().map(|s| s.as_str()), &name("rotation")) {
+            if let Some(problem) =
+                record.problem(axes.each_ref().map(|s| s.as_str()), &name("rotation"))
+            {
                 return Err(at.err(problem));
             }
             record.resolve()

@@ -30,8 +30,9 @@
 //! is a superset of the spheres crossed, so the hits are the same, in the same order (tested).
 //!
 //! **Ellipsoids** (docs/design.md §9) are culled as their bounding spheres (a superset of what
-//! their own test would keep) and tested exactly per shadow ray with the ellipsoid's
-//! intersection, the one [`Bvh::all_hits`] uses; their kinks are the ellipsoid's own.
+//! their own test would keep) and kept in a list of their own, after the spheres: each shadow
+//! ray tests them exactly with the ellipsoid's intersection, the one [`Bvh::all_hits`] uses,
+//! and their kinks are the ellipsoid's own. The spheres' lanes stay as they are.
 
 // `!(a > b)` is deliberate: unlike `a <= b` it is also true when a value is NaN, so degenerate
 // input takes the safe branch.
@@ -60,33 +61,10 @@ const RANGE_PADDING: f64 = 1e-6;
 #[derive(Debug, Clone, Copy)]
 struct Candidate {
     center: DVec3,
-    /// The sphere's radius, an ellipsoid's bounding radius.
     radius: f64,
     index: u32,
-    /// [`SPHERE`], or the position of the ellipsoid in the list's `ellipsoids`.
-    shape: u32,
     t_lo: f64,
     t_hi: f64,
-}
-
-/// [`Candidate::shape`] of a sphere.
-const SPHERE: u32 = u32::MAX;
-
-impl Candidate {
-    #[inline]
-    fn shape<'a>(&self, ellipsoids: &'a [Ellipsoid]) -> Shape<'a> {
-        if self.shape == SPHERE {
-            Shape::Sphere {
-                center: self.center,
-                radius: self.radius,
-            }
-        } else {
-            Shape::Ellipsoid {
-                center: self.center,
-                ellipsoid: &ellipsoids[self.shape as usize],
-            }
-        }
-    }
 }
 
 /// A shadow ray of [`Occluders::hits_batch`]: from the camera ray's point x(`t`), along
@@ -108,7 +86,9 @@ pub struct Occluders {
     ta: f64,
     tb: f64,
     candidates: Vec<Candidate>,
-    /// The ellipsoids among the candidates ([`Candidate::shape`]).
+    /// The candidates that are ellipsoids (their `radius` the bounding radius), with their
+    /// ellipsoids, position for position.
+    ellipsoid_candidates: Vec<Candidate>,
     ellipsoids: Vec<Ellipsoid>,
 }
 
@@ -132,6 +112,7 @@ impl Occluders {
         self.ta = ta;
         self.tb = tb;
         self.candidates.clear();
+        self.ellipsoid_candidates.clear();
         self.ellipsoids.clear();
     }
 
@@ -152,7 +133,9 @@ impl Occluders {
         let (ya, yb) = (camera_ray.at(ta), camera_ray.at(tb));
         let poly = swept_polygon(bvh, light, ya, yb);
         let ahead = AheadOfSegment::new(light, ya, yb);
-        let (candidates, ellipsoids) = (&mut self.candidates, &mut self.ellipsoids);
+        let candidates = &mut self.candidates;
+        let (ellipsoid_candidates, ellipsoids) =
+            (&mut self.ellipsoid_candidates, &mut self.ellipsoids);
         for_each_swept_leaf(bvh, &poly, |leaf| {
             // The leaf's centres and radii (the particles', in leaf order) lie together.
             for (k, (i, center, radius)) in leaf.spheres().enumerate() {
@@ -169,21 +152,20 @@ impl Occluders {
                     _ => poly.overlaps_box(center - DVec3::splat(pad), center + DVec3::splat(pad)),
                 };
                 if near {
-                    let shape = match leaf.ellipsoid(k) {
-                        None => SPHERE,
-                        Some(e) => {
-                            ellipsoids.push(*e);
-                            ellipsoids.len() as u32 - 1
-                        }
-                    };
-                    candidates.push(Candidate {
+                    let candidate = Candidate {
                         center,
                         radius,
                         index: i,
-                        shape,
                         t_lo,
                         t_hi,
-                    });
+                    };
+                    match leaf.ellipsoid(k) {
+                        None => candidates.push(candidate),
+                        Some(e) => {
+                            ellipsoid_candidates.push(candidate);
+                            ellipsoids.push(*e);
+                        }
+                    }
                 }
             }
         });
@@ -241,7 +223,17 @@ impl Occluders {
             return;
         }
         for c in &self.candidates {
-            let shape = c.shape(&self.ellipsoids);
+            let shape = Shape::Sphere {
+                center: c.center,
+                radius: c.radius,
+            };
+            push_sided_tangencies(camera_ray, (t_lo, t_hi), light, shape, out);
+        }
+        for (c, ellipsoid) in self.ellipsoid_candidates.iter().zip(&self.ellipsoids) {
+            let shape = Shape::Ellipsoid {
+                center: c.center,
+                ellipsoid,
+            };
             push_sided_tangencies(camera_ray, (t_lo, t_hi), light, shape, out);
         }
         out.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
@@ -272,31 +264,35 @@ impl Occluders {
     ) {
         self.start((tag, l), (ta, tb));
         let ahead = AheadOfSegment::new(light, camera_ray.at(ta), camera_ray.at(tb));
-        for c in &wide.candidates {
+        let keep = |c: &Candidate| {
             if !(c.t_lo <= tb && c.t_hi >= ta) {
-                continue;
+                return false;
             }
-            let keep = match &ahead {
+            match &ahead {
                 Some(ahead) if c.t_lo.is_finite() && c.t_hi.is_finite() => {
                     ahead.keeps(c.center, padded_radius(c.center, c.radius))
                 }
                 _ => true,
-            };
-            if keep {
-                let mut c = *c;
-                if c.shape != SPHERE {
-                    self.ellipsoids.push(wide.ellipsoids[c.shape as usize]);
-                    c.shape = self.ellipsoids.len() as u32 - 1;
-                }
-                self.candidates.push(c);
+            }
+        };
+        for c in &wide.candidates {
+            if keep(c) {
+                self.candidates.push(*c);
+            }
+        }
+        for (c, e) in wide.ellipsoid_candidates.iter().zip(&wide.ellipsoids) {
+            if keep(c) {
+                self.ellipsoid_candidates.push(*c);
+                self.ellipsoids.push(*e);
             }
         }
     }
 
     /// Every candidate whose chord overlaps (0, t_max) along `ray`, the shadow ray from the
     /// camera ray's point x(`t`): the set that [`Bvh::all_hits`]`(ray, 0, t_max)` returns for the
-    /// spheres with σ > 0 (the others contribute nothing to a shadow ray), in list order (the
-    /// interval cutter takes hits in any order and gives the same intervals). Candidates whose
+    /// spheres with σ > 0 (the others contribute nothing to a shadow ray), in list order, the
+    /// spheres' list before the ellipsoids' (the interval cutter takes hits in any order and
+    /// gives the same intervals). Candidates whose
     /// reach range excludes `t` are not tested. `out` is cleared first.
     #[cfg(test)]
     pub fn hits(&self, t: f64, ray: &Ray, t_max: f64, out: &mut Vec<Hit>) {
@@ -319,17 +315,48 @@ impl Occluders {
             o.clear();
         }
         for (shadow, out) in shadow.chunks(LANES).zip(out.chunks_mut(LANES)) {
-            hits_in_lanes(&self.candidates, &self.ellipsoids, shadow, out);
+            hits_in_lanes(&self.candidates, shadow, out);
+        }
+        if !self.ellipsoids.is_empty() {
+            ellipsoid_hits(&self.ellipsoid_candidates, &self.ellipsoids, shadow, out);
         }
     }
 
     /// Number of candidates in the current list.
     pub fn len(&self) -> usize {
-        self.candidates.len()
+        self.candidates.len() + self.ellipsoid_candidates.len()
     }
 
     pub fn is_empty(&self) -> bool {
-        self.candidates.is_empty()
+        self.len() == 0
+    }
+}
+
+/// The ellipsoids' part of [`Occluders::hits_batch`]: each candidate (`candidates[k]` with its
+/// ellipsoid `ellipsoids[k]`) against every shadow ray whose reach range holds it, with the
+/// ellipsoid's own intersection, appended to `out`.
+#[inline(never)]
+fn ellipsoid_hits(
+    candidates: &[Candidate],
+    ellipsoids: &[Ellipsoid],
+    shadow: &[ShadowRay],
+    out: &mut [Vec<Hit>],
+) {
+    for (c, ellipsoid) in candidates.iter().zip(ellipsoids) {
+        for (s, o) in shadow.iter().zip(out.iter_mut()) {
+            // Written so that a NaN t tests every candidate, as in the lanes.
+            if s.t < c.t_lo || s.t > c.t_hi {
+                continue;
+            }
+            if let Some(chord) = ellipsoid.intersect(&s.ray, c.center) {
+                if chord.t_exit > 0.0 && chord.t_enter < s.t_max {
+                    o.push(Hit {
+                        index: c.index,
+                        chord,
+                    });
+                }
+            }
+        }
     }
 }
 
@@ -344,14 +371,7 @@ const LANES: usize = 8;
 /// instruction, where the loop over one ray at a time waited for each), and kept where its
 /// checks pass. (Compiled for AVX2's four lanes it was no faster: 1UUN lit 128², one thread,
 /// 15 interleaved runs, fastest 1.27 s against 1.26 s.)
-///
-/// An ellipsoid's chords are its own intersection's, one shadow ray at a time.
-fn hits_in_lanes(
-    candidates: &[Candidate],
-    ellipsoids: &[Ellipsoid],
-    shadow: &[ShadowRay],
-    out: &mut [Vec<Hit>],
-) {
+fn hits_in_lanes(candidates: &[Candidate], shadow: &[ShadowRay], out: &mut [Vec<Hit>]) {
     let n = shadow.len().min(LANES);
     let (mut ox, mut oy, mut oz) = ([0.0; LANES], [0.0; LANES], [0.0; LANES]);
     let (mut dx, mut dy, mut dz) = ([0.0; LANES], [0.0; LANES], [0.0; LANES]);
@@ -369,23 +389,6 @@ fn hits_in_lanes(
     }
     for c in candidates {
         if c.t_hi < t_first || c.t_lo > t_last {
-            continue;
-        }
-        if c.shape != SPHERE {
-            let shape = c.shape(ellipsoids);
-            for (s, o) in shadow[..n].iter().zip(out.iter_mut()) {
-                if s.t < c.t_lo || s.t > c.t_hi {
-                    continue;
-                }
-                if let Some(chord) = shape.intersect(&s.ray) {
-                    if chord.t_exit > 0.0 && chord.t_enter < s.t_max {
-                        o.push(Hit {
-                            index: c.index,
-                            chord,
-                        });
-                    }
-                }
-            }
             continue;
         }
         let (cx, cy, cz, r) = (c.center.x, c.center.y, c.center.z, c.radius);
@@ -662,25 +665,48 @@ mod tests {
     /// time and in batches.
     #[test]
     fn list_hits_equal_bvh_hits() {
+        lists_equal_the_bvh(false);
+    }
+
+    /// The same with every third particle an ellipsoid (axis ratios up to 1:10, turned).
+    #[test]
+    fn list_hits_equal_bvh_hits_among_ellipsoids() {
+        lists_equal_the_bvh(true);
+    }
+
+    fn lists_equal_the_bvh(ellipsoids: bool) {
         let mut rng = SplitMix64::new(7);
         let mut v = |s: f64| {
             DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * 2.0 * s - DVec3::splat(s)
         };
         let particles: Vec<Particle> = (0..400)
-            .map(|_| Particle {
-                ellipsoid: None,
-                center: v(6.0),
-                radius: 0.3 + 0.5 * v(1.0).x.abs(),
-                color: DVec3::ONE,
-                sigma: 0.5,
-                albedo: DVec3::ONE,
-                ks: 0.0,
-                shininess: 0.0,
+            .map(|i| {
+                let mut p = Particle {
+                    ellipsoid: None,
+                    center: v(6.0),
+                    radius: 0.3 + 0.5 * v(1.0).x.abs(),
+                    color: DVec3::ONE,
+                    sigma: 0.5,
+                    albedo: DVec3::ONE,
+                    ks: 0.0,
+                    shininess: 0.0,
+                };
+                if ellipsoids && i % 3 == 0 {
+                    let w = v(1.0);
+                    let axes = p.radius * DVec3::new(1.0, 0.1 + w.x.abs(), 0.1 + w.y.abs());
+                    let q = glam::DQuat::from_xyzw(w.z, v(1.0).x, v(1.0).y, 0.5).normalize();
+                    let e = Ellipsoid::new(axes * 1.5, q);
+                    p.radius = e.bounding_radius();
+                    p.ellipsoid = Some(e);
+                }
+                p
             })
             .collect();
-        let bvh = Bvh::build(
+        let bvh = Bvh::build_shapes(
             particles.iter().map(|p| p.center).collect(),
             particles.iter().map(|p| p.radius).collect(),
+            particles.iter().map(|p| p.ellipsoid).collect(),
+            |_| true,
         );
         let lights = [
             Light::Directional {
