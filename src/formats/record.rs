@@ -31,7 +31,7 @@ pub struct ParticleRecord {
 
 /// An ellipsoid as a file gives it (docs/design.md §9), checked by
 /// [`check_records`](super::check_records) and resolved (the quaternion normalised) when the
-/// scene is built.
+/// scene is built (`scene::validate`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EllipsoidRecord {
     /// Semi-axes along the body's x, y, z, in the file's length unit.
@@ -61,25 +61,6 @@ impl EllipsoidRecord {
             ));
         }
         None
-    }
-
-    /// The shape it describes, checked by [`EllipsoidRecord::problem`] first: the radius of the
-    /// particle (the longest semi-axis) and its ellipsoid with the quaternion normalised, or no
-    /// ellipsoid where the three semi-axes are equal (docs/design.md §9: that is the sphere, bit
-    /// for bit, whatever the rotation).
-    pub fn resolve(&self) -> (f64, Option<crate::geometry::Ellipsoid>) {
-        let s = self.semi_axes;
-        if s.x == s.y && s.y == s.z {
-            return (s.x, None);
-        }
-        let [w, x, y, z] = self.rotation;
-        // Scaled first, so that a quaternion of huge or tiny components normalises without
-        // overflow or underflow.
-        let q = glam::DVec4::new(x, y, z, w);
-        let q = q / q.abs().max_element();
-        let q = glam::DQuat::from_vec4(q.normalize());
-        let e = crate::geometry::Ellipsoid::new(s, q);
-        (e.bounding_radius(), Some(e))
     }
 }
 

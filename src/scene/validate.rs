@@ -9,7 +9,7 @@ use super::framing::{default_camera, thesis_lights, DEFAULT_FOV_Y, DEFAULT_SIZE}
 use super::{IncludeSpec, ParticleRecord, RenderSettings, Scene, SceneLoadOptions};
 use crate::error::{line_of, toml_error, At, Location, PgtError, Result, SourceText};
 use crate::formats::EllipsoidRecord;
-use crate::geometry::{Camera, CameraPath, Keyframe};
+use crate::geometry::{Camera, CameraPath, Ellipsoid, Keyframe};
 use crate::optics::extinction::Extinction;
 use crate::optics::light::{Falloff, Light};
 use crate::optics::particle::Particle;
@@ -467,7 +467,7 @@ fn inline_particle(
             {
                 return Err(at.err(problem));
             }
-            record.resolve()
+            resolve_ellipsoid(&record)
         }
         (Some(_), Some(_)) => {
             return Err(at.err(format!(
@@ -531,7 +531,7 @@ fn record_particle(
             if let Some(problem) = e.problem(["sx", "sy", "sz"], "the rotation qw, qx, qy, qz") {
                 return Err(at.err(format!("the particle's {problem}")));
             }
-            e.resolve()
+            resolve_ellipsoid(e)
         }
         None => (at.finite("particle radius", rec.radius)?, None),
     };
@@ -560,6 +560,24 @@ fn record_particle(
         shininess: d.shininess,
         ellipsoid,
     })
+}
+
+/// The shape an ellipsoid record describes, checked by [`EllipsoidRecord::problem`] first: the
+/// radius of the particle (the longest semi-axis) and its ellipsoid with the quaternion
+/// normalised, or no ellipsoid where the three semi-axes are equal (docs/design.md §9: that is
+/// the sphere, bit for bit, whatever the rotation).
+fn resolve_ellipsoid(e: &EllipsoidRecord) -> (f64, Option<Ellipsoid>) {
+    let s = e.semi_axes;
+    if s.x == s.y && s.y == s.z {
+        return (s.x, None);
+    }
+    let [w, x, y, z] = e.rotation;
+    // Scaled first, so that a quaternion of huge or tiny components normalises without
+    // overflow or underflow.
+    let q = glam::DVec4::new(x, y, z, w);
+    let q = q / q.abs().max_element();
+    let ellipsoid = Ellipsoid::new(s, glam::DQuat::from_vec4(q.normalize()));
+    (ellipsoid.bounding_radius(), Some(ellipsoid))
 }
 
 fn light(at: &At, i: usize, l: &LightTable) -> Result<Light> {
