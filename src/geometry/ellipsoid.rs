@@ -25,7 +25,7 @@ pub struct Ellipsoid {
     /// Orientation, body to world: a unit quaternion.
     rotation: DQuat,
     /// M = S⁻¹Rᵀ: a world offset from the centre to unit-sphere coordinates (the inverse, R·S,
-    /// is needed rarely and made when it is: [`Ellipsoid::from_unit`]).
+    /// is needed rarely and made when it is: [`Ellipsoid::unit_to_world`]).
     to_unit: DMat3,
 }
 
@@ -42,7 +42,7 @@ impl Ellipsoid {
     }
 
     /// M⁻¹ = R·S: unit-sphere coordinates to a world offset from the centre.
-    fn from_unit(&self) -> DMat3 {
+    fn unit_to_world(&self) -> DMat3 {
         DMat3::from_quat(self.rotation) * DMat3::from_diagonal(self.semi_axes)
     }
 
@@ -101,7 +101,7 @@ impl Ellipsoid {
     /// Half the extent of the tightest axis-aligned box about the centre: along world axis i,
     /// √Σⱼ (R_ij·s_j)² (the support of the ellipsoid in direction eᵢ).
     pub fn half_extent(&self) -> DVec3 {
-        let m = self.from_unit().transpose();
+        let m = self.unit_to_world().transpose();
         DVec3::new(m.x_axis.length(), m.y_axis.length(), m.z_axis.length())
     }
 
@@ -119,7 +119,7 @@ impl Ellipsoid {
     /// `x` moved onto the surface along the line through the centre (the unit sphere's
     /// radial projection, mapped back).
     pub fn snap_to_surface(&self, center: DVec3, x: DVec3) -> DVec3 {
-        center + self.from_unit() * self.to_unit(center, x).normalize_or_zero()
+        center + self.unit_to_world() * self.to_unit(center, x).normalize_or_zero()
     }
 }
 
@@ -289,7 +289,7 @@ mod tests {
                 for j in 0..32 {
                     let (th, ph) = (std::f64::consts::TAU * i as f64 / 64.0, std::f64::consts::PI * j as f64 / 31.0);
                     let u = DVec3::new(ph.sin() * th.cos(), ph.sin() * th.sin(), ph.cos());
-                    let x = e.from_unit() * u;
+                    let x = e.unit_to_world() * u;
                     prop_assert!(x.abs().cmple(half * (1.0 + 1e-12)).all());
                     reached = reached.max(x.abs());
                 }
