@@ -21,6 +21,7 @@ fn random_scene(n: usize, size: u32) -> Scene {
             let c = DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * side;
             let color = DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64());
             Particle {
+                ellipsoid: None,
                 center: c,
                 radius: 1.2 + 0.7 * rng.next_f64(),
                 color,

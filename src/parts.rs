@@ -110,6 +110,7 @@ impl Fnv128 {
             albedo,
             ks,
             shininess,
+            ellipsoid,
         } = *p;
         self.vec3(center);
         self.f64(radius);
@@ -118,6 +119,18 @@ impl Fnv128 {
         self.vec3(albedo);
         self.f64(ks);
         self.f64(shininess);
+        // An ellipsoid is its semi-axes and rotation (the rest of it is computed from them).
+        match ellipsoid {
+            None => self.word(0),
+            Some(e) => {
+                self.word(1);
+                self.vec3(e.semi_axes());
+                let q = e.rotation();
+                for v in [q.x, q.y, q.z, q.w] {
+                    self.f64(v);
+                }
+            }
+        }
     }
 }
 

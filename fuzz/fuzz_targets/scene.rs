@@ -25,6 +25,10 @@ const FILES: &[(&str, &str)] = &[
          ATOM C A 1.0 2.0 3.0\nATOM O B 2.0 2.0 3.0\n",
     ),
     ("a.csv", "x,y,z,radius,red,green,blue,opacity\n0,0,0,1,1,0,0,0.5\n1,0,0,0.5,0,1,0,0.9\n"),
+    (
+        "b.csv",
+        "x,y,z,sx,sy,sz,qw,qx,qy,qz,opacity\n0,0,0,1,0.1,0.5,1,0,0,0,0.5\n1,0,0,0.5,0.5,0.5,0.3,0.2,0.1,0.9,0.9\n",
+    ),
     ("a.xyz", "2\nframe 0\nC 0 0 0\nO 1 0 0\n1\nframe 1\nH 0 1 0\n"),
     (
         "a.wrl",

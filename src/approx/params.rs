@@ -82,11 +82,12 @@ impl Method {
         }
     }
 
-    /// Refuses combinations that have no meaning, with a message that says what to do.
+    /// Refuses combinations that have no meaning, with a message that says what to do (a user
+    /// shader too refuses ellipsoids: [`methods::check_shapes`]).
     pub fn check_scene(&self, scene: &Scene) -> Result<()> {
         match self {
             Method::Builtin(m) => m.check_scene(scene),
-            Method::User(_) => Ok(()),
+            Method::User(_) => methods::check_shapes(&self.name(), scene),
         }
     }
 

@@ -14,6 +14,11 @@
 //!
 //! Θmax = 1 − e^{−2rσ} (docs/design.md §1 inverted; for a particle given by κ it is the opacity that
 //! the resolved σ has along a diameter).
+//!
+//! **Ellipsoids** (docs/design.md §9): where the scene has any, both formats replace `radius`
+//! with the semi-axes `sx sy sz` and the unit quaternion `qw qx qy qz` (a sphere's row has three
+//! equal semi-axes and the identity), the columns pgt's CSV reader takes, and Θmax is the
+//! opacity along the shortest diameter (r the shortest semi-axis above).
 
 use super::output::{check_outputs, Output, OutputKind};
 use super::Outcome;
@@ -73,13 +78,30 @@ pub const COLUMNS: [&str; 9] = [
     "x", "y", "z", "radius", "red", "green", "blue", "opacity", "sigma",
 ];
 
-/// Θmax = 1 − e^{−2rσ}, the opacity along a diameter (docs/design.md §1); 1 for σ = ∞. `expm1` keeps
-/// small opacities exact.
+/// The columns of a scene with ellipsoids, in the order both formats store them.
+pub const ELLIPSOID_COLUMNS: [&str; 15] = [
+    "x", "y", "z", "sx", "sy", "sz", "qw", "qx", "qy", "qz", "red", "green", "blue", "opacity",
+    "sigma",
+];
+
+/// The columns for `particles`: [`ELLIPSOID_COLUMNS`] where any is an ellipsoid, else
+/// [`COLUMNS`].
+pub fn columns(particles: &[Particle]) -> &'static [&'static str] {
+    if particles.iter().any(|p| p.ellipsoid.is_some()) {
+        &ELLIPSOID_COLUMNS
+    } else {
+        &COLUMNS
+    }
+}
+
+/// Θmax = 1 − e^{−2rσ}, the opacity along a diameter (docs/design.md §1), the shortest one of an
+/// ellipsoid (§9); 1 for σ = ∞. `expm1` keeps small opacities exact.
 pub fn opacity_of(p: &Particle) -> f64 {
+    let r = p.ellipsoid.map_or(p.radius, |e| e.shortest_semi_axis());
     if p.sigma == f64::INFINITY {
         1.0
     } else {
-        -(-2.0 * p.radius * p.sigma).exp_m1()
+        -(-2.0 * r * p.sigma).exp_m1()
     }
 }
 
@@ -98,11 +120,49 @@ pub fn row(p: &Particle) -> [f64; 9] {
     ]
 }
 
+/// A particle's row, in [`ELLIPSOID_COLUMNS`] order.
+pub fn ellipsoid_row(p: &Particle) -> [f64; 15] {
+    let (s, q) = p
+        .ellipsoid
+        .map_or((glam::DVec3::splat(p.radius), glam::DQuat::IDENTITY), |e| {
+            (e.semi_axes(), e.rotation())
+        });
+    [
+        p.center.x,
+        p.center.y,
+        p.center.z,
+        s.x,
+        s.y,
+        s.z,
+        q.w,
+        q.x,
+        q.y,
+        q.z,
+        p.color.x,
+        p.color.y,
+        p.color.z,
+        opacity_of(p),
+        p.sigma,
+    ]
+}
+
+/// The rows of `particles` in the order of [`columns`].
+fn rows(particles: &[Particle]) -> impl Iterator<Item = Vec<f64>> + '_ {
+    let ellipsoids = columns(particles).len() == ELLIPSOID_COLUMNS.len();
+    particles.iter().map(move |p| {
+        if ellipsoids {
+            ellipsoid_row(p).to_vec()
+        } else {
+            row(p).to_vec()
+        }
+    })
+}
+
 /// Writes the CSV form (see the module docs).
 pub fn write_csv(w: &mut impl Write, particles: &[Particle]) -> std::io::Result<()> {
-    writeln!(w, "{}", COLUMNS.join(","))?;
-    for p in particles {
-        let cells: Vec<String> = row(p).iter().map(|v| format!("{v:?}")).collect();
+    writeln!(w, "{}", columns(particles).join(","))?;
+    for r in rows(particles) {
+        let cells: Vec<String> = r.iter().map(|v| format!("{v:?}")).collect();
         writeln!(w, "{}", cells.join(","))?;
     }
     Ok(())
@@ -117,12 +177,12 @@ pub fn write_ply(w: &mut impl Write, particles: &[Particle]) -> std::io::Result<
         "comment pgt export: linear RGB colour, opacity = Theta_max, sigma = extinction in 1/m (inf for opacity 1)"
     )?;
     writeln!(w, "element vertex {}", particles.len())?;
-    for c in COLUMNS {
+    for c in columns(particles) {
         writeln!(w, "property double {c}")?;
     }
     writeln!(w, "end_header")?;
-    for p in particles {
-        for v in row(p) {
+    for r in rows(particles) {
+        for v in r {
             w.write_all(&v.to_le_bytes())?;
         }
     }

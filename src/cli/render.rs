@@ -133,12 +133,23 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
     write_image(&args.output, &out.image, &layers, args.exposure)?;
     let s = &out.stats;
     let rays = s.primary_rays + s.shadow_rays;
+    let ellipsoids = scene
+        .particles
+        .iter()
+        .filter(|p| p.ellipsoid.is_some())
+        .count();
+    let particles = match ellipsoids {
+        0 => format!("{} spheres", scene.particles.len()),
+        n => format!(
+            "{} particles, {n} of them ellipsoids",
+            scene.particles.len()
+        ),
+    };
     let mut line = format!(
-        "rendered {} ({}x{}, {} spheres, {} lights) in {:.2} s: {} primary + {} shadow rays, {:.3} Mrays/s",
+        "rendered {} ({}x{}, {particles}, {} lights) in {:.2} s: {} primary + {} shadow rays, {:.3} Mrays/s",
         args.output.display(),
         scene.camera.width,
         scene.camera.height,
-        scene.particles.len(),
         scene.lights.len(),
         s.seconds,
         s.primary_rays,

@@ -366,6 +366,7 @@ pub(crate) fn make_records(
             ColorBy::Uniform => None,
         };
         records.push(ParticleRecord {
+            ellipsoid: None,
             center: a.position,
             radius: element_radius(a.element),
             color,

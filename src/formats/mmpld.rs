@@ -627,6 +627,7 @@ fn read_list_particles(
             ));
         }
         out.push(ParticleRecord {
+            ellipsoid: None,
             center,
             radius,
             color: Some(color),

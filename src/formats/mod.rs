@@ -30,7 +30,7 @@ pub mod vrml;
 pub mod xtc;
 pub mod xyz_csv;
 
-pub use record::{ColorBy, IncludeSpec, ParticleRecord};
+pub use record::{ColorBy, EllipsoidRecord, IncludeSpec, ParticleRecord};
 
 use crate::error::{PgtError, Result};
 use std::path::Path;
@@ -223,6 +223,9 @@ pub(crate) fn apply_include_options(spec: &IncludeSpec, records: &mut [ParticleR
     if spec.radius_scale != 1.0 {
         for r in records.iter_mut() {
             r.radius *= spec.radius_scale;
+            if let Some(e) = &mut r.ellipsoid {
+                e.semi_axes *= spec.radius_scale;
+            }
         }
     }
     if spec.color_by == ColorBy::Uniform {
@@ -252,11 +255,16 @@ fn no_particles(spec: &IncludeSpec, format: &Format, len: usize, warnings: &[Str
 }
 
 /// Every particle has a finite centre, a finite radius > 0, a colour ≥ 0 and an opacity in
-/// [0, 1] (also for `pgt info`, which does not build a scene); the error points at the
-/// particle's line or byte.
+/// [0, 1], and an ellipsoid finite semi-axes > 0 and a finite, non-zero quaternion (also for
+/// `pgt info`, which does not build a scene); the error points at the particle's line or byte.
 pub(crate) fn check_records(path: &Path, records: &[ParticleRecord]) -> Result<()> {
     for r in records {
-        let problem = if !r.center.is_finite() {
+        let problem = if let Some(problem) = r
+            .ellipsoid
+            .and_then(|e| e.problem(["sx", "sy", "sz"], "the rotation qw, qx, qy, qz"))
+        {
+            Some(format!("the particle's {problem}"))
+        } else if !r.center.is_finite() {
             Some(format!("the particle position {} is not finite", r.center))
         } else if !(r.radius.is_finite() && r.radius > 0.0) {
             Some(format!(

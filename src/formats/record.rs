@@ -24,6 +24,44 @@ pub struct ParticleRecord {
     pub sigma: Option<f64>,
     /// Where in its file the particle was defined (line, or byte offset for binary formats).
     pub location: crate::error::Location,
+    /// An ellipsoid's semi-axes and orientation, where the file gives them (`radius` is then
+    /// its longest semi-axis); `None`: a sphere.
+    pub ellipsoid: Option<EllipsoidRecord>,
+}
+
+/// An ellipsoid as a file gives it (docs/design.md §9), checked by
+/// [`check_records`](super::check_records) and resolved (the quaternion normalised) when the
+/// scene is built (`scene::validate`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EllipsoidRecord {
+    /// Semi-axes along the body's x, y, z, in the file's length unit.
+    pub semi_axes: DVec3,
+    /// The orientation (w, x, y, z), body to world, not necessarily of unit length.
+    pub rotation: [f64; 4],
+}
+
+impl EllipsoidRecord {
+    /// What is wrong with it, naming the field (`axes`: the three semi-axes' names, `rotation`:
+    /// the quaternion's), or `None`: every semi-axis finite and > 0 (not subnormal), the
+    /// quaternion finite and not zero.
+    pub fn problem(&self, axes: [&str; 3], rotation: &str) -> Option<String> {
+        for (name, v) in axes.iter().zip(self.semi_axes.to_array()) {
+            // A subnormal semi-axis has no finite reciprocal: the map to the unit sphere needs it.
+            if !(v.is_finite() && v >= f64::MIN_POSITIVE) {
+                return Some(format!(
+                    "{name} (a semi-axis) must be finite and > 0 (and not below {:e}), got {v}",
+                    f64::MIN_POSITIVE
+                ));
+            }
+        }
+        let q = self.rotation;
+        if !q.iter().all(|v| v.is_finite()) || q.iter().all(|&v| v == 0.0) {
+            return Some(format!(
+                "{rotation} must be a finite, non-zero quaternion (w, x, y, z), got {q:?}"
+            ));
+        }
+        None
+    }
 }
 
 /// How particles read from a file are coloured (PDB/mmCIF; `uniform` applies to every format).

@@ -11,7 +11,13 @@
 //! is red, and a second `r`, or `radius`, is the radius), linear RGB ≥ 0; `opacity` (Θmax in
 //! [0, 1]); `sigma` (extinction σ in 1/length, ≥ 0, `inf` for a perfectly absorbing ball).
 //! Without a radius column every particle has radius 1 (with a warning). Blank lines and lines
-//! starting with `#` are skipped. `pgt export`'s CSV is such a file and reads back without a
+//! starting with `#` are skipped.
+//!
+//! **Ellipsoids** (docs/design.md §9): columns `sx`, `sy`, `sz` (the semi-axes along the body's
+//! axes, in place of `radius`, all three or none) and optionally `qw`, `qx`, `qy`, `qz` (the
+//! orientation, body to world, a quaternion that need not have unit length; without them the
+//! body's axes are the scene's). Every row of such a file is an ellipsoid; one with three equal
+//! semi-axes is the sphere of that radius. `opacity` is then Θmax along the shortest axis. `pgt export`'s CSV is such a file and reads back without a
 //! warning, σ bit for bit.
 //!
 //! **σ and opacity.** A particle's σ, where the file gives one, is its σ exactly (no λ, no
@@ -24,7 +30,7 @@ use super::elements::{element_color, element_radius, Element};
 use super::frame_source::{
     finish_frame, past_the_end, scan_lines, ByteSource, Frame, FrameInfo, FrameSource, TextFrames,
 };
-use super::{Format, IncludeSpec, LoadedParticles, ParticleRecord};
+use super::{EllipsoidRecord, Format, IncludeSpec, LoadedParticles, ParticleRecord};
 use crate::error::{Location, PgtError, Result};
 use glam::DVec3;
 use std::path::Path;
@@ -166,6 +172,7 @@ fn read_xyz_from(spec: &IncludeSpec, bytes: &[u8], first_line: usize) -> Result<
             }
             let c = |i: usize, w: &str| number(path, l, w, f.get(i).copied().unwrap_or_default());
             records.push(ParticleRecord {
+                ellipsoid: None,
                 center: DVec3::new(c(1, "x")?, c(2, "y")?, c(3, "z")?),
                 radius: element_radius(el),
                 color: Some(element_color(el)),
@@ -319,6 +326,10 @@ struct Columns {
     rgb: Option<[usize; 3]>,
     opacity: Option<usize>,
     sigma: Option<usize>,
+    /// `sx, sy, sz`.
+    semi_axes: Option<[usize; 3]>,
+    /// `qw, qx, qy, qz`.
+    rotation: Option<[usize; 4]>,
 }
 
 fn columns(path: &Path, line: usize, header: &str, warnings: &mut Vec<String>) -> Result<Columns> {
@@ -373,6 +384,45 @@ fn columns(path: &Path, line: usize, header: &str, warnings: &mut Vec<String>) -
     }
     cols.opacity = find("opacity");
     cols.sigma = find("sigma");
+    let all = |names: &[&str]| -> Result<Option<Vec<usize>>> {
+        let found: Vec<Option<usize>> = names.iter().map(|n| find(n)).collect();
+        if found.iter().all(Option::is_none) {
+            return Ok(None);
+        }
+        if let Some(k) = found.iter().position(Option::is_none) {
+            return Err(PgtError::at_line(
+                path,
+                line,
+                format!(
+                    "the header names some of the columns {} but not {}: give all of them or none",
+                    names.join(", "),
+                    names[k]
+                ),
+            ));
+        }
+        Ok(Some(found.into_iter().flatten().collect()))
+    };
+    cols.semi_axes = all(&["sx", "sy", "sz"])?.map(|v| [v[0], v[1], v[2]]);
+    cols.rotation = all(&["qw", "qx", "qy", "qz"])?.map(|v| [v[0], v[1], v[2], v[3]]);
+    if cols.semi_axes.is_some() && find("radius").is_some() {
+        return Err(PgtError::at_line(
+            path,
+            line,
+            "the header names both radius and the semi-axes sx, sy, sz: a row is a sphere (radius) or an ellipsoid (sx, sy, sz), give one of them",
+        ));
+    }
+    if cols.semi_axes.is_some() {
+        // An `r` column is red, never a radius, where the semi-axes give the size.
+        cols.radius = None;
+    } else if cols.rotation.is_some() {
+        return Err(PgtError::at_line(
+            path,
+            line,
+            "the header names the rotation qw, qx, qy, qz but not the semi-axes sx, sy, sz it turns",
+        ));
+    }
+    used.extend(cols.semi_axes.iter().flatten());
+    used.extend(cols.rotation.iter().flatten());
     used.extend(cols.radius);
     used.extend(cols.rgb.iter().flatten());
     used.extend(cols.opacity);
@@ -390,7 +440,7 @@ fn columns(path: &Path, line: usize, header: &str, warnings: &mut Vec<String>) -
             unused
         ));
     }
-    if cols.radius.is_none() {
+    if cols.radius.is_none() && cols.semi_axes.is_none() {
         warnings.push(format!(
             "{}: no radius column; every particle has radius 1",
             path.display()
@@ -466,16 +516,38 @@ pub fn read_csv(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
         let get =
             |i: usize, what: &str| number(path, line, what, f.get(i).copied().unwrap_or_default());
         let [xi, yi, zi] = c.xyz;
-        let radius = c.radius.map_or(Ok(1.0), |i| get(i, "radius"))?;
+        let ellipsoid = c
+            .semi_axes
+            .map(|[sx, sy, sz]| {
+                let semi_axes = DVec3::new(get(sx, "sx")?, get(sy, "sy")?, get(sz, "sz")?);
+                let rotation = match c.rotation {
+                    Some([w, x, y, z]) => {
+                        [get(w, "qw")?, get(x, "qx")?, get(y, "qy")?, get(z, "qz")?]
+                    }
+                    None => [1.0, 0.0, 0.0, 0.0],
+                };
+                Ok::<_, PgtError>(EllipsoidRecord {
+                    semi_axes,
+                    rotation,
+                })
+            })
+            .transpose()?;
+        let radius = match &ellipsoid {
+            Some(e) => e.semi_axes.max_element(),
+            None => c.radius.map_or(Ok(1.0), |i| get(i, "radius"))?,
+        };
         let opacity = c.opacity.map(|i| get(i, "opacity")).transpose()?;
         let sigma = c
             .sigma
             .map(|i| sigma(path, line, f.get(i).copied().unwrap_or_default()))
             .transpose()?;
         if let (Some(o), Some(s)) = (opacity, sigma) {
-            check_agreement(path, line, radius, o, s)?;
+            // Θmax is the opacity along the shortest diameter (docs/design.md §9).
+            let r = ellipsoid.map_or(radius, |e| e.semi_axes.min_element());
+            check_agreement(path, line, r, o, s)?;
         }
         records.push(ParticleRecord {
+            ellipsoid,
             center: DVec3::new(get(xi, "x")?, get(yi, "y")?, get(zi, "z")?),
             radius,
             color: c

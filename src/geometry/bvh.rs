@@ -1,11 +1,12 @@
-//! A bounding volume hierarchy over spheres, built with binned SAH (docs/design.md §3).
+//! A bounding volume hierarchy over spheres and ellipsoids, built with binned SAH
+//! (docs/design.md §3, §9).
 //!
 //! Nodes live in one flat `Vec` (the GPU side flattens the same array into a storage buffer);
 //! memory is O(n): at most 2n − 1 nodes of 56 bytes and one u32 index per sphere.
 //! Two queries: every sphere a ray crosses, sorted by entry (the volume renderer cuts rays into
 //! intervals with them) and whether any sphere blocks a segment (shadow rays).
 
-use super::{intersect_sphere, Chord, Ray};
+use super::{intersect_sphere, Chord, Ellipsoid, Ray, Shape};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -44,6 +45,10 @@ pub struct Bvh {
     /// large scene).
     centers: Vec<DVec3>,
     radii: Vec<f64>,
+    /// In leaf order, the ellipsoid about each centre (`None`: the sphere of its radius, which
+    /// for an ellipsoid is its bounding radius); empty where every particle is a sphere, so
+    /// that sphere scenes take the sphere-only loop.
+    ellipsoids: Vec<Option<Ellipsoid>>,
 }
 
 /// The spheres of one BVH leaf: their indices in the caller's order, centres and radii.
@@ -51,7 +56,10 @@ pub struct Bvh {
 pub struct Leaf<'a> {
     pub indices: &'a [u32],
     pub centers: &'a [DVec3],
+    /// Radii of the spheres, bounding radii of the ellipsoids.
     pub radii: &'a [f64],
+    /// The ellipsoids by leaf position; empty where the tree holds spheres only.
+    pub ellipsoids: &'a [Option<Ellipsoid>],
 }
 
 impl<'a> Leaf<'a> {
@@ -63,6 +71,23 @@ impl<'a> Leaf<'a> {
             .zip(centers)
             .zip(radii)
             .map(|((&i, &c), &r)| (i, c, r))
+    }
+
+    /// The ellipsoid of the leaf's `k`-th particle, `None` for a sphere.
+    #[inline]
+    pub fn ellipsoid(&self, k: usize) -> Option<&'a Ellipsoid> {
+        self.ellipsoids.get(k).and_then(|e| e.as_ref())
+    }
+
+    /// (index, shape) of each particle.
+    pub fn shapes(&self) -> impl Iterator<Item = (u32, Shape<'a>)> + '_ {
+        self.spheres().enumerate().map(|(k, (i, center, radius))| {
+            let shape = match self.ellipsoid(k) {
+                None => Shape::Sphere { center, radius },
+                Some(ellipsoid) => Shape::Ellipsoid { center, ellipsoid },
+            };
+            (i, shape)
+        })
     }
 }
 
@@ -104,6 +129,17 @@ fn sphere_box(c: DVec3, r: f64) -> Aabb {
     }
 }
 
+/// The box about `c` of half extent `half` (an ellipsoid's tight box), padded as
+/// [`sphere_box`] pads, relative to the largest extent.
+fn padded_box(c: DVec3, half: DVec3) -> Aabb {
+    let pad = half * (1.0 + 1e-9)
+        + DVec3::splat(1e-9 * half.max_element() + 1e-12 * c.abs().max_element());
+    Aabb {
+        min: c - pad,
+        max: c + pad,
+    }
+}
+
 impl Bvh {
     /// Builds the hierarchy. Centres and radii must be finite (the scene validates them).
     ///
@@ -118,12 +154,34 @@ impl Bvh {
     /// [`Bvh::build`] over the spheres i with `keep(i)` only; indices stay positions in
     /// `centers` and `radii`.
     pub fn build_over(centers: Vec<DVec3>, radii: Vec<f64>, keep: impl Fn(usize) -> bool) -> Bvh {
+        Self::build_shapes(centers, radii, Vec::new(), keep)
+    }
+
+    /// [`Bvh::build_over`] where particle i is the ellipsoid `ellipsoids[i]` about `centers[i]`
+    /// where that is `Some` (its radius then the bounding radius), a sphere where `None`.
+    /// `ellipsoids` is empty or as long as `centers`; empty (or all `None`) is a sphere tree.
+    pub fn build_shapes(
+        centers: Vec<DVec3>,
+        radii: Vec<f64>,
+        ellipsoids: Vec<Option<Ellipsoid>>,
+        keep: impl Fn(usize) -> bool,
+    ) -> Bvh {
         assert_eq!(centers.len(), radii.len());
+        assert!(ellipsoids.is_empty() || ellipsoids.len() == centers.len());
+        let ellipsoids = if ellipsoids.iter().any(Option::is_some) {
+            ellipsoids
+        } else {
+            Vec::new()
+        };
         let n = centers.len();
         let boxes: Vec<Aabb> = centers
             .par_iter()
             .zip(&radii)
-            .map(|(&c, &r)| sphere_box(c, r))
+            .enumerate()
+            .map(|(i, (&c, &r))| match ellipsoids.get(i) {
+                Some(Some(e)) => padded_box(c, e.half_extent()),
+                _ => sphere_box(c, r),
+            })
             .collect();
         let mut indices: Vec<u32> = (0..n as u32).filter(|&i| keep(i as usize)).collect();
         let nodes = if indices.is_empty() {
@@ -141,11 +199,17 @@ impl Bvh {
             .iter()
             .map(|&i| (centers[i as usize], radii[i as usize]))
             .unzip();
+        let ellipsoids = if ellipsoids.is_empty() {
+            ellipsoids
+        } else {
+            indices.iter().map(|&i| ellipsoids[i as usize]).collect()
+        };
         Bvh {
             nodes,
             indices,
             centers,
             radii,
+            ellipsoids,
         }
     }
 
@@ -155,7 +219,8 @@ impl Bvh {
         Leaf {
             indices: &self.indices[range.clone()],
             centers: &self.centers[range.clone()],
-            radii: &self.radii[range],
+            radii: &self.radii[range.clone()],
+            ellipsoids: self.ellipsoids.get(range).unwrap_or(&[]),
         }
     }
 
@@ -242,13 +307,27 @@ impl Bvh {
         while let Some(n) = stack.pop() {
             let node = &self.nodes[n as usize];
             if node.count > 0 {
-                for (i, center, radius) in self.leaf(node).spheres() {
-                    if let Some(chord) = intersect_sphere(ray, center, radius) {
-                        if chord.t_exit > t_min
-                            && chord.t_enter < limit
-                            && visit(i, chord, &mut limit)
-                        {
-                            return;
+                let leaf = self.leaf(node);
+                if leaf.ellipsoids.is_empty() {
+                    for (i, center, radius) in leaf.spheres() {
+                        if let Some(chord) = intersect_sphere(ray, center, radius) {
+                            if chord.t_exit > t_min
+                                && chord.t_enter < limit
+                                && visit(i, chord, &mut limit)
+                            {
+                                return;
+                            }
+                        }
+                    }
+                } else {
+                    for (i, shape) in leaf.shapes() {
+                        if let Some(chord) = shape.intersect(ray) {
+                            if chord.t_exit > t_min
+                                && chord.t_enter < limit
+                                && visit(i, chord, &mut limit)
+                            {
+                                return;
+                            }
                         }
                     }
                 }

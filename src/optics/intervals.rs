@@ -8,8 +8,8 @@
 //! **Order independence.** Floating-point sums depend on their order, and the renderer promises
 //! that shuffling the particle list changes no pixel. The sums therefore run over the set
 //! sorted by a *canonical rank*: the position of the particle in a total order of its content
-//! (σ, radius, centre, colour, albedo), which does not depend on where it sits in the input
-//! ([`canonical_ranks`]). Particles with equal content are interchangeable, so ties cannot
+//! (σ, radius, centre, colour, albedo, then an ellipsoid's axes and orientation), which does
+//! not depend on where it sits in the input ([`canonical_ranks`]). Particles with equal content are interchangeable, so ties cannot
 //! change a sum either.
 //!
 //! **Θmax = 0 and Θmax = 1.** Particles with σ = 0 are invisible and left out. Where a particle
@@ -63,15 +63,26 @@ pub fn canonical_ranks(particles: &[Particle]) -> Vec<u32> {
             p.albedo.x, p.albedo.y, p.albedo.z,
         ]
     };
-    let mut order: Vec<u32> = (0..particles.len() as u32).collect();
-    // Sequential: the comparison is heavy, and a parallel sort makes more calls of it.
-    order.sort_by(|&a, &b| {
-        let (ka, kb) = (key(&particles[a as usize]), key(&particles[b as usize]));
+    // An ellipsoid's semi-axes and orientation; a sphere's are all zero (and it sorts before
+    // every ellipsoid of the same σ, radius, centre and colours).
+    let shape_key = |p: &Particle| {
+        p.ellipsoid.map_or([0.0; 7], |e| {
+            let (s, q) = (e.semi_axes(), e.rotation());
+            [s.x, s.y, s.z, q.w, q.x, q.y, q.z]
+        })
+    };
+    let compare = |ka: &[f64], kb: &[f64]| {
         ka.iter()
-            .zip(&kb)
+            .zip(kb)
             .map(|(x, y)| x.total_cmp(y))
             .find(|o| *o != Ordering::Equal)
             .unwrap_or(Ordering::Equal)
+    };
+    let mut order: Vec<u32> = (0..particles.len() as u32).collect();
+    // Sequential: the comparison is heavy, and a parallel sort makes more calls of it.
+    order.sort_by(|&a, &b| {
+        let (pa, pb) = (&particles[a as usize], &particles[b as usize]);
+        compare(&key(pa), &key(pb)).then_with(|| compare(&shape_key(pa), &shape_key(pb)))
     });
     let mut rank = vec![0u32; particles.len()];
     for (r, &i) in order.iter().enumerate() {
@@ -219,6 +230,7 @@ mod tests {
 
     fn particle(sigma: f64, color: DVec3) -> Particle {
         Particle {
+            ellipsoid: None,
             center: DVec3::ZERO,
             radius: 1.0,
             color,

@@ -14,6 +14,13 @@
 //!   as the tangent point (√(D² − r²)), so that the tangent point lies on the shadow segment:
 //!   a ray–cone intersection, again a quadratic. A light inside a sphere has no tangencies.
 //!
+//! An ellipsoid is the unit sphere after an affine map (`geometry::ellipsoid`), which keeps lines,
+//! tangency and the order of points on a line: its tangencies are the unit sphere's for the
+//! mapped camera ray and the mapped light (a directional light's direction M·ω, normalised; a
+//! point light's position M(p − c)), found by the same functions, the roots scaled back from the
+//! mapped ray's parameter. The cylinder and the cone become an elliptic cylinder and an
+//! elliptic cone in the scene, still quadrics, so there are still at most two kinks per light.
+//!
 //! The candidate spheres are those that a shadow ray from some point of the camera segment can
 //! reach: the segment swept towards the light (a parallelogram for a directional light, a
 //! triangle for a point light). The BVH is traversed with a separating-axis test of that
@@ -28,7 +35,7 @@
 
 use super::light::Light;
 use super::particle::Particle;
-use crate::geometry::{Bvh, Leaf, Ray};
+use crate::geometry::{Bvh, Leaf, Ray, Shape};
 use glam::DVec3;
 
 /// Appends to `out` the ray parameters t in (t_lo, t_hi) where the shadow ray from `ray.at(t)`
@@ -47,9 +54,9 @@ pub fn shadow_tangencies(
     }
     let poly = swept_polygon(bvh, light, ray.at(t_lo), ray.at(t_hi));
     for_each_swept_leaf(bvh, &poly, |leaf| {
-        for (i, center, radius) in leaf.spheres() {
+        for (i, shape) in leaf.shapes() {
             if particles[i as usize].sigma > 0.0 {
-                push_tangencies(ray, (t_lo, t_hi), light, (center, radius), out);
+                push_tangencies(ray, (t_lo, t_hi), light, shape, out);
             }
         }
     });
@@ -58,15 +65,15 @@ pub fn shadow_tangencies(
 }
 
 /// Appends to `out` the t in (t_lo, t_hi) where the shadow ray from `ray.at(t)` towards `light`
-/// is tangent to the sphere (c, r): one sphere's part of [`shadow_tangencies`].
+/// is tangent to `shape`: one particle's part of [`shadow_tangencies`].
 pub(crate) fn push_tangencies(
     ray: &Ray,
     (t_lo, t_hi): (f64, f64),
     light: &Light,
-    (c, r): (DVec3, f64),
+    shape: Shape,
     out: &mut Vec<f64>,
 ) {
-    let (roots, _) = sided_roots(ray, light, (c, r));
+    let (roots, _) = shape_roots(ray, light, shape);
     out.extend(
         roots
             .into_iter()
@@ -88,19 +95,62 @@ pub const CROSSES_BELOW: u8 = 2;
 /// double root, the ray touching the cylinder, comes twice and gets both). For a point light
 /// the crossing side is the inside of the tangent cone, where the ray enters or leaves it
 /// ([`cone_roots`]); a root too close to double for that to be certain gets both.
+#[inline]
 pub(crate) fn push_sided_tangencies(
     ray: &Ray,
     (t_lo, t_hi): (f64, f64),
     light: &Light,
-    (c, r): (DVec3, f64),
+    shape: Shape,
     out: &mut Vec<(f64, u8)>,
 ) {
-    let (roots, sides) = sided_roots(ray, light, (c, r));
+    let (roots, sides) = shape_roots(ray, light, shape);
     for (t, side) in roots.into_iter().zip(sides) {
         if let Some(t) = t.filter(|&t| t > t_lo && t < t_hi) {
             out.push((t, side));
         }
     }
+}
+
+/// The two tangency roots of `shape` for `light` along `ray`, each with its side
+/// ([`push_sided_tangencies`]): a sphere's from [`sided_roots`], an ellipsoid's from the unit
+/// sphere's for the mapped ray and light (see the module documentation).
+#[inline(always)]
+fn shape_roots(ray: &Ray, light: &Light, shape: Shape) -> ([Option<f64>; 2], [u8; 2]) {
+    match shape {
+        Shape::Sphere { center, radius } => sided_roots(ray, light, (center, radius)),
+        Shape::Ellipsoid { center, ellipsoid } => ellipsoid_roots(ray, light, center, ellipsoid),
+    }
+}
+
+/// [`shape_roots`] of an ellipsoid: the unit sphere's for the mapped ray and light.
+#[inline(never)]
+fn ellipsoid_roots(
+    ray: &Ray,
+    light: &Light,
+    center: DVec3,
+    ellipsoid: &crate::geometry::Ellipsoid,
+) -> ([Option<f64>; 2], [u8; 2]) {
+    let (unit, k) = ellipsoid.unit_ray(ray, center);
+    let mapped = match *light {
+        Light::Directional {
+            direction,
+            irradiance,
+        } => Light::Directional {
+            direction: ellipsoid.to_unit(DVec3::ZERO, direction).normalize(),
+            irradiance,
+        },
+        Light::Point {
+            position,
+            intensity,
+            falloff,
+        } => Light::Point {
+            position: ellipsoid.to_unit(center, position),
+            intensity,
+            falloff,
+        },
+    };
+    let (roots, sides) = sided_roots(&unit, &mapped, (DVec3::ZERO, 1.0));
+    (roots.map(|s| s.map(|s| s / k)), sides)
 }
 
 /// The two tangency roots of the sphere (c, r) for `light` along `ray`, each with its side
@@ -398,11 +448,11 @@ impl SweptPolygon {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::intersect_sphere;
     use crate::optics::light::Falloff;
 
     fn sphere(c: DVec3, r: f64) -> Particle {
         Particle {
+            ellipsoid: None,
             center: c,
             radius: r,
             color: DVec3::ONE,
@@ -415,15 +465,32 @@ mod tests {
 
     /// Checks each reported root against the definition: the shadow ray from x(t*) is tangent
     /// to the sphere (its distance to the centre equals r, to 1e-9 relative).
+    /// An ellipsoid's is the unit sphere's in its map.
     fn is_tangent(ray: &Ray, t: f64, light: &Light, p: &Particle) -> bool {
         let x = ray.at(t);
         let inc = light.incident_at(x).unwrap();
-        let f = x - p.center;
-        let t_c = -f.dot(inc.toward);
-        let dist = (f + t_c * inc.toward).length();
+        let shadow = Ray {
+            origin: x,
+            direction: inc.toward,
+        };
+        let (shadow, k, radius) = match &p.ellipsoid {
+            None => (shadow, 1.0, p.radius),
+            Some(e) => {
+                let (unit, k) = e.unit_ray(&shadow, p.center);
+                (unit, k, 1.0)
+            }
+        };
+        let center = if p.ellipsoid.is_some() {
+            DVec3::ZERO
+        } else {
+            p.center
+        };
+        let f = shadow.origin - center;
+        let t_c = -f.dot(shadow.direction);
+        let dist = (f + t_c * shadow.direction).length();
         t_c > 0.0
-            && t_c <= inc.distance * (1.0 + 1e-9)
-            && (dist - p.radius).abs() < 1e-9 * p.radius.max(1.0)
+            && t_c <= k * inc.distance * (1.0 + 1e-9)
+            && (dist - radius).abs() < 1e-9 * radius.max(1.0)
     }
 
     /// Leaving out the repeated and zero edge axes changes no decision of the separating-axis
@@ -479,6 +546,26 @@ mod tests {
     /// root of each; a directional light and a point light, also one among the spheres).
     #[test]
     fn a_kink_is_crossed_on_its_side_only() {
+        kinks_are_crossed_on_their_side(false);
+    }
+
+    /// The same for ellipsoids of axis ratios up to 1:20, randomly turned: the roots of the
+    /// mapped sphere are kinks of the ellipsoid, with the sides the scene's shadow rays show.
+    #[test]
+    fn an_ellipsoids_kink_is_crossed_on_its_side_only() {
+        kinks_are_crossed_on_their_side(true);
+    }
+
+    fn random_ellipsoid(mut unit: impl FnMut(f64) -> DVec3) -> crate::geometry::Ellipsoid {
+        let long = 0.3 + unit(0.5).x.abs();
+        let ratio = |u: f64| 1.0 / (1.0 + 19.0 * u.abs());
+        let w = unit(1.0);
+        let axes = DVec3::new(long, long * ratio(w.x), long * ratio(w.y));
+        let q = glam::DQuat::from_xyzw(w.z, unit(1.0).x, unit(1.0).y, unit(1.0).z + 0.1);
+        crate::geometry::Ellipsoid::new(axes, q.normalize())
+    }
+
+    fn kinks_are_crossed_on_their_side(ellipsoids: bool) {
         let lights = [
             Light::Directional {
                 direction: DVec3::new(0.2, -1.0, 0.1).normalize(),
@@ -505,9 +592,21 @@ mod tests {
             for _ in 0..2000 {
                 let c = unit(3.0);
                 let r = 0.3 + unit(0.25).x.abs();
+                let e = random_ellipsoid(&mut unit);
+                let shape = if ellipsoids {
+                    Shape::Ellipsoid {
+                        center: c,
+                        ellipsoid: &e,
+                    }
+                } else {
+                    Shape::Sphere {
+                        center: c,
+                        radius: r,
+                    }
+                };
                 let ray = Ray::new(DVec3::new(-6.0, 0.0, 0.0) + unit(2.0), DVec3::X + unit(0.4));
                 let mut out = Vec::new();
-                push_sided_tangencies(&ray, (0.0, 20.0), light, (c, r), &mut out);
+                push_sided_tangencies(&ray, (0.0, 20.0), light, shape, &mut out);
                 for &(t, side) in &out {
                     let crosses = |t: f64| {
                         let x = ray.at(t);
@@ -516,7 +615,8 @@ mod tests {
                             origin: x,
                             direction: inc.toward,
                         };
-                        intersect_sphere(&shadow, c, r)
+                        shape
+                            .intersect(&shadow)
                             .is_some_and(|h| h.t_exit > 0.0 && h.t_enter < inc.distance)
                     };
                     let d = 1e-7 * (1.0 + t.abs());
@@ -541,9 +641,42 @@ mod tests {
             sphere(DVec3::new(-1.0, 3.0, 0.5), 0.4),
             sphere(DVec3::new(0.5, -2.5, -0.2), 0.9),
         ];
-        let bvh = Bvh::build(
+        every_change_of_hit_is_a_tangency(&particles);
+    }
+
+    /// The same with elongated (1:20) and flat ellipsoids among spheres.
+    #[test]
+    fn ellipsoid_tangencies_are_tangent_and_every_change_of_hit_is_found() {
+        let ellipsoid = |c: DVec3, axes: DVec3, q: glam::DQuat| {
+            let e = crate::geometry::Ellipsoid::new(axes, q.normalize());
+            Particle {
+                ellipsoid: Some(e),
+                radius: e.bounding_radius(),
+                ..sphere(c, 1.0)
+            }
+        };
+        let particles = vec![
+            ellipsoid(
+                DVec3::new(0.3, 2.0, 0.1),
+                DVec3::new(1.4, 0.07, 0.3),
+                glam::DQuat::from_xyzw(0.3, 0.1, -0.4, 0.8),
+            ),
+            sphere(DVec3::new(-1.0, 3.0, 0.5), 0.4),
+            ellipsoid(
+                DVec3::new(0.5, -2.5, -0.2),
+                DVec3::new(0.2, 1.2, 0.9),
+                glam::DQuat::from_xyzw(-0.2, 0.5, 0.1, 0.6),
+            ),
+        ];
+        every_change_of_hit_is_a_tangency(&particles);
+    }
+
+    fn every_change_of_hit_is_a_tangency(particles: &[Particle]) {
+        let bvh = Bvh::build_shapes(
             particles.iter().map(|p| p.center).collect(),
             particles.iter().map(|p| p.radius).collect(),
+            particles.iter().map(|p| p.ellipsoid).collect(),
+            |_| true,
         );
         let lights = [
             Light::Directional {
@@ -559,7 +692,7 @@ mod tests {
         let ray = Ray::new(DVec3::new(-4.0, 0.2, 0.0), DVec3::new(1.0, 0.05, 0.02));
         for light in &lights {
             let mut kinks = Vec::new();
-            shadow_tangencies(&ray, (0.0, 8.0), light, &bvh, &particles, &mut kinks);
+            shadow_tangencies(&ray, (0.0, 8.0), light, &bvh, particles, &mut kinks);
             assert!(!kinks.is_empty());
             for &t in &kinks {
                 let ok = particles.iter().any(|p| is_tangent(&ray, t, light, p));
@@ -575,17 +708,12 @@ mod tests {
                 };
                 particles
                     .iter()
-                    .map(|p| {
-                        intersect_sphere(&sray, p.center, p.radius).is_some_and(|c| c.t_exit > 0.0)
-                    })
+                    .map(|p| p.shape().intersect(&sray).is_some_and(|c| c.t_exit > 0.0))
                     .collect()
             };
             let inside_at = |t: f64| -> Vec<bool> {
                 let x = ray.at(t);
-                particles
-                    .iter()
-                    .map(|p| (x - p.center).length() < p.radius)
-                    .collect()
+                particles.iter().map(|p| p.shape().contains(x)).collect()
             };
             let n = 4000;
             let mut changes = 0;

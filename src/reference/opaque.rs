@@ -1,8 +1,9 @@
-//! Opaque mode (docs/design.md §2 "Opaque mode", thesis task 1): opaque spheres, Lambertian C/π with
-//! optional Blinn–Phong, hard global shadows from every sphere, an ambient term.
+//! Opaque mode (docs/design.md §2 "Opaque mode", thesis task 1): opaque spheres and ellipsoids
+//! (§9), Lambertian C/π with optional Blinn–Phong, hard global shadows from every particle, an
+//! ambient term.
 
 use super::{RadianceEstimator, Sample};
-use crate::geometry::{Bvh, Ray};
+use crate::geometry::{Bvh, Ray, Shape};
 use crate::optics::light::Light;
 use crate::optics::particle::Particle;
 use crate::scene::Scene;
@@ -87,10 +88,10 @@ impl<'a> OpaqueRenderer<'a> {
     }
 }
 
-/// Whether `light` is a point light strictly inside sphere `p`.
+/// Whether `light` is a point light strictly inside particle `p`.
 fn light_inside(light: &Light, p: &Particle) -> bool {
     match *light {
-        Light::Point { position, .. } => (position - p.center).length() < p.radius,
+        Light::Point { position, .. } => p.shape().contains(position),
         Light::Directional { .. } => false,
     }
 }
@@ -104,9 +105,17 @@ impl RadianceEstimator for OpaqueRenderer<'_> {
             };
         };
         let p = &self.scene.particles[index as usize];
-        let outward = (ray.at(t) - p.center).normalize();
         // Snap the point onto the surface so the shadow ray starts exactly there.
-        let x = p.center + outward * p.radius;
+        let (x, outward) = match p.shape() {
+            Shape::Sphere { center, radius } => {
+                let outward = (ray.at(t) - center).normalize();
+                (center + outward * radius, outward)
+            }
+            shape => {
+                let x = shape.snap_to_surface(ray.at(t));
+                (x, shape.normal(x))
+            }
+        };
         let n = if entering { outward } else { -outward };
         let (radiance, shadow_rays) = self.shade(p, index, x, n, entering, ray.direction);
         Sample {
@@ -128,6 +137,7 @@ mod tests {
 
     fn particle(center: DVec3, radius: f64) -> Particle {
         Particle {
+            ellipsoid: None,
             center,
             radius,
             color: DVec3::ONE,

@@ -112,7 +112,11 @@ pub(super) struct ParticleDefaults {
 #[serde(deny_unknown_fields)]
 pub(super) struct ParticleTable {
     pub center: [f64; 3],
-    pub radius: f64,
+    /// A sphere's radius; an ellipsoid gives `semi_axes` instead (docs/design.md §9).
+    pub radius: Option<f64>,
+    pub semi_axes: Option<[f64; 3]>,
+    /// The ellipsoid's orientation (w, x, y, z), body to world; normalised, identity if absent.
+    pub rotation: Option<[f64; 4]>,
     pub color: Option<[f64; 3]>,
     pub opacity: Option<f64>,
     pub kappa: Option<f64>,

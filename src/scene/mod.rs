@@ -181,19 +181,31 @@ impl Scene {
 
     /// A BVH over the scene's particles (indices are positions in `particles`).
     pub fn build_bvh(&self) -> crate::geometry::Bvh {
-        crate::geometry::Bvh::build(
-            self.particles.iter().map(|p| p.center).collect(),
-            self.particles.iter().map(|p| p.radius).collect(),
-        )
+        self.bvh_over(|_| true)
     }
 
     /// A BVH over the particles with σ > 0 (indices are positions in `particles`): all that
     /// the volume reference sees, since a particle with σ = 0 neither absorbs nor emits.
     pub fn build_gas_bvh(&self) -> crate::geometry::Bvh {
-        crate::geometry::Bvh::build_over(
+        self.bvh_over(|i| self.particles[i].sigma > 0.0)
+    }
+
+    /// Whether any particle is an ellipsoid (docs/design.md §9).
+    pub fn has_ellipsoids(&self) -> bool {
+        self.particles.iter().any(|p| p.ellipsoid.is_some())
+    }
+
+    fn bvh_over(&self, keep: impl Fn(usize) -> bool) -> crate::geometry::Bvh {
+        let ellipsoids = if self.has_ellipsoids() {
+            self.particles.iter().map(|p| p.ellipsoid).collect()
+        } else {
+            Vec::new()
+        };
+        crate::geometry::Bvh::build_shapes(
             self.particles.iter().map(|p| p.center).collect(),
             self.particles.iter().map(|p| p.radius).collect(),
-            |i| self.particles[i].sigma > 0.0,
+            ellipsoids,
+            keep,
         )
     }
 }

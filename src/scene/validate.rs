@@ -8,7 +8,8 @@ use super::file::{
 use super::framing::{default_camera, thesis_lights, DEFAULT_FOV_Y, DEFAULT_SIZE};
 use super::{IncludeSpec, ParticleInput, ParticleRecord, RenderSettings, Scene, SceneLoadOptions};
 use crate::error::{line_of, toml_error, At, Location, PgtError, Result, SourceText};
-use crate::geometry::{Camera, CameraPath, Keyframe};
+use crate::formats::EllipsoidRecord;
+use crate::geometry::{Camera, CameraPath, Ellipsoid, Keyframe};
 use crate::optics::extinction::Extinction;
 use crate::optics::light::{Falloff, Light};
 use crate::optics::particle::Particle;
@@ -323,7 +324,9 @@ fn inline_particles<'a>(
 fn given_table(p: ParticleInput) -> ParticleTable {
     ParticleTable {
         center: p.center,
-        radius: p.radius,
+        radius: Some(p.radius),
+        semi_axes: None,
+        rotation: None,
         color: p.color,
         opacity: p.opacity,
         kappa: p.kappa,
@@ -520,10 +523,46 @@ fn inline_particle(
 ) -> Result<Particle> {
     let name = |f: &str| format!("particles[{i}].{f}");
     let center = at.vec3(&name("center"), p.center)?;
-    let radius = at.finite(&name("radius"), p.radius)?;
-    if radius <= 0.0 {
-        return Err(at.err(format!("{} must be > 0, got {radius}", name("radius"))));
-    }
+    let (radius, ellipsoid) = match (p.radius, p.semi_axes) {
+        (Some(radius), None) => {
+            if p.rotation.is_some() {
+                return Err(at.err(format!(
+                    "{} turns an ellipsoid: give semi_axes = [a, b, c] instead of radius",
+                    name("rotation")
+                )));
+            }
+            let radius = at.finite(&name("radius"), radius)?;
+            if radius <= 0.0 {
+                return Err(at.err(format!("{} must be > 0, got {radius}", name("radius"))));
+            }
+            (radius, None)
+        }
+        (None, Some(semi_axes)) => {
+            let record = EllipsoidRecord {
+                semi_axes: DVec3::from(semi_axes),
+                rotation: p.rotation.unwrap_or([1.0, 0.0, 0.0, 0.0]),
+            };
+            let axes = [0, 1, 2].map(|k| name(&format!("semi_axes[{k}]")));
+            if let Some(problem) =
+                record.problem(axes.each_ref().map(|s| s.as_str()), &name("rotation"))
+            {
+                return Err(at.err(problem));
+            }
+            resolve_ellipsoid(&record)
+        }
+        (Some(_), Some(_)) => {
+            return Err(at.err(format!(
+                "particles[{i}]: give radius (a sphere) or semi_axes (an ellipsoid), not both"
+            )))
+        }
+        (None, None) => {
+            return Err(at.err(format!(
+                "particles[{i}]: give radius = r (a sphere) or semi_axes = [a, b, c] (an ellipsoid)"
+            )))
+        }
+    };
+    // Θmax is the opacity along the shortest diameter (docs/design.md §9).
+    let sigma_radius = ellipsoid.map_or(radius, |e| e.shortest_semi_axis());
     if p.opacity.is_some() && p.kappa.is_some() {
         return Err(at.err(format!("particles[{i}]: set opacity or kappa, not both")));
     }
@@ -542,7 +581,7 @@ fn inline_particle(
         center,
         radius,
         color,
-        sigma: d.sigma(opacity, kappa, radius, lambda),
+        sigma: d.sigma(opacity, kappa, sigma_radius, lambda),
         albedo: p.albedo.map_or(Ok(d.albedo.unwrap_or(color)), |a| {
             at.non_negative3(&name("albedo"), a)
         })?,
@@ -552,6 +591,7 @@ fn inline_particle(
         shininess: p.shininess.map_or(Ok(d.shininess), |v| {
             at.in_range(&name("shininess"), v, 0.0, f64::MAX, "≥ 0")
         })?,
+        ellipsoid,
     })
 }
 
@@ -567,10 +607,20 @@ fn record_particle(
         location: rec.location.clone(),
     };
     let center = at.vec3("particle position", rec.center.to_array())?;
-    let radius = at.finite("particle radius", rec.radius)?;
+    let (radius, ellipsoid) = match &rec.ellipsoid {
+        Some(e) => {
+            if let Some(problem) = e.problem(["sx", "sy", "sz"], "the rotation qw, qx, qy, qz") {
+                return Err(at.err(format!("the particle's {problem}")));
+            }
+            resolve_ellipsoid(e)
+        }
+        None => (at.finite("particle radius", rec.radius)?, None),
+    };
     if radius <= 0.0 {
         return Err(at.err(format!("particle radius must be > 0, got {radius}")));
     }
+    // Θmax is the opacity along the shortest diameter (docs/design.md §9).
+    let sigma_radius = ellipsoid.map_or(radius, |e| e.shortest_semi_axis());
     let color = rec.color.map_or(Ok(d.color), |c| {
         at.non_negative3("particle colour", c.to_array())
     })?;
@@ -585,11 +635,30 @@ fn record_particle(
         // A σ the file gives is the particle's σ exactly (crate::formats::xyz_csv, "σ and opacity").
         sigma: rec
             .sigma
-            .unwrap_or_else(|| d.sigma(opacity, None, radius, lambda)),
+            .unwrap_or_else(|| d.sigma(opacity, None, sigma_radius, lambda)),
         albedo: d.albedo.unwrap_or(color),
         ks: d.ks,
         shininess: d.shininess,
+        ellipsoid,
     })
+}
+
+/// The shape an ellipsoid record describes, checked by [`EllipsoidRecord::problem`] first: the
+/// radius of the particle (the longest semi-axis) and its ellipsoid with the quaternion
+/// normalised, or no ellipsoid where the three semi-axes are equal (docs/design.md §9: that is
+/// the sphere, bit for bit, whatever the rotation).
+fn resolve_ellipsoid(e: &EllipsoidRecord) -> (f64, Option<Ellipsoid>) {
+    let s = e.semi_axes;
+    if s.x == s.y && s.y == s.z {
+        return (s.x, None);
+    }
+    let [w, x, y, z] = e.rotation;
+    // Scaled first, so that a quaternion of huge or tiny components normalises without
+    // overflow or underflow.
+    let q = glam::DVec4::new(x, y, z, w);
+    let q = q / q.abs().max_element();
+    let ellipsoid = Ellipsoid::new(s, glam::DQuat::from_vec4(q.normalize()));
+    (ellipsoid.bounding_radius(), Some(ellipsoid))
 }
 
 fn light(at: &At, i: usize, l: &LightTable) -> Result<Light> {

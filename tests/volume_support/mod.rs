@@ -43,6 +43,7 @@ impl Rng {
 
 pub fn particle(center: DVec3, radius: f64, color: DVec3, sigma: f64) -> Particle {
     Particle {
+        ellipsoid: None,
         center,
         radius,
         color,

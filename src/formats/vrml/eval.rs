@@ -383,6 +383,7 @@ impl Ctx<'_> {
             ));
         }
         self.records.push(ParticleRecord {
+            ellipsoid: None,
             center,
             radius,
             color,

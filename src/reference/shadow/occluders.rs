@@ -28,12 +28,17 @@
 //! camera ray), and each interval's list is *narrowed* from it ([`Occluders::narrow`]: the same
 //! reach-range and half-space tests, no BVH). The narrowed list keeps the wide one's order and
 //! is a superset of the spheres crossed, so the hits are the same, in the same order (tested).
+//!
+//! **Ellipsoids** (docs/design.md §9) are culled as their bounding spheres (a superset of what
+//! their own test would keep) and kept in a list of their own, after the spheres: each shadow
+//! ray tests them exactly with the ellipsoid's intersection, the one [`Bvh::all_hits`] uses,
+//! and their kinks are the ellipsoid's own. The spheres' lanes stay as they are.
 
 // `!(a > b)` is deliberate: unlike `a <= b` it is also true when a value is NaN, so degenerate
 // input takes the safe branch.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use crate::geometry::{Bvh, Chord, Hit, Ray};
+use crate::geometry::{Bvh, Chord, Ellipsoid, Hit, Ray, Shape};
 use crate::optics::kinks::{
     axis_approach, for_each_swept_leaf, push_sided_tangencies, solve_quadratic, swept_polygon,
     AxisApproach,
@@ -81,6 +86,10 @@ pub struct Occluders {
     ta: f64,
     tb: f64,
     candidates: Vec<Candidate>,
+    /// The candidates that are ellipsoids (their `radius` the bounding radius), with their
+    /// ellipsoids, position for position.
+    ellipsoid_candidates: Vec<Candidate>,
+    ellipsoids: Vec<Ellipsoid>,
 }
 
 impl Occluders {
@@ -103,6 +112,8 @@ impl Occluders {
         self.ta = ta;
         self.tb = tb;
         self.candidates.clear();
+        self.ellipsoid_candidates.clear();
+        self.ellipsoids.clear();
     }
 
     /// Gathers the spheres of `bvh` whose padded box the polygon swept from [x(ta), x(tb)]
@@ -123,9 +134,11 @@ impl Occluders {
         let poly = swept_polygon(bvh, light, ya, yb);
         let ahead = AheadOfSegment::new(light, ya, yb);
         let candidates = &mut self.candidates;
+        let (ellipsoid_candidates, ellipsoids) =
+            (&mut self.ellipsoid_candidates, &mut self.ellipsoids);
         for_each_swept_leaf(bvh, &poly, |leaf| {
             // The leaf's centres and radii (the particles', in leaf order) lie together.
-            for (i, center, radius) in leaf.spheres() {
+            for (k, (i, center, radius)) in leaf.spheres().enumerate() {
                 let (t_lo, t_hi) = reach_range(camera_ray, light, center, radius, tb);
                 if !(t_lo <= tb && t_hi >= ta) {
                     continue;
@@ -139,13 +152,20 @@ impl Occluders {
                     _ => poly.overlaps_box(center - DVec3::splat(pad), center + DVec3::splat(pad)),
                 };
                 if near {
-                    candidates.push(Candidate {
+                    let candidate = Candidate {
                         center,
                         radius,
                         index: i,
                         t_lo,
                         t_hi,
-                    });
+                    };
+                    match leaf.ellipsoid(k) {
+                        None => candidates.push(candidate),
+                        Some(e) => {
+                            ellipsoid_candidates.push(candidate);
+                            ellipsoids.push(*e);
+                        }
+                    }
                 }
             }
         });
@@ -203,7 +223,18 @@ impl Occluders {
             return;
         }
         for c in &self.candidates {
-            push_sided_tangencies(camera_ray, (t_lo, t_hi), light, (c.center, c.radius), out);
+            let shape = Shape::Sphere {
+                center: c.center,
+                radius: c.radius,
+            };
+            push_sided_tangencies(camera_ray, (t_lo, t_hi), light, shape, out);
+        }
+        for (c, ellipsoid) in self.ellipsoid_candidates.iter().zip(&self.ellipsoids) {
+            let shape = Shape::Ellipsoid {
+                center: c.center,
+                ellipsoid,
+            };
+            push_sided_tangencies(camera_ray, (t_lo, t_hi), light, shape, out);
         }
         out.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
         out.dedup_by(|b, a| {
@@ -233,26 +264,35 @@ impl Occluders {
     ) {
         self.start((tag, l), (ta, tb));
         let ahead = AheadOfSegment::new(light, camera_ray.at(ta), camera_ray.at(tb));
-        for c in &wide.candidates {
+        let keep = |c: &Candidate| {
             if !(c.t_lo <= tb && c.t_hi >= ta) {
-                continue;
+                return false;
             }
-            let keep = match &ahead {
+            match &ahead {
                 Some(ahead) if c.t_lo.is_finite() && c.t_hi.is_finite() => {
                     ahead.keeps(c.center, padded_radius(c.center, c.radius))
                 }
                 _ => true,
-            };
-            if keep {
+            }
+        };
+        for c in &wide.candidates {
+            if keep(c) {
                 self.candidates.push(*c);
+            }
+        }
+        for (c, e) in wide.ellipsoid_candidates.iter().zip(&wide.ellipsoids) {
+            if keep(c) {
+                self.ellipsoid_candidates.push(*c);
+                self.ellipsoids.push(*e);
             }
         }
     }
 
     /// Every candidate whose chord overlaps (0, t_max) along `ray`, the shadow ray from the
     /// camera ray's point x(`t`): the set that [`Bvh::all_hits`]`(ray, 0, t_max)` returns for the
-    /// spheres with σ > 0 (the others contribute nothing to a shadow ray), in list order (the
-    /// interval cutter takes hits in any order and gives the same intervals). Candidates whose
+    /// spheres with σ > 0 (the others contribute nothing to a shadow ray), in list order, the
+    /// spheres' list before the ellipsoids' (the interval cutter takes hits in any order and
+    /// gives the same intervals). Candidates whose
     /// reach range excludes `t` are not tested. `out` is cleared first.
     #[cfg(test)]
     pub fn hits(&self, t: f64, ray: &Ray, t_max: f64, out: &mut Vec<Hit>) {
@@ -277,15 +317,46 @@ impl Occluders {
         for (shadow, out) in shadow.chunks(LANES).zip(out.chunks_mut(LANES)) {
             hits_in_lanes(&self.candidates, shadow, out);
         }
+        if !self.ellipsoids.is_empty() {
+            ellipsoid_hits(&self.ellipsoid_candidates, &self.ellipsoids, shadow, out);
+        }
     }
 
     /// Number of candidates in the current list.
     pub fn len(&self) -> usize {
-        self.candidates.len()
+        self.candidates.len() + self.ellipsoid_candidates.len()
     }
 
     pub fn is_empty(&self) -> bool {
-        self.candidates.is_empty()
+        self.len() == 0
+    }
+}
+
+/// The ellipsoids' part of [`Occluders::hits_batch`]: each candidate (`candidates[k]` with its
+/// ellipsoid `ellipsoids[k]`) against every shadow ray whose reach range holds it, with the
+/// ellipsoid's own intersection, appended to `out`.
+#[inline(never)]
+fn ellipsoid_hits(
+    candidates: &[Candidate],
+    ellipsoids: &[Ellipsoid],
+    shadow: &[ShadowRay],
+    out: &mut [Vec<Hit>],
+) {
+    for (c, ellipsoid) in candidates.iter().zip(ellipsoids) {
+        for (s, o) in shadow.iter().zip(out.iter_mut()) {
+            // Written so that a NaN t tests every candidate, as in the lanes.
+            if s.t < c.t_lo || s.t > c.t_hi {
+                continue;
+            }
+            if let Some(chord) = ellipsoid.intersect(&s.ray, c.center) {
+                if chord.t_exit > 0.0 && chord.t_enter < s.t_max {
+                    o.push(Hit {
+                        index: c.index,
+                        chord,
+                    });
+                }
+            }
+        }
     }
 }
 
@@ -594,24 +665,48 @@ mod tests {
     /// time and in batches.
     #[test]
     fn list_hits_equal_bvh_hits() {
+        lists_equal_the_bvh(false);
+    }
+
+    /// The same with every third particle an ellipsoid (axis ratios up to 1:10, turned).
+    #[test]
+    fn list_hits_equal_bvh_hits_among_ellipsoids() {
+        lists_equal_the_bvh(true);
+    }
+
+    fn lists_equal_the_bvh(ellipsoids: bool) {
         let mut rng = SplitMix64::new(7);
         let mut v = |s: f64| {
             DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * 2.0 * s - DVec3::splat(s)
         };
         let particles: Vec<Particle> = (0..400)
-            .map(|_| Particle {
-                center: v(6.0),
-                radius: 0.3 + 0.5 * v(1.0).x.abs(),
-                color: DVec3::ONE,
-                sigma: 0.5,
-                albedo: DVec3::ONE,
-                ks: 0.0,
-                shininess: 0.0,
+            .map(|i| {
+                let mut p = Particle {
+                    ellipsoid: None,
+                    center: v(6.0),
+                    radius: 0.3 + 0.5 * v(1.0).x.abs(),
+                    color: DVec3::ONE,
+                    sigma: 0.5,
+                    albedo: DVec3::ONE,
+                    ks: 0.0,
+                    shininess: 0.0,
+                };
+                if ellipsoids && i % 3 == 0 {
+                    let w = v(1.0);
+                    let axes = p.radius * DVec3::new(1.0, 0.1 + w.x.abs(), 0.1 + w.y.abs());
+                    let q = glam::DQuat::from_xyzw(w.z, v(1.0).x, v(1.0).y, 0.5).normalize();
+                    let e = Ellipsoid::new(axes * 1.5, q);
+                    p.radius = e.bounding_radius();
+                    p.ellipsoid = Some(e);
+                }
+                p
             })
             .collect();
-        let bvh = Bvh::build(
+        let bvh = Bvh::build_shapes(
             particles.iter().map(|p| p.center).collect(),
             particles.iter().map(|p| p.radius).collect(),
+            particles.iter().map(|p| p.ellipsoid).collect(),
+            |_| true,
         );
         let lights = [
             Light::Directional {

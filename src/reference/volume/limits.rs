@@ -110,7 +110,7 @@ impl VolumeRenderer<'_> {
             for h in hits.iter().filter(|h| is_opaque_here(h)) {
                 let p = &particles[h.index as usize];
                 let ci = if h.chord.t_enter == iv.t0 && h.chord.t_enter > 0.0 {
-                    let n = (x - p.center).normalize_or_zero();
+                    let n = p.shape().normal(x);
                     let mu_in = -ray.direction.dot(n);
                     let mu_l = inc.toward.dot(n);
                     if mu_l > 0.0 && mu_in > 0.0 {

@@ -11,6 +11,7 @@ use crate::scene::{LightWeight, RenderMode, RenderSettings};
 /// A gas sphere of the given opacity Θmax, its albedo its colour.
 fn sphere(center: DVec3, radius: f64, color: DVec3, opacity: f64) -> Particle {
     Particle {
+        ellipsoid: None,
         center,
         radius,
         color,
