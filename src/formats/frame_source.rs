@@ -197,6 +197,27 @@ impl TextFrames {
         let end = self.starts.get(index + 1).copied().unwrap_or(file_len);
         Some((start, end, *self.lines.get(index)?))
     }
+
+    /// The frame facts of a text file of these frames (a count only: the text formats give
+    /// neither a fixed atom count nor a time step).
+    pub fn info(&self) -> FrameInfo {
+        FrameInfo {
+            count: self.starts.len(),
+            atoms_per_frame: None,
+            time_step_ps: None,
+        }
+    }
+
+    /// The bytes of frame `index` of `source` and the line it starts on; a frame past the end
+    /// is an error naming the file and the count.
+    pub fn read(&self, source: &ByteSource, index: usize) -> Result<(Vec<u8>, usize)> {
+        let path = source.path();
+        let (start, end, first_line) = self
+            .range(index, source.len())
+            .ok_or_else(|| past_the_end(path, index, self.starts.len()))?;
+        let bytes = source.read_at(start, end - start, &format!("frame {index}"))?;
+        Ok((bytes, first_line))
+    }
 }
 
 /// Calls `f(line_number, byte_offset, line)` for every line of a file (1-based numbers, the line

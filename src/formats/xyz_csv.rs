@@ -28,7 +28,7 @@
 
 use super::elements::{element_color, element_radius, Element};
 use super::frame_source::{
-    finish_frame, past_the_end, scan_lines, ByteSource, Frame, FrameInfo, FrameSource, TextFrames,
+    finish_frame, scan_lines, ByteSource, Frame, FrameInfo, FrameSource, TextFrames,
 };
 use super::{EllipsoidRecord, Format, IncludeSpec, LoadedParticles, ParticleRecord};
 use crate::error::{Location, PgtError, Result};
@@ -289,21 +289,11 @@ impl FrameSource for XyzFrames {
         self.source.path()
     }
     fn info(&self) -> FrameInfo {
-        FrameInfo {
-            count: self.text.starts.len(),
-            atoms_per_frame: None,
-            time_step_ps: None,
-        }
+        self.text.info()
     }
     fn read_frame(&self, index: usize) -> Result<Frame> {
         let path = self.source.path();
-        let (start, end, first_line) = self
-            .text
-            .range(index, self.source.len())
-            .ok_or_else(|| past_the_end(path, index, self.text.starts.len()))?;
-        let bytes = self
-            .source
-            .read_at(start, end - start, &format!("frame {index}"))?;
+        let (bytes, first_line) = self.text.read(&self.source, index)?;
         let mut spec = self.spec.clone();
         spec.path = path.to_path_buf();
         spec.frame = None;

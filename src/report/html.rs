@@ -51,8 +51,7 @@ struct Figure {
 /// main layer = abs error, layers `rel`, `ssim`, `flip`) and `summary.json`. Returns the path of
 /// the page.
 pub fn write_report(dir: &Path, inputs: &ReportInputs) -> Result<std::path::PathBuf> {
-    // Under the signal cleanup's hold: a folder it has removed is not made again.
-    crate::signals::hold_off(|| std::fs::create_dir_all(dir)).map_err(|e| PgtError::io(dir, e))?;
+    super::text::create_folder(dir)?;
     let cmp = inputs.comparison;
     let (w, h) = (cmp.width, cmp.height);
     // The inputs as the eye sees them: scaled so the data range maps to white.

@@ -15,7 +15,7 @@ use super::html::page;
 use super::plot::{line_plot_svg, PlotSpec, Series};
 use super::summary::short;
 use super::text::escape;
-use crate::error::{PgtError, Result};
+use crate::error::Result;
 use crate::image_io::write_image;
 use crate::metrics::gate::GateCheck;
 use crate::metrics::maps;
@@ -44,9 +44,7 @@ pub fn temporal_scale(pop_threshold: f64) -> Scale {
 /// Writes one frame's images into the report folder `dir`.
 pub fn write_frame_images(dir: &Path, view: &FrameView, pop_threshold: f64) -> Result<()> {
     let frames = dir.join(FRAMES_DIR);
-    // Under the signal cleanup's hold: a folder it has removed is not made again.
-    crate::signals::hold_off(|| std::fs::create_dir_all(&frames))
-        .map_err(|e| PgtError::io(&frames, e))?;
+    super::text::create_folder(&frames)?;
     let exposure = -(view.comparison.data_range.max(f64::MIN_POSITIVE)).log2() as f32;
     let f = view.figures.frame;
     write_image(&dir.join(frame_file("r", f)), view.reference, &[], exposure)?;
