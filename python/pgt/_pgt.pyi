@@ -22,11 +22,13 @@ class Scene:
     @staticmethod
     def from_arrays(
         centers: npt.ArrayLike,
-        radii: npt.ArrayLike,
+        radii: Optional[npt.ArrayLike],
         colors: Optional[npt.ArrayLike] = None,
         opacity: Union[None, float, npt.ArrayLike] = None,
         kappa: Union[None, float, npt.ArrayLike] = None,
         *,
+        semi_axes: Optional[npt.ArrayLike] = None,
+        rotations: Optional[npt.ArrayLike] = None,
         lights: Optional[Sequence[Mapping[str, Any]]] = None,
         camera: Optional[Mapping[str, Any]] = None,
         size: Optional[Tuple[int, int]] = None,

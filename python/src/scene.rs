@@ -181,11 +181,16 @@ impl Scene {
     ///
     /// Particles (float32 or float64 arrays; lists are converted):
     ///   centers   (n, 3) centres in metres.
-    ///   radii     (n,) radii in metres, > 0.
+    ///   radii     (n,) radii in metres, > 0; None with semi_axes.
     ///   colors    (n, 3) linear RGB >= 0 [white].
-    ///   opacity   (n,) or one value: Theta_max in [0, 1], the opacity along a diameter.
+    ///   opacity   (n,) or one value: Theta_max in [0, 1], the opacity along a diameter
+    ///             (an ellipsoid's shortest one).
     ///   kappa     (n,) or one value: extinction coefficient >= 0 (sigma = lambda*kappa);
     ///             give opacity or kappa, not both [opacity 0.5].
+    ///
+    /// Ellipsoids (keyword arguments, docs/design.md §9), instead of radii:
+    ///   semi_axes (n, 3) semi-axes in metres along the body's x, y, z, > 0.
+    ///   rotations (n, 4) orientations as quaternions (w, x, y, z), normalised [none].
     ///
     /// Scene (keyword arguments; the fields of a scene file, docs/design.md §1):
     ///   lights           list of dicts, e.g. pgt.directional_light(direction, irradiance),
@@ -207,18 +212,21 @@ impl Scene {
     /// shape or dtype, NaN or infinity, and values out of range.
     #[staticmethod]
     #[pyo3(signature = (
-        centers, radii, colors=None, opacity=None, kappa=None, *, lights=None, camera=None,
-        size=None, mode=None, model=None, background=None, tol=None, lambda_=None,
-        light_weight=None, emission_weight=None, ambient=None, defaults=None
+        centers, radii, colors=None, opacity=None, kappa=None, *, semi_axes=None,
+        rotations=None, lights=None, camera=None, size=None, mode=None, model=None,
+        background=None, tol=None, lambda_=None, light_weight=None, emission_weight=None,
+        ambient=None, defaults=None
     ))]
     #[allow(clippy::too_many_arguments)]
     fn from_arrays(
         py: Python<'_>,
         centers: &Bound<'_, PyAny>,
-        radii: &Bound<'_, PyAny>,
+        radii: Option<&Bound<'_, PyAny>>,
         colors: Option<&Bound<'_, PyAny>>,
         opacity: Option<&Bound<'_, PyAny>>,
         kappa: Option<&Bound<'_, PyAny>>,
+        semi_axes: Option<&Bound<'_, PyAny>>,
+        rotations: Option<&Bound<'_, PyAny>>,
         lights: Option<&Bound<'_, PyAny>>,
         camera: Option<&Bound<'_, PyAny>>,
         size: Option<&Bound<'_, PyAny>>,
@@ -234,8 +242,46 @@ impl Scene {
     ) -> PyResult<Scene> {
         let centers: Floats<Ix2> = floats("centers", centers, &[Size::Any("n"), Size::Is(3)])?;
         let n = centers.shape()[0];
-        let radii: Floats<Ix1> =
-            floats("radii", radii, &[Size::Is(n)]).map_err(|e| with_n(py, e, n))?;
+        let (radii, semi_axes, rotations) = (
+            radii.filter(|v| !v.is_none()),
+            semi_axes.filter(|v| !v.is_none()),
+            rotations.filter(|v| !v.is_none()),
+        );
+        match (&radii, &semi_axes) {
+            (Some(_), Some(_)) => {
+                return Err(input_error(
+                    py,
+                    format!(
+                        "{FROM_ARRAYS}: give radii (spheres) or semi_axes (ellipsoids), not both"
+                    ),
+                ))
+            }
+            (None, None) => {
+                return Err(input_error(
+                    py,
+                    format!("{FROM_ARRAYS}: give radii (spheres) or semi_axes (ellipsoids)"),
+                ))
+            }
+            _ => {}
+        }
+        if rotations.is_some() && semi_axes.is_none() {
+            return Err(input_error(
+                py,
+                format!("{FROM_ARRAYS}: rotations turn ellipsoids; give semi_axes with them"),
+            ));
+        }
+        let radii: Option<Floats<Ix1>> = radii
+            .map(|r| floats("radii", r, &[Size::Is(n)]))
+            .transpose()
+            .map_err(|e| with_n(py, e, n))?;
+        let semi_axes: Option<Floats<Ix2>> = semi_axes
+            .map(|a| floats("semi_axes", a, &[Size::Is(n), Size::Is(3)]))
+            .transpose()
+            .map_err(|e| with_n(py, e, n))?;
+        let rotations: Option<Floats<Ix2>> = rotations
+            .map(|q| floats("rotations", q, &[Size::Is(n), Size::Is(4)]))
+            .transpose()
+            .map_err(|e| with_n(py, e, n))?;
         let colors: Option<Floats<Ix2>> = colors
             .filter(|c| !c.is_none())
             .map(|c| floats("colors", c, &[Size::Is(n), Size::Is(3)]))
@@ -278,7 +324,13 @@ impl Scene {
                 centers.get((i, 1)),
                 centers.get((i, 2)),
             ],
-            radius: radii.get(i),
+            radius: radii.as_ref().map_or(0.0, |r| r.get(i)),
+            semi_axes: semi_axes
+                .as_ref()
+                .map(|a| [a.get((i, 0)), a.get((i, 1)), a.get((i, 2))]),
+            rotation: rotations
+                .as_ref()
+                .map(|q| [q.get((i, 0)), q.get((i, 1)), q.get((i, 2)), q.get((i, 3))]),
             color: colors
                 .as_ref()
                 .map(|c| [c.get((i, 0)), c.get((i, 1)), c.get((i, 2))]),
@@ -302,7 +354,10 @@ impl Scene {
 
     /// The resolved particles, as `pgt export` writes them: a dict of float64 arrays
     /// "center" (n, 3), "radius" (n,), "color" (n, 3) linear RGB, "opacity" (n,) Theta_max
-    /// along a diameter and "sigma" (n,) the extinction in 1/m (inf for opacity 1).
+    /// along a diameter (an ellipsoid's shortest) and "sigma" (n,) the extinction in 1/m (inf
+    /// for opacity 1); where any particle is an ellipsoid also "semi_axes" (n, 3) and
+    /// "rotation" (n, 4) quaternions (w, x, y, z) (a sphere: its radius three times and the
+    /// identity), and "radius" is each one's longest semi-axis.
     fn particles<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, PyDict>> {
         let particles = &self.inner.particles;
         let n = particles.len();
@@ -327,6 +382,16 @@ impl Scene {
         out.set_item("color", vec_to_array(py, color, Ix2(n, 3)))?;
         out.set_item("opacity", vec_to_array(py, opacity, Ix1(n)))?;
         out.set_item("sigma", vec_to_array(py, sigma, Ix1(n)))?;
+        if particles.iter().any(|p| p.ellipsoid.is_some()) {
+            let (mut axes, mut rotation) = (Vec::with_capacity(3 * n), Vec::with_capacity(4 * n));
+            for p in particles {
+                let row = pgt::cli::export::ellipsoid_row(p);
+                axes.extend_from_slice(&row[3..6]);
+                rotation.extend_from_slice(&row[6..10]);
+            }
+            out.set_item("semi_axes", vec_to_array(py, axes, Ix2(n, 3)))?;
+            out.set_item("rotation", vec_to_array(py, rotation, Ix2(n, 4)))?;
+        }
         Ok(out)
     }
 

@@ -98,7 +98,12 @@ pub struct SceneLoadOptions {
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ParticleInput {
     pub center: [f64; 3],
+    /// The sphere's radius; ignored where `semi_axes` makes the particle an ellipsoid.
     pub radius: f64,
+    /// An ellipsoid's semi-axes (docs/design.md §9), instead of the radius.
+    pub semi_axes: Option<[f64; 3]>,
+    /// An ellipsoid's orientation as a quaternion (w, x, y, z), normalised; with `semi_axes`.
+    pub rotation: Option<[f64; 4]>,
     /// Linear RGB; `None`: `[defaults]`' colour.
     pub color: Option<[f64; 3]>,
     /// Θmax; set this or `kappa` or neither (then `[defaults]`' or 0.5).

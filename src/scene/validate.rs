@@ -324,9 +324,9 @@ fn inline_particles<'a>(
 fn given_table(p: ParticleInput) -> ParticleTable {
     ParticleTable {
         center: p.center,
-        radius: Some(p.radius),
-        semi_axes: None,
-        rotation: None,
+        radius: p.semi_axes.is_none().then_some(p.radius),
+        semi_axes: p.semi_axes,
+        rotation: p.rotation,
         color: p.color,
         opacity: p.opacity,
         kappa: p.kappa,
