@@ -8,6 +8,7 @@
 //! | `million` | 1,000,000 random spheres (`pgt gen random --count 1000000`), emission model only |
 //! | `million-lit` | the same, lit (not in the default list: minutes on two cores) |
 //! | `1uun-scatter` | 1UUN as `1uun`, single-scatter model, two point lights: one at the centre of the particles' bounding sphere (inside the gas) and one above it (not in the default list) |
+//! | `1uun-ellipsoids` | 1UUN as `1uun`, each atom an ellipsoid of the same volume: semi-axes r·k·(1, u, v), u and v uniform in [1/4, 1], k = (uv)^{−1/3}, a uniformly random orientation, Θmax 0.5 along the shortest diameter (SplitMix64 seed 1; not in the default list) |
 //! | `orbit`, `xtc` | sequences of frames: a frame of a sequence against a single render of it ([`super::bench_frames`]; not in the default list) |
 //!
 //! Every scene is the bare-file default (docs/design.md §1): the camera frames the bounding sphere,
@@ -66,6 +67,9 @@ pub enum Workload {
     /// 1UUN (or the protein-sized set), single-scatter, point lights inside and above.
     #[value(name = "1uun-scatter")]
     ProteinScatter,
+    /// 1UUN (or the protein-sized set) as ellipsoids of the atoms' volumes, lit.
+    #[value(name = "1uun-ellipsoids")]
+    ProteinEllipsoids,
     /// 1UUN chains A+B, lit, on an orbiting camera: a frame of the sequence against a single
     /// render.
     Orbit,
@@ -276,7 +280,7 @@ fn max_difference(a: &RenderOutput, b: &RenderOutput) -> f64 {
 /// The scene of a workload and its name in the table.
 fn workload_scene(w: Workload, size: u32, data: &Path) -> anyhow::Result<(String, Scene)> {
     match w {
-        Workload::Protein | Workload::ProteinScatter => {
+        Workload::Protein | Workload::ProteinScatter | Workload::ProteinEllipsoids => {
             let pdb = data.join("pdb").join("1uun_opm_oriented.pdb");
             let (name, mut scene) = if pdb.is_file() {
                 ("1UUN A+B".to_string(), protein_scene(&pdb, size)?)
@@ -293,6 +297,10 @@ fn workload_scene(w: Workload, size: u32, data: &Path) -> anyhow::Result<(String
                 scene.lights = inside_and_above(&scene.particles);
                 let short = if pdb.is_file() { "1UUN" } else { "protein" };
                 return Ok((format!("{short} scatter"), scene));
+            }
+            if w == Workload::ProteinEllipsoids {
+                as_ellipsoids(&mut scene.particles);
+                return Ok((format!("{name} ellipsoids"), scene));
             }
             Ok((name, scene))
         }
@@ -374,6 +382,29 @@ fn particle(center: DVec3, radius: f64, color: DVec3) -> Particle {
         albedo: color,
         ks: 0.0,
         shininess: 32.0,
+    }
+}
+
+/// Turns each sphere into an ellipsoid of the same volume (the `1uun-ellipsoids` workload): semi-axes
+/// r·k·(1, u, v) with u, v uniform in [1/4, 1] and k = (uv)^{−1/3}, a uniformly random unit
+/// quaternion (normalised Gaussian components, by Box–Muller), σ for Θmax = [`OPACITY`] along
+/// the shortest diameter.
+fn as_ellipsoids(particles: &mut [Particle]) {
+    let mut rng = SplitMix64::new(1);
+    for p in particles {
+        let (u, v) = (0.25 + 0.75 * rng.next_f64(), 0.25 + 0.75 * rng.next_f64());
+        let k = (u * v).powf(-1.0 / 3.0);
+        let semi_axes = DVec3::new(1.0, u, v) * (p.radius * k);
+        let mut gaussian = || {
+            let (a, b) = (1.0 - rng.next_f64(), rng.next_f64());
+            (-2.0 * a.ln()).sqrt() * (std::f64::consts::TAU * b).cos()
+        };
+        let q = glam::DVec4::new(gaussian(), gaussian(), gaussian(), gaussian());
+        let rotation = glam::DQuat::from_vec4(q.normalize());
+        let ellipsoid = crate::geometry::Ellipsoid::new(semi_axes, rotation);
+        p.radius = ellipsoid.bounding_radius();
+        p.sigma = sigma_from_opacity(OPACITY, ellipsoid.shortest_semi_axis());
+        p.ellipsoid = Some(ellipsoid);
     }
 }
 
