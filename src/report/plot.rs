@@ -88,6 +88,24 @@ pub fn tick_label(v: f64) -> String {
     }
 }
 
+/// A tick label on a linear axis spanning `span` with about `ticks` ticks: like [`tick_label`],
+/// with as many significant digits as the spacing of the ticks needs (at least three), so that
+/// neighbouring ticks of a narrow range (0.9975, 0.998) do not print alike.
+pub fn span_label(v: f64, span: f64, ticks: usize) -> String {
+    let step = span / ticks.max(1) as f64;
+    if v == 0.0 || !(step > 0.0 && step.is_finite()) {
+        return tick_label(v);
+    }
+    let magnitude = v.abs().max(span);
+    let digits = (magnitude.log10().floor() - step.log10().floor() + 2.0).clamp(3.0, 15.0) as usize;
+    let rounded: f64 = format!("{v:.*e}", digits - 1).parse().unwrap_or(v);
+    if (1e-3..1e5).contains(&v.abs()) {
+        format!("{rounded}")
+    } else {
+        format!("{rounded:e}")
+    }
+}
+
 const PALETTE: [RGBColor; 6] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
@@ -214,6 +232,13 @@ pub fn line_plot_svg(path: &Path, spec: &PlotSpec, series: &[Series]) -> Result<
         Some(_) => String::new(),
         None => tick_label(*v),
     };
+    let y_label = |v: &f64| {
+        if spec.log_y {
+            tick_label(*v)
+        } else {
+            span_label(*v, y1 - y0, MAX_Y_TICKS)
+        }
+    };
     // A category axis is linear from −0.5 to n − 0.5: plotters puts its ticks on the integers
     // when asked for n + 1 at most, and the formatter leaves any others blank.
     let x_labels = spec.x_categories.map_or(MAX_X_TICKS, |c| c.len() + 1);
@@ -236,7 +261,7 @@ pub fn line_plot_svg(path: &Path, spec: &PlotSpec, series: &[Series]) -> Result<
                 .x_labels(x_labels)
                 .y_labels(MAX_Y_TICKS)
                 .x_label_formatter(&x_label)
-                .y_label_formatter(&|v| tick_label(*v))
+                .y_label_formatter(&y_label)
                 .draw()
                 .map_err(|e| err(&e))?;
             for (i, s) in series.iter().enumerate() {
@@ -399,6 +424,43 @@ mod tests {
         assert_eq!(tick_label(0.002), "0.002");
         assert_eq!(tick_label(2e-7), "2e-7");
         assert_eq!(tick_label(123456.0), "1.23e5");
+    }
+
+    #[test]
+    fn a_narrow_linear_range_keeps_its_labels_apart() {
+        // The SSIM of a sequence: 0.9972 … 0.9987 over the frames.
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("ssim.svg");
+        let series = [Series {
+            label: "ssim".into(),
+            points: (0..64)
+                .map(|f| (f as f64, 0.9972 + 0.0015 * (f as f64 / 10.0).sin().abs()))
+                .collect(),
+        }];
+        let spec = PlotSpec {
+            title: "SSIM",
+            x_label: "frame",
+            y_label: "ssim",
+            log_x: false,
+            log_y: false,
+            x_categories: None,
+        };
+        line_plot_svg(&path, &spec, &series).unwrap();
+        let svg = std::fs::read_to_string(&path).unwrap();
+        let labels: Vec<&str> = svg
+            .split("</text>")
+            .filter_map(|t| t.rsplit('>').next())
+            .map(str::trim)
+            .filter(|t| t.starts_with("0.99"))
+            .collect();
+        assert!(labels.len() >= 3, "{labels:?}");
+        let mut sorted = labels.clone();
+        sorted.sort();
+        sorted.dedup();
+        assert_eq!(sorted.len(), labels.len(), "repeated labels: {labels:?}");
+        assert_eq!(span_label(0.9975, 0.002, 8), "0.9975");
+        assert_eq!(span_label(0.998, 0.002, 8), "0.998");
+        assert_eq!(span_label(250.0, 1000.0, 8), "250");
     }
 
     #[test]
