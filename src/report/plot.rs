@@ -426,6 +426,15 @@ mod tests {
         assert_eq!(tick_label(123456.0), "1.23e5");
     }
 
+    /// The texts of an SVG's `<text>` elements, trimmed, the empty ones left out.
+    fn svg_texts(svg: &str) -> Vec<&str> {
+        svg.split("</text>")
+            .filter_map(|t| t.rsplit('>').next())
+            .map(str::trim)
+            .filter(|t| !t.is_empty())
+            .collect()
+    }
+
     #[test]
     fn a_narrow_linear_range_keeps_its_labels_apart() {
         // The SSIM of a sequence: 0.9972 … 0.9987 over the frames.
@@ -447,10 +456,8 @@ mod tests {
         };
         line_plot_svg(&path, &spec, &series).unwrap();
         let svg = std::fs::read_to_string(&path).unwrap();
-        let labels: Vec<&str> = svg
-            .split("</text>")
-            .filter_map(|t| t.rsplit('>').next())
-            .map(str::trim)
+        let labels: Vec<&str> = svg_texts(&svg)
+            .into_iter()
             .filter(|t| t.starts_with("0.99"))
             .collect();
         assert!(labels.len() >= 3, "{labels:?}");
@@ -481,12 +488,7 @@ mod tests {
         };
         line_plot_svg(&path, &spec, &series).unwrap();
         let svg = std::fs::read_to_string(&path).unwrap();
-        let labels: Vec<&str> = svg
-            .split("</text>")
-            .filter_map(|t| t.rsplit('>').next())
-            .map(str::trim)
-            .filter(|t| !t.is_empty())
-            .collect();
+        let labels = svg_texts(&svg);
         for l in ["1", "10", "1e-7", "0.001"] {
             assert!(labels.contains(&l), "{l} not in {labels:?}");
         }
