@@ -134,6 +134,9 @@ impl Fnv128 {
     }
 }
 
+/// The header attribute of a part (and of a frame of a sequence) that holds its render hash.
+pub const RENDER_HASH_ATTRIBUTE: &str = "pgtRenderHash";
+
 /// The hash that ties parts to one render: the loaded scene (everything but its file name and
 /// warnings, so the same scene at another path on another node matches) and the options that
 /// change pixels, with pgt's version (another version may compute other bits).
@@ -231,7 +234,7 @@ pub fn write_part(path: &Path, part: &Part) -> Result<()> {
             "pgtRows",
             format!("y mod {} = {}", h.part.count, h.part.index),
         ),
-        ("pgtRenderHash", h.hash.clone()),
+        (RENDER_HASH_ATTRIBUTE, h.hash.clone()),
     ];
     let layers: Vec<(&str, &RgbImage)> = part.error.iter().map(|e| ("err", e)).collect();
     crate::image_io::write_exr_with_header(path, &part.image, &layers, &header)
@@ -286,7 +289,7 @@ pub fn read_part(path: &Path) -> Result<Part> {
         width,
         height,
         part,
-        hash: get("pgtRenderHash")?.clone(),
+        hash: get(RENDER_HASH_ATTRIBUTE)?.clone(),
     };
     let rows = rows_of(part, height).len();
     if (layer.size.0, layer.size.1) != (width as usize, rows) {

@@ -17,7 +17,7 @@
 use crate::parts::render_hash;
 use crate::reference::{self, RenderOptions};
 use crate::scene::{SceneFrames, SceneLoadOptions};
-use crate::sequence::render::render_frames;
+use crate::sequence::render::{render_frames, write_frame};
 use crate::sequence::SequencePattern;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -128,16 +128,9 @@ pub fn bench_frames(
         for &k in &list {
             let scene = load()?.frame(k)?;
             let out = reference::render(&scene, &options)?;
-            let layers: Vec<(&str, &crate::image_io::RgbImage)> =
-                out.error.iter().map(|e| ("err", e)).collect();
             let path = dir.path().join(format!("single/f_{k:04}.exr"));
             let hash = render_hash(&scene, &options);
-            crate::image_io::write_exr_with_header(
-                &path,
-                &out.image,
-                &layers,
-                &[("pgtRenderHash", hash)],
-            )?;
+            write_frame(&path, k, &hash, &out.image, out.error.as_ref(), 0.0)?;
         }
         let single = start.elapsed().as_secs_f64();
 

@@ -38,12 +38,10 @@ pub fn open_sequence(
     }
     let mut list = frames_in(range, scene, frames.frame_count())?;
     if let Some(part) = part {
+        let all = list.len();
         list = frames_of_part(&list, part);
         if list.is_empty() {
-            eprintln!(
-                "part {part} of {} frame(s) holds no frame: nothing to do",
-                frames_in(range, scene, frames.frame_count())?.len()
-            );
+            eprintln!("part {part} of {all} frame(s) holds no frame: nothing to do");
         }
     }
     Ok((frames, list, pattern))

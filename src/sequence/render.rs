@@ -23,8 +23,8 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
 
-/// The header attribute that holds a frame's render hash.
-pub const HASH_ATTRIBUTE: &str = "pgtRenderHash";
+/// The header attribute that holds a frame's render hash (the parts' attribute).
+pub use crate::parts::RENDER_HASH_ATTRIBUTE as HASH_ATTRIBUTE;
 /// The header attribute that holds a frame's number.
 pub const FRAME_ATTRIBUTE: &str = "pgtFrame";
 
@@ -75,7 +75,8 @@ impl SequenceSummary {
         (rendered, self.frames.len() - rendered)
     }
 
-    /// The reference's figures summed over the rendered frames.
+    /// The reference's figures summed over the rendered frames (counts and seconds; no error
+    /// estimates).
     pub fn totals(&self) -> RenderStats {
         let mut t = RenderStats {
             pixels: 0,
@@ -94,10 +95,6 @@ impl SequenceSummary {
                 t.shadow_rays += s.shadow_rays;
                 t.seconds += s.seconds;
                 t.unconverged += s.unconverged;
-                t.max_error = match (t.max_error, s.max_error) {
-                    (Some(a), Some(b)) => Some(a.max(b)),
-                    (a, b) => a.or(b),
-                };
             }
         }
         t
@@ -135,7 +132,7 @@ fn already_rendered(path: &Path, hash: &str) -> bool {
 }
 
 /// Writes one frame: an EXR with its hash and number in the header, or a PNG.
-fn write_frame(
+pub fn write_frame(
     path: &Path,
     frame: usize,
     hash: &str,
