@@ -134,37 +134,38 @@ fn evaluate(
     cmp: &SequenceComparison,
     frame_checks: &[(usize, Vec<GateCheck>)],
 ) -> (Vec<GateCheck>, Vec<usize>) {
-    let mut checks: Vec<GateCheck> = Vec::new();
     let mut failed = Vec::new();
+    // Every frame has the same checks in the same order: keep, per position, the frame
+    // furthest on the failing side of the threshold.
+    let mut worst: Vec<(usize, GateCheck)> = Vec::new();
     for (frame, list) in frame_checks {
         if list.iter().any(|c| !c.passed) {
             failed.push(*frame);
         }
-        for c in list {
-            let named = GateCheck {
-                name: format!("{} (worst frame: {frame})", c.name),
-                ..c.clone()
-            };
-            match checks
-                .iter_mut()
-                .find(|k| k.name.starts_with(&format!("{} (", c.name)))
-            {
-                None => checks.push(named),
-                Some(k) => {
-                    // The worst frame: the one furthest on the failing side of the threshold.
-                    let lower_bound = c.name.starts_with("min_") || c.name.contains(">=");
-                    let worse = if lower_bound {
+        for (i, c) in list.iter().enumerate() {
+            match worst.get_mut(i) {
+                None => worst.push((*frame, c.clone())),
+                Some((f, k)) => {
+                    let worse = if c.lower_bound {
                         c.value < k.value
                     } else {
                         c.value > k.value
                     };
                     if worse {
-                        *k = named;
+                        *f = *frame;
+                        *k = c.clone();
                     }
                 }
             }
         }
     }
+    let mut checks: Vec<GateCheck> = worst
+        .into_iter()
+        .map(|(frame, c)| GateCheck {
+            name: format!("{} (worst frame: {frame})", c.name),
+            ..c
+        })
+        .collect();
     for (name, threshold) in gate.temporal_keys() {
         let value = cmp
             .frames
@@ -181,6 +182,7 @@ fn evaluate(
             value,
             threshold,
             passed: value <= threshold,
+            lower_bound: false,
         });
     }
     (checks, failed)
@@ -230,5 +232,63 @@ fn verdict(cmp: &SequenceComparison, checks: &[GateCheck], failed: &[usize]) -> 
             format!("; {} frame(s) failed a per-frame threshold", failed.len())
         };
         format!("FAIL: {line}; {}{frames}", names.join(", "))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn check(name: &str, value: f64, threshold: f64, lower_bound: bool) -> GateCheck {
+        let passed = if lower_bound {
+            value >= threshold
+        } else {
+            value <= threshold
+        };
+        GateCheck {
+            name: name.into(),
+            value,
+            threshold,
+            passed,
+            lower_bound,
+        }
+    }
+
+    #[test]
+    fn each_check_is_reported_at_its_worst_frame() {
+        let frames: FrameChecks = vec![
+            (
+                0,
+                vec![
+                    check("channels.min_ssim[R]", 0.99, 0.95, true),
+                    check("max_rmse", 0.03, 0.05, false),
+                ],
+            ),
+            (
+                1,
+                vec![
+                    check("channels.min_ssim[R]", 0.90, 0.95, true),
+                    check("max_rmse", 0.01, 0.05, false),
+                ],
+            ),
+            (
+                2,
+                vec![
+                    check("channels.min_ssim[R]", 0.97, 0.95, true),
+                    check("max_rmse", 0.04, 0.05, false),
+                ],
+            ),
+        ];
+        let cmp = SequenceComparison {
+            frames: Vec::new(),
+            pop_threshold: 0.05,
+            data_range: 1.0,
+        };
+        let (checks, failed) = evaluate(&Gate::default(), &cmp, &frames);
+        assert_eq!(failed, vec![1]);
+        assert_eq!(checks[0].name, "channels.min_ssim[R] (worst frame: 1)");
+        assert!(!checks[0].passed);
+        assert_eq!(checks[1].name, "max_rmse (worst frame: 2)");
+        assert_eq!(checks[1].value, 0.04);
     }
 }

@@ -147,6 +147,9 @@ pub struct GateCheck {
     pub value: f64,
     pub threshold: f64,
     pub passed: bool,
+    /// A lower bound (`min_*`: passes when value ≥ threshold), else an upper bound.
+    #[serde(skip)]
+    pub lower_bound: bool,
 }
 
 impl Gate {
@@ -372,13 +375,13 @@ impl Checks {
     /// A lower bound: passes when `value >= threshold` (NaN fails).
     fn at_least(&mut self, name: String, value: f64, threshold: f64) {
         let passed = value >= threshold;
-        self.push(name, value, threshold, passed);
+        self.push(name, value, threshold, passed, true);
     }
 
     /// An upper bound: passes when `value <= threshold` (NaN fails).
     fn at_most(&mut self, name: String, value: f64, threshold: f64) {
         let passed = value <= threshold;
-        self.push(name, value, threshold, passed);
+        self.push(name, value, threshold, passed, false);
     }
 
     /// One check per channel, named `name[R]`, `name[G]`, `name[B]`.
@@ -399,12 +402,13 @@ impl Checks {
         }
     }
 
-    fn push(&mut self, name: String, value: f64, threshold: f64, passed: bool) {
+    fn push(&mut self, name: String, value: f64, threshold: f64, passed: bool, lower: bool) {
         self.0.push(GateCheck {
             name,
             value,
             threshold,
             passed,
+            lower_bound: lower,
         });
     }
 }
