@@ -343,8 +343,20 @@ fn attribution_splits_the_error_into_causes_whose_shares_add_up() {
         bars.starts_with("<svg") && bars.contains("interaction"),
         "{bars}"
     );
+    // The maps' colour bar: a file for other pages (the thesis report) and inline beside each
+    // map, with the scale's top as its top label.
+    let scale = std::fs::read_to_string(rep.join(a["scale"].as_str().unwrap())).unwrap();
+    assert!(scale.starts_with("<svg class=\"colorbar\""), "{scale}");
     let page = std::fs::read_to_string(rep.join("index.html")).unwrap();
     assert!(page.contains("Error attribution") && page.contains("SSIM share"));
+    let runs: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(rep.join("sweep.json")).unwrap()).unwrap();
+    assert_eq!(
+        page.matches("<svg class=\"colorbar\"").count(),
+        // one per run's heatmap, one per cause's map
+        runs.as_array().unwrap().len() + causes.len(),
+        "{page}"
+    );
     assert!(rep.join("error_time.svg").is_file());
 
     // A swap to a run the experiment does not list is an error at its line.
@@ -430,4 +442,65 @@ fn a_sweep_reports_the_references_unconverged_pixels() {
         );
         assert!(worst[2].as_f64().unwrap() > 1e-4, "{summary}");
     }
+}
+
+#[test]
+fn conventions_repeat_the_baseline_comparisons_on_prepared_images() {
+    let dir = tempfile::tempdir().unwrap();
+    disjoint_scene(dir.path());
+    let exp = dir.path().join("exp.toml");
+    std::fs::write(
+        &exp,
+        "scene = \"disjoint.toml\"\nsize = [32, 24]\n[[approximations]]\nmethod = \"thesis-cpu\"\nsamples = 4\nn_exact = [0, \"all\"]\nbaseline = { n_exact = \"all\" }\n[[approximations]]\nmethod = \"thesis-cpu\"\nsamples = 4\nn_exact = 0\nrest_model = 1\nbaseline = { n_exact = \"all\", rest_model = 0 }\n[[conventions]]\nname = \"as-is\"\n[[conventions]]\nname = \"max-8bit\"\nnormalize = \"max\"\nquantize = 8\n[[conventions]]\nname = \"channel-max\"\nnormalize = \"channel-max\"\n",
+    )
+    .unwrap();
+    let rep = dir.path().join("rep");
+    sweep_ok(&exp, &rep);
+    let runs: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(rep.join("sweep.json")).unwrap()).unwrap();
+    let run = |n: serde_json::Value, rest: u64| {
+        runs.as_array()
+            .unwrap()
+            .iter()
+            .find(|r| r["params"]["n_exact"] == n && r["params"]["rest_model"] == rest)
+            .unwrap()
+            .clone()
+    };
+    let n0 = run(0.into(), 0);
+    let base = &n0["baseline"];
+    let conventions = base["conventions"].as_object().unwrap();
+    assert_eq!(conventions.len(), 3);
+    // A convention that prepares nothing repeats the comparison exactly.
+    assert_eq!(conventions["as-is"]["ssim"], base["ssim"]);
+    assert_eq!(conventions["as-is"]["rmse"], base["rmse"]);
+    // Normalised, the images differ otherwise (the lit and the emission model's maxima are not
+    // the same), and SSIM stays a similarity below 1.
+    for name in ["max-8bit", "channel-max"] {
+        let s = conventions[name]["ssim"]["mean"].as_f64().unwrap();
+        assert!(s < 1.0 && s > 0.0, "{name}: {s}");
+        assert_ne!(conventions[name]["ssim"], base["ssim"], "{name}");
+    }
+    // The baseline against itself is exact under every convention.
+    let all = run("all".into(), 0);
+    for name in ["as-is", "max-8bit", "channel-max"] {
+        assert_eq!(all["baseline"]["conventions"][name]["ssim"]["mean"], 1.0);
+    }
+    // Absorption only past N = 0, on a black background: nothing is emitted, the image is black.
+    let absorbed = run(0.into(), 1);
+    assert_eq!(
+        absorbed["baseline"]["run"],
+        "thesis-cpu samples=4 n_exact=all"
+    );
+    assert_eq!(
+        absorbed["image"],
+        "thesis-cpu_samples_4_n_exact_0_rest_model_1.png"
+    );
+    let png = image::open(rep.join(absorbed["image"].as_str().unwrap()))
+        .unwrap()
+        .to_rgb8();
+    assert!(png.pixels().all(|p| p.0 == [0, 0, 0]));
+    let emitted = image::open(rep.join(n0["image"].as_str().unwrap()))
+        .unwrap()
+        .to_rgb8();
+    assert!(emitted.pixels().any(|p| p.0 != [0, 0, 0]));
 }

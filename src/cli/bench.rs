@@ -4,7 +4,7 @@
 //! | workload | scene |
 //! |---|---|
 //! | `1uun` | 1UUN chains A+B (2,758 atoms) from `DATA/pdb/1uun_opm_oriented.pdb`, or, where the file is missing, a generated protein-sized set (2,758 spheres, radii 1.2–1.9 Å, one per 20 Å³) |
-//! | `random` | the random set of `pgt gen random` with its defaults (73,642 spheres) |
+//! | `random` | the thesis's random set "cool random" (73,642 spheres, `DATA/mmpld/cool_random.mmpld`), or, where the file is missing, `pgt gen random`'s set of the same size |
 //! | `million` | 1,000,000 random spheres (`pgt gen random --count 1000000`), emission model only |
 //! | `million-lit` | the same, lit (not in the default list: minutes on two cores) |
 //! | `1uun-scatter` | 1UUN as `1uun`, single-scatter model, two point lights: one at the centre of the particles' bounding sphere (inside the gas) and one above it (not in the default list) |
@@ -58,7 +58,7 @@ pub enum Workload {
     /// 1UUN chains A+B, lit (or a generated protein-sized set).
     #[value(name = "1uun")]
     Protein,
-    /// The random set (73,642 spheres), lit.
+    /// The thesis's random set "cool random" (73,642 spheres), lit.
     Random,
     /// 1,000,000 random spheres, emission model.
     Million,
@@ -103,7 +103,7 @@ pub struct BenchArgs {
     /// Frames of the sequence workloads (`orbit`: 4; `xtc`: all 51).
     #[arg(long)]
     pub frames: Option<usize>,
-    /// Folder with `pdb/1uun_opm_oriented.pdb` (default `../shared/data`).
+    /// Folder with `pdb/1uun_opm_oriented.pdb` and `mmpld/cool_random.mmpld` (default `../shared/data`).
     #[arg(long, default_value = "../shared/data")]
     pub data: PathBuf,
 }
@@ -307,10 +307,20 @@ fn workload_scene(w: Workload, size: u32, data: &Path) -> anyhow::Result<(String
         Workload::Orbit | Workload::Xtc => {
             anyhow::bail!("{w:?} is a sequence workload, timed by bench_frames")
         }
-        Workload::Random => Ok((
-            "random 73,642".into(),
-            bare_scene(random_set(THESIS_COUNT), size),
-        )),
+        Workload::Random => {
+            let mmpld = data.join("mmpld").join("cool_random.mmpld");
+            if mmpld.is_file() {
+                return Ok(("cool random 73,642".into(), set_scene(&mmpld, size)?));
+            }
+            eprintln!(
+                "bench: {} not found; using pgt gen random's set of the same size",
+                mmpld.display()
+            );
+            Ok((
+                "random 73,642".into(),
+                bare_scene(random_set(THESIS_COUNT), size),
+            ))
+        }
         Workload::Million | Workload::MillionLit => {
             let mut s = bare_scene(random_set(MILLION), size);
             if w == Workload::Million {
@@ -342,19 +352,30 @@ fn inside_and_above(particles: &[Particle]) -> Vec<Light> {
 
 /// 1UUN chains A and B with the bare-file defaults (docs/design.md §1), through the scene loader.
 fn protein_scene(pdb: &Path, size: u32) -> anyhow::Result<Scene> {
+    thesis_scene(pdb, "chains = [\"A\", \"B\"]\n", size)
+}
+
+/// The thesis's scene around the particle file `path` (its own colours and radii).
+fn set_scene(path: &Path, size: u32) -> anyhow::Result<Scene> {
+    thesis_scene(path, "", size)
+}
+
+/// The thesis's lights, Θmax and tolerance around the file `path`, with `include` lines added
+/// to its `[[include]]` table.
+fn thesis_scene(path: &Path, include: &str, size: u32) -> anyhow::Result<Scene> {
     let text = format!(
         "[render]\ntol = {TOL:e}\n\n[defaults]\nopacity = {OPACITY}\n\n\
          [[lights]]\ntype = \"directional\"\ndirection = [0.0, -1.0, 0.0]\nirradiance = [0.0, 1.0, 0.0]\n\n\
          [[lights]]\ntype = \"directional\"\ndirection = [0.0, 1.0, 0.0]\nirradiance = [0.0, 0.0, 1.0]\n\n\
-         [[include]]\npath = {:?}\nchains = [\"A\", \"B\"]\n",
-        pdb.display().to_string()
+         [[include]]\npath = {:?}\n{include}",
+        path.display().to_string()
     );
     let options = SceneLoadOptions {
         size: Some((size, size)),
         ..SceneLoadOptions::default()
     };
     Scene::from_toml_str(&text, Path::new("bench.toml"), &options)
-        .with_context(|| format!("loading {}", pdb.display()))
+        .with_context(|| format!("loading {}", path.display()))
 }
 
 /// The default scene of a bare particle file (docs/design.md §1) around `particles`, lit, tol 1e-4.

@@ -3,6 +3,7 @@
 //! interaction term, as defined in [`crate::sweep::attribution`]), an error map per cause on one
 //! scale, and a table.
 
+use super::colorbar::colorbar_svg;
 use super::text::escape;
 use super::{heatmap, ColorMap, Scale};
 use crate::error::Result;
@@ -19,6 +20,27 @@ const INTERACTION: &str = "#9c9c9c";
 /// `attribution_STEM.svg`.
 pub fn bar_file(a: &AttributionResult) -> String {
     format!("attribution_{}.svg", a.stem)
+}
+
+/// `attribution_STEM_scale.svg`: the colour bar of the run's error maps.
+pub fn scale_file(a: &AttributionResult) -> String {
+    format!("attribution_{}_scale.svg", a.stem)
+}
+
+/// The one scale of a run's error maps (all causes on it, so that the maps compare by eye):
+/// 0 to the largest value of any cause's map.
+fn map_scale(a: &AttributionResult) -> Scale {
+    let highs: Vec<f32> = a
+        .causes
+        .iter()
+        .map(|c| Scale::zero_to_max(&c.map).hi as f32)
+        .collect();
+    Scale::zero_to_max(&highs)
+}
+
+/// The colour bar of a run's error maps; `id` tells the bars of one page apart.
+fn map_colorbar(a: &AttributionResult, id: &str) -> String {
+    colorbar_svg(map_scale(a), ColorMap::Magma, "|before − after|", id)
 }
 
 /// `attribution_STEM_CAUSE.png`.
@@ -127,13 +149,10 @@ pub fn write_attribution_files(
 ) -> Result<()> {
     for a in attributions {
         super::text::write_text(&dir.join(bar_file(a)), &bars_svg(a))?;
-        // One scale for all causes of a run, so that the maps compare by eye.
-        let highs: Vec<f32> = a
-            .causes
-            .iter()
-            .map(|c| Scale::zero_to_max(&c.map).hi as f32)
-            .collect();
-        let scale = Scale::zero_to_max(&highs);
+        // A standalone file for pages that show the maps outside the sweep's own page (the
+        // thesis report); the sweep page inlines the same bar.
+        super::text::write_text(&dir.join(scale_file(a)), &map_colorbar(a, "bar"))?;
+        let scale = map_scale(a);
         for c in &a.causes {
             heatmap(&c.map, width, height, scale, ColorMap::Magma)
                 .write_png(&dir.join(map_file(a, &c.cause)))?;
@@ -178,10 +197,11 @@ pub fn attribution_section(attributions: &[AttributionResult]) -> String {
             "<tr><td>interaction</td><td>cross terms</td><td></td><td></td><td></td><td>{:.1}%</td></tr>\n</table>\n<div class=\"grid\">",
             100.0 * a.interaction
         );
-        for c in &a.causes {
+        for (k, c) in a.causes.iter().enumerate() {
+            let bar = map_colorbar(a, &format!("bar-{}-{k}", a.stem));
             let _ = writeln!(
                 b,
-                "<figure><img src=\"{}\" alt=\"error map of {}\"><figcaption>{}: |before − after|, mean over R, G, B; one scale per run</figcaption></figure>",
+                "<figure><div class=\"heat\"><img src=\"{}\" alt=\"error map of {}\">{bar}</div><figcaption>{}: |before − after|, mean over R, G, B; magma, one scale per run</figcaption></figure>",
                 escape(&map_file(a, &c.cause)),
                 escape(&c.cause),
                 escape(&c.cause)
@@ -211,7 +231,7 @@ pub fn attribution_json(attributions: &[AttributionResult]) -> serde_json::Value
                     .collect();
                 serde_json::json!({
                     "run": a.label, "rmse": a.rmse, "ssim": a.ssim, "causes": causes,
-                    "interaction": a.interaction, "bars": bar_file(a),
+                    "interaction": a.interaction, "bars": bar_file(a), "scale": scale_file(a),
                 })
             })
             .collect(),

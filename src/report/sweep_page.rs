@@ -430,6 +430,20 @@ fn sweep_json(runs: &[RunResult]) -> serde_json::Value {
                         "rmse": base.comparison.error_values(|e| e.rmse),
                         "psnr": base.comparison.error_values(|e| e.psnr),
                     });
+                    if !base.conventions.is_empty() {
+                        let conventions: serde_json::Map<String, serde_json::Value> = base
+                            .conventions
+                            .iter()
+                            .map(|(name, c)| {
+                                let v = serde_json::json!({
+                                    "ssim": c.ssim_values(),
+                                    "rmse": c.error_values(|e| e.rmse),
+                                });
+                                (name.clone(), v)
+                            })
+                            .collect();
+                        run["baseline"]["conventions"] = conventions.into();
+                    }
                 }
                 run
             })

@@ -3,6 +3,7 @@
 //! expansion of each `[[approximations]]` entry into runs (the Cartesian product of its lists),
 //! each with the index of its baseline run where the entry names one.
 
+use super::conventions::{Convention, MAX_QUANTIZE_BITS};
 use super::method::{ParamDefault, ParamValue, SweepMethod, SweepParam};
 use super::registry::{find_method, method_names};
 use crate::error::{toml_error, PgtError, Result, SourceText};
@@ -24,6 +25,8 @@ struct ExperimentFile {
     plot_x: Option<Spanned<String>>,
     #[serde(default)]
     attribution: Vec<AttributionFile>,
+    #[serde(default)]
+    conventions: Vec<Spanned<Convention>>,
 }
 
 /// An `[[attribution]]` table as TOML sees it.
@@ -68,6 +71,8 @@ pub struct Experiment {
     pub plot_x: Option<&'static str>,
     /// The error attributions (`[[attribution]]`), in file order.
     pub attributions: Vec<Attribution>,
+    /// The baseline comparisons' other conventions (`[[conventions]]`), in file order.
+    pub conventions: Vec<Convention>,
 }
 
 /// An error attribution (`[[attribution]]`): a run, and a chain of runs each with one more
@@ -103,11 +108,18 @@ pub struct Run {
 }
 
 impl Run {
-    /// `thesis samples=100 n_exact=all`.
+    /// `thesis samples=100 n_exact=all`: every parameter but those a method leaves out of
+    /// labels at their default ([`SweepParam::quiet_default`]).
     pub fn label(&self) -> String {
+        let declared = find_method(self.method).map_or(&[][..], |m| m.params());
         let mut s = self.method.to_string();
         for (k, v) in &self.params {
-            let _ = write!(s, " {k}={v}");
+            let quiet = declared
+                .iter()
+                .any(|p| p.name == *k && p.quiet_default && p.default == ParamDefault::Value(*v));
+            if !quiet {
+                let _ = write!(s, " {k}={v}");
+            }
         }
         s
     }
@@ -207,6 +219,7 @@ impl Experiment {
             .as_ref()
             .map(|x| at.plot_x(x, &runs))
             .transpose()?;
+        let conventions = at.conventions(&file.conventions, &runs)?;
         let base = path.parent().unwrap_or(Path::new("."));
         Ok(Experiment {
             path: path.to_path_buf(),
@@ -217,6 +230,7 @@ impl Experiment {
             runs,
             plot_x,
             attributions,
+            conventions,
         })
     }
 }
@@ -354,6 +368,37 @@ impl Validator<'_> {
             }
         }
         Ok(())
+    }
+
+    /// Checks the `[[conventions]]`: names given once each, `quantize` in 1..=24 bits, and a
+    /// run with a baseline for them to repeat.
+    fn conventions(&self, tables: &[Spanned<Convention>], runs: &[Run]) -> Result<Vec<Convention>> {
+        let mut out: Vec<Convention> = Vec::with_capacity(tables.len());
+        for table in tables {
+            let line = self.src.line(table);
+            let c = table.get_ref();
+            if c.name.trim().is_empty() {
+                return Err(self
+                    .src
+                    .error(line, "conventions: name must not be empty".into()));
+            }
+            if out.iter().any(|o| o.name == c.name) {
+                let message = format!("conventions: the name '{}' is given twice", c.name);
+                return Err(self.src.error(line, message));
+            }
+            if let Some(bits) = c.quantize.filter(|b| !(1..=MAX_QUANTIZE_BITS).contains(b)) {
+                let message = format!(
+                    "conventions: quantize must be between 1 and {MAX_QUANTIZE_BITS} bits, got {bits}"
+                );
+                return Err(self.src.error(line, message));
+            }
+            if runs.iter().all(|r| r.baseline.is_none()) {
+                let message = "conventions repeat the comparisons with a baseline run, and no [[approximations]] entry has a `baseline`";
+                return Err(self.src.error(line, message.into()));
+            }
+            out.push(c.clone());
+        }
+        Ok(out)
     }
 
     /// Validates one `[[approximations]]` table against its method's parameters.
@@ -600,6 +645,7 @@ fn one_value(p: &SweepParam, v: &toml::Value) -> std::result::Result<ParamValue,
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::sweep::conventions::Normalize;
 
     fn parse(text: &str) -> Result<Experiment> {
         Experiment::parse(text, Path::new("dir/exp.toml"))
@@ -755,6 +801,64 @@ mod tests {
             .to_string();
         assert!(
             err.starts_with("dir/exp.toml:2: plot_x: no run has a parameter 'spp2'"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn conventions_are_read_in_order_and_checked_at_their_line() {
+        let runs = "scene = \"s.toml\"\n[[approximations]]\nmethod = \"thesis-cpu\"\nn_exact = [1, \"all\"]\nbaseline = { n_exact = \"all\" }\n";
+        let e = parse(&format!("{runs}[[conventions]]\nname = \"a\"\nnormalize = \"channel-max\"\nquantize = 8\n[[conventions]]\nname = \"b\"\n")).unwrap();
+        let got: Vec<_> = e
+            .conventions
+            .iter()
+            .map(|c| (c.name.as_str(), c.normalize, c.quantize))
+            .collect();
+        assert_eq!(
+            got,
+            [
+                ("a", Normalize::ChannelMax, Some(8)),
+                ("b", Normalize::None, None)
+            ]
+        );
+        // Each case's table starts at line 6 (after the five lines of runs).
+        let cases = [
+            (
+                "name = \"a\"\nquantize = 0\n",
+                "quantize must be between 1 and 24 bits, got 0",
+            ),
+            (
+                "name = \"a\"\nquantize = 25\n",
+                "quantize must be between 1 and 24 bits, got 25",
+            ),
+            ("name = \" \"\n", "name must not be empty"),
+        ];
+        for (table, message) in cases {
+            let err = parse(&format!("{runs}[[conventions]]\n{table}"))
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("exp.toml:6") && err.contains(message),
+                "{table}: {err}"
+            );
+        }
+        let twice = format!("{runs}[[conventions]]\nname = \"a\"\n[[conventions]]\nname = \"a\"\n");
+        let err = parse(&twice).unwrap_err().to_string();
+        assert!(
+            err.contains("exp.toml:8") && err.contains("'a' is given twice"),
+            "{err}"
+        );
+        let unknown = format!("{runs}[[conventions]]\nname = \"a\"\nnormalize = \"mean\"\n");
+        let err = parse(&unknown).unwrap_err().to_string();
+        assert!(
+            err.contains("exp.toml:8") && err.contains("channel-max"),
+            "{err}"
+        );
+        let no_baseline = "scene = \"s.toml\"\n[[approximations]]\nmethod = \"thesis-cpu\"\nn_exact = 1\n[[conventions]]\nname = \"a\"\n";
+        let err = parse(no_baseline).unwrap_err().to_string();
+        assert!(
+            err.contains("exp.toml:5")
+                && err.contains("no [[approximations]] entry has a `baseline`"),
             "{err}"
         );
     }

@@ -70,6 +70,9 @@ pub struct SweepParam {
     pub max: u32,
     /// Whether `"all"` is a value.
     pub accepts_all: bool,
+    /// Whether a run's label and file names leave the parameter out at its default value, so
+    /// that runs keep the names they had before the method gained it.
+    pub quiet_default: bool,
     pub doc: &'static str,
 }
 

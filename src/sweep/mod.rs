@@ -40,6 +40,11 @@
 //!     { cause = "overlap",  swap = { method = "riemann" } },
 //!     { cause = "sampling", swap = "reference" },
 //! ]
+//!
+//! [[conventions]]             # optional: the baseline comparisons again, images stored otherwise
+//! name = "max-8bit"
+//! normalize = "max"           # "none" (default), "max" or "channel-max"
+//! quantize = 8                # optional: bits per channel after normalisation
 //! ```
 //!
 //! * `method` names any method of [`find_method`]: `riemann` and `thesis-cpu` (CPU), and every GPU method of the
@@ -68,11 +73,16 @@
 //!   whole particles in entry order: `riemann`, the reference with the same Riemann sums) and
 //!   `sampling` (the adaptive quadrature: the reference). What a cause's share means, and how
 //!   the interaction is reported, is in [`attribution`].
+//! * `[[conventions]]` repeat every comparison of a run with its baseline run after both images
+//!   are normalised by their maximum and rounded to a bit depth, each image on its own (what
+//!   each choice means: [`conventions`]); `sweep.json` files them under the run's
+//!   `baseline.conventions.NAME`. They need a run with a baseline.
 //!
 //! The GPU methods run on the first adapter wgpu finds, one context for the whole sweep; their
 //! time is the GPU time, the CPU methods' the wall time.
 
 pub mod attribution;
+pub mod conventions;
 pub mod experiment;
 pub mod gpu;
 pub mod method;

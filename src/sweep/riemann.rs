@@ -27,6 +27,7 @@ const PARAMS: [SweepParam; 2] = [
         min: 1,
         max: u32::MAX - 1,
         accepts_all: false,
+        quiet_default: false,
         doc: "midpoint samples per interval",
     },
     SweepParam {
@@ -35,6 +36,7 @@ const PARAMS: [SweepParam; 2] = [
         min: 1,
         max: crate::reference::MAX_SPP,
         accepts_all: false,
+        quiet_default: false,
         doc: "stratified k×k samples per pixel",
     },
 ];

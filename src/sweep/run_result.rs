@@ -12,6 +12,8 @@ pub struct BaselineResult {
     pub label: String,
     /// The run's image against the baseline's (the baseline in the reference's place).
     pub comparison: Comparison,
+    /// The same comparison under each of the experiment's `[[conventions]]`: (name, result).
+    pub conventions: Vec<(String, Comparison)>,
 }
 
 /// The result of one run.

@@ -219,6 +219,16 @@ pub fn run_sweep(
         }
         runs.push(result);
     }
+    // Each kept image as each convention stores it, prepared once.
+    let prepared: Vec<Vec<Option<RgbImage>>> = exp
+        .conventions
+        .iter()
+        .map(|c| {
+            kept.iter()
+                .map(|k| k.as_ref().map(|k| c.prepare(k)))
+                .collect()
+        })
+        .collect();
     for (i, result) in runs.iter_mut().enumerate() {
         let Some(j) = result.run.baseline else {
             continue;
@@ -226,11 +236,20 @@ pub fn run_sweep(
         let (Some(image), Some(base)) = (&kept[i], &kept[j]) else {
             continue;
         };
-        let comparison =
-            compare(base, image, &compare_options).map_err(|e| e.context(result.run.label()))?;
+        let label = || result.run.label();
+        let comparison = compare(base, image, &compare_options).map_err(|e| e.context(label()))?;
+        let mut conventions = Vec::with_capacity(exp.conventions.len());
+        for (c, images) in exp.conventions.iter().zip(&prepared) {
+            let (Some(image), Some(base)) = (&images[i], &images[j]) else {
+                continue;
+            };
+            let cmp = compare(base, image, &compare_options).map_err(|e| e.context(label()))?;
+            conventions.push((c.name.clone(), cmp));
+        }
         result.baseline = Some(BaselineResult {
             label: exp.runs[j].label(),
             comparison,
+            conventions,
         });
     }
     let attributions = exp

@@ -13,7 +13,11 @@
 //! | parameter | default | meaning |
 //! |-----------|---------|---------|
 //! | `samples` | 100     | midpoint samples per particle chord |
-//! | `n_exact` | all     | particles from the eye that get the lit model; the rest the emission model |
+//! | `n_exact` | all     | particles from the eye that get the lit model; the rest the simplified model |
+//! | `rest_model` | 0    | the simplified model of the particles past `n_exact`: 0 the emission closed form C·(1−T) (as the shader), 1 absorption only (the particle dims what is behind it and adds nothing), 2 the lit model without shadow rays, w·Σ_l E_l·(1−T) |
+//!
+//! The thesis says the particles past N get "the simplified model" and no more; `rest_model`
+//! lets `reports/thesis/` measure what the readings of that sentence are worth.
 
 use super::method::{
     value_of, ParamDefault, ParamValue, RunImage, SweepContext, SweepMethod, SweepParam,
@@ -23,7 +27,7 @@ use crate::geometry::{Bvh, Hit, Ray};
 use crate::image_io::RgbImage;
 use crate::optics::light::light_weight;
 use crate::optics::models;
-use crate::scene::{RenderMode, Scene};
+use crate::scene::{Particle, RenderMode, Scene};
 use glam::DVec3;
 use rayon::prelude::*;
 
@@ -33,7 +37,7 @@ pub struct ThesisCpu;
 /// The one instance the method table holds.
 pub static THESIS_CPU: ThesisCpu = ThesisCpu;
 
-const PARAMS: [SweepParam; 2] = [
+const PARAMS: [SweepParam; 3] = [
     SweepParam {
         name: "samples",
         default: ParamDefault::Value(ParamValue::Count(100)),
@@ -41,6 +45,7 @@ const PARAMS: [SweepParam; 2] = [
         // As the GPU `thesis` allows, so that the two can be swept over the same values.
         max: 1 << 24,
         accepts_all: false,
+        quiet_default: false,
         doc: "midpoint samples per particle chord",
     },
     SweepParam {
@@ -49,9 +54,24 @@ const PARAMS: [SweepParam; 2] = [
         min: 0,
         max: u32::MAX - 1,
         accepts_all: true,
+        quiet_default: false,
         doc: "particles from the eye that get the lit model; the rest get the emission model",
     },
+    SweepParam {
+        name: "rest_model",
+        default: ParamDefault::Value(ParamValue::Count(REST_EMISSION)),
+        min: REST_EMISSION,
+        max: REST_UNSHADOWED,
+        accepts_all: false,
+        quiet_default: true,
+        doc: "model of the particles past n_exact: 0 emission C(1-T), 1 absorption only, 2 lit without shadow rays",
+    },
 ];
+
+/// `rest_model` values (see the module documentation).
+const REST_EMISSION: u32 = 0;
+const REST_ABSORPTION: u32 = 1;
+const REST_UNSHADOWED: u32 = 2;
 
 /// What every pixel needs.
 struct Shading<'a> {
@@ -59,6 +79,7 @@ struct Shading<'a> {
     bvh: Bvh,
     samples: u32,
     n_exact: u32,
+    rest_model: u32,
     lit: bool,
     /// w of the lit model: 1/m or 1 (docs/design.md §2).
     weight: f64,
@@ -109,6 +130,20 @@ impl Shading<'_> {
         sum
     }
 
+    /// The source S of a particle past `n_exact` (its radiance is S·(1−T)): its colour, nothing,
+    /// or the light arriving at its centre unoccluded, weighed as the lit model weighs it.
+    fn rest_source(&self, p: &Particle) -> DVec3 {
+        match self.rest_model {
+            REST_ABSORPTION => DVec3::ZERO,
+            REST_UNSHADOWED => {
+                let lights = self.scene.lights.iter();
+                let incident = lights.filter_map(|l| l.incident_at(p.center));
+                self.weight * incident.map(|i| i.irradiance).sum::<DVec3>()
+            }
+            _ => p.color,
+        }
+    }
+
     /// One pixel: L = Σ_i P_i·S_i + P·L_bg, P_i the transmittance in front of particle i.
     fn pixel(&self, px: u32, py: u32, camera_hits: &mut Vec<Hit>, hits: &mut Vec<Hit>) -> DVec3 {
         let ray = self.scene.camera.pixel_ray(px, py);
@@ -129,7 +164,7 @@ impl Shading<'_> {
                 * if k < n_lit {
                     self.lit_samples(&ray, p.sigma, t0, t1, hits)
                 } else {
-                    p.color * (1.0 - transmittance)
+                    self.rest_source(p) * (1.0 - transmittance)
                 };
             front *= transmittance;
             if front <= 0.0 {
@@ -177,6 +212,7 @@ impl SweepMethod for ThesisCpu {
             bvh: scene.build_bvh(),
             samples: value_of(values, "samples", 100).max(1),
             n_exact: value_of(values, "n_exact", u32::MAX),
+            rest_model: value_of(values, "rest_model", REST_EMISSION),
             lit: scene.render.model == models::LIT,
             weight: light_weight(scene.render.light_weight, scene.lights.len()),
         };
@@ -210,5 +246,69 @@ impl SweepMethod for ThesisCpu {
             gpu_seconds: None,
             warnings: Vec::new(),
         })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::SceneLoadOptions;
+    use std::path::Path;
+
+    /// One sphere (Θmax 0.6, colour (0.9, 0.5, 0.1)) in front of a grey background, one
+    /// directional light of irradiance (0.2, 0.4, 0.8), a 1×1 image whose one ray crosses the
+    /// sphere's diameter, so that its transmittance is exactly 1 − Θmax.
+    fn one_sphere() -> Scene {
+        let text = r#"
+[camera]
+position = [0.0, 0.0, -10.0]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 10.0
+width = 1
+height = 1
+[render]
+model = "lit"
+background = [0.3, 0.3, 0.3]
+[[lights]]
+type = "directional"
+direction = [0.0, -1.0, 0.0]
+irradiance = [0.2, 0.4, 0.8]
+[[particles]]
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+color = [0.9, 0.5, 0.1]
+opacity = 0.6
+"#;
+        Scene::from_toml_str(text, Path::new("one.toml"), &SceneLoadOptions::default()).unwrap()
+    }
+
+    fn pixel(scene: &Scene, rest_model: u32) -> [f32; 3] {
+        let values = [("samples", 8), ("n_exact", 0), ("rest_model", rest_model)];
+        let out = ThesisCpu
+            .render(&mut SweepContext::new(Some(1)), scene, &values)
+            .unwrap();
+        out.image.pixels[0]
+    }
+
+    #[test]
+    fn past_n_each_rest_model_gives_its_closed_form() {
+        let scene = one_sphere();
+        let (theta, bg) = (0.6, 0.3);
+        let expect = |source: [f64; 3]| source.map(|s| (s * theta + bg * (1.0 - theta)) as f32);
+        let close = |a: [f32; 3], b: [f32; 3]| a.iter().zip(&b).all(|(x, y)| (x - y).abs() < 1e-6);
+        // 0: the particle's colour; 1: nothing, only the background dimmed; 2: the light's
+        // irradiance (one light: w = 1 for `mean` as for `sum`) with no shadow.
+        for (rest, source) in [
+            (REST_EMISSION, [0.9, 0.5, 0.1]),
+            (REST_ABSORPTION, [0.0, 0.0, 0.0]),
+            (REST_UNSHADOWED, [0.2, 0.4, 0.8]),
+        ] {
+            let got = pixel(&scene, rest);
+            assert!(
+                close(got, expect(source)),
+                "rest_model {rest}: {got:?} vs {:?}",
+                expect(source)
+            );
+        }
     }
 }
