@@ -4,7 +4,7 @@
 // this prelude and defines
 //     fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32>
 // Coordinates are camera-relative (world − camera position): the camera is at the origin.
-// The shared declarations are generated from Rust (see below); tests/gpu_layout.rs checks
+// The shared declarations are generated from Rust (see below); tests/gpu/layout.rs checks
 // their layout with naga.
 
 // The constants (MAX_HITS, STACK_SIZE, T_FAR, SIGMA_INFINITE, NO_PARTICLE, PI, the light and

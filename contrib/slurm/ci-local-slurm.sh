@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # A pgt cluster render through a real, single-node Slurm on this machine (the test
-# tests/cluster_slurm.rs runs it; it is also a worked example of contrib/slurm/submit.sh).
+# tests/cluster/slurm.rs runs it; it is also a worked example of contrib/slurm/submit.sh).
 #
 #   PGT=/path/to/pgt contrib/slurm/ci-local-slurm.sh WORK SCENE N [pgt render options...]
 #

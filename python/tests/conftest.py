@@ -1,7 +1,7 @@
 """Shared fixtures of the pgt Python tests.
 
 Data and tools the tests need but a bare checkout may lack follow the Rust tests' rule
-(tests/common/mod.rs): absent under CI=true is a failure, elsewhere the test is skipped with a
+(tests/support/mod.rs): absent under CI=true is a failure, elsewhere the test is skipped with a
 message.
 
 * shared data: $PGT_SHARED_DATA, else ../shared/data beside the repository;

@@ -1,7 +1,7 @@
 //! The scene as the GPU sees it (docs/design.md §4): one Rust definition of every struct that the
 //! WGSL prelude uses, with explicit padding, so that `bytemuck` can upload them byte for byte.
 //! The WGSL declarations are *generated* from these definitions ([`gpu_struct!`] records each
-//! field's WGSL type, [`super::wgsl::wgsl_declarations`] writes them); `tests/gpu_layout.rs`
+//! field's WGSL type, [`super::wgsl::wgsl_declarations`] writes them); `tests/gpu/layout.rs`
 //! parses the result with naga and compares every member offset and struct size with these
 //! definitions, so a Rust layout that WGSL would pad differently fails a test instead of
 //! silently scrambling the scene.

@@ -10,10 +10,10 @@
 //! The `nv-flip` bindings to NVIDIA's C++ LDR-FLIP are kept as the oracle ([`flip_srgb8`],
 //! [`flip_ldr_8bit`], [`flip_hdr_8bit`]): they only accept 8-bit sRGB, so each image (each
 //! tone-mapped exposure) was quantised to 8 bits, which pgt no longer does; and they are
-//! single-threaded (tests/compare_speed.rs times both).
+//! single-threaded (tests/compare/speed.rs times both).
 //!
 //! Checked against `flip-evaluator` (pip, `evaluate(ref, test, "LDR")` and `"HDR"`) on committed
-//! vectors in tests/compare_flip.rs, and against nv-flip on identical 8-bit input in
+//! vectors in tests/compare/flip.rs, and against nv-flip on identical 8-bit input in
 //! `flip_float`'s tests.
 
 use crate::image_io::{linear_to_srgb8, RgbImage};
@@ -154,7 +154,7 @@ pub fn flip_reach(pixels_per_degree: f32) -> u32 {
 /// LDR-FLIP map of two 8-bit sRGB images (row-major RGB bytes), evaluated in parallel bands of
 /// rows: each band is run by nv-flip with [`flip_reach`] extra rows above and below, and only its
 /// own rows are kept. FLIP is local (no image-wide statistics), so the map equals the one of a
-/// single call (tests/compare_flip.rs checks bit equality); nv-flip itself is single-threaded.
+/// single call (tests/compare/flip.rs checks bit equality); nv-flip itself is single-threaded.
 pub fn flip_srgb8(w: u32, h: u32, reference: &[u8], approximation: &[u8], ppd: f32) -> Vec<f32> {
     use rayon::prelude::*;
     let halo = flip_reach(ppd);

@@ -7,7 +7,7 @@
 //! It replaces nv-flip in [`super::flip`] for speed and because nv-flip only accepts 8-bit sRGB:
 //! HDR-FLIP here tone-maps each exposure in float and never quantises. Evaluated on the decoded
 //! bytes nv-flip would see, it reproduces nv-flip's map to float rounding (tests below and in
-//! tests/compare_flip.rs); the filters sum in the same order as NVIDIA's C++ (taps from −r to r,
+//! tests/compare/flip.rs); the filters sum in the same order as NVIDIA's C++ (taps from −r to r,
 //! products then sums), and the cube root and powers of the per-pixel finish are
 //! [`super::flip_math`]'s vectorisable ones (within 10⁻⁶ of libm's).
 //!

@@ -7,7 +7,7 @@
 //! within 3 ulp; [`pow`] within 2·10⁻⁷ + 10⁻⁷·|e·log₂ x| relative (the second term is the f32
 //! rounding of the exponent e·log₂ x itself), for the exponents FLIP uses (q_c = 0.7 on distances
 //! up to a few hundred, 1 − feature ∈ [0, 1] on values in [0, 1]). FLIP's own budgets are 10⁻⁵
-//! per pixel against nv-flip and flip-evaluator (tests/compare_flip.rs).
+//! per pixel against nv-flip and flip-evaluator (tests/compare/flip.rs).
 
 /// 1.5·2²³: adding and subtracting it rounds an f32 of magnitude < 2²² to the nearest integer
 /// (without `f32::round`, a library call on x86-64's baseline SSE2).

@@ -16,7 +16,7 @@
 //! Images smaller than the window on either side are refused, as scikit-image refuses them.
 //! The arithmetic mirrors scipy's (`NI_Correlate1D` for symmetric kernels: centre tap first, then
 //! the pairs from the outside in), so results agree with scikit-image to ~1e-15; the test budget
-//! is 1e-6 (tests/compare_ssim.rs against vectors from `scripts/ssim_vectors.py`).
+//! is 1e-6 (tests/compare/ssim.rs against vectors from `scripts/ssim_vectors.py`).
 
 use crate::image_io::RgbImage;
 use rayon::prelude::*;

@@ -1,0 +1,81 @@
+//! What decoding a trajectory frame costs next to rendering it (issue 32: decoding an XTC or DCD
+//! frame costs ≤ 5 % of rendering it). Run:
+//! `cargo test --release --test formats frames_timing:: -- --ignored --nocapture`.
+//! Prints the figures and checks the 5 % bound on the XTC workload of the issue (ngl_md.xtc with
+//! ngl_md.gro, 17,411 atoms, emission, 256²).
+
+use crate::support::shared;
+use pgt::formats::topology::open_trajectory_file;
+use pgt::reference::{render, RenderOptions};
+use pgt::scene::{SceneFrames, SceneLoadOptions};
+use std::time::Instant;
+
+/// Best of `n` runs of `f`, seconds.
+fn best_of(n: usize, mut f: impl FnMut()) -> f64 {
+    (0..n)
+        .map(|_| {
+            let t = Instant::now();
+            f();
+            t.elapsed().as_secs_f64()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+#[test]
+#[ignore]
+fn decoding_a_frame_next_to_rendering_it() {
+    let (Some(gro), Some(xtc), Some(psf), Some(dcd)) = (
+        shared("trajectories/ngl_md.gro"),
+        shared("trajectories/ngl_md.xtc"),
+        shared("trajectories/tip125_tric_C36.psf"),
+        shared("trajectories/tip125_tric_C36.dcd"),
+    ) else {
+        return;
+    };
+    let dir = std::env::temp_dir().join(format!("pgt-frames-timing-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("mkdir");
+    let mut ratios = Vec::new();
+    for (name, topology, trajectory, frame) in
+        [("xtc", &gro, &xtc, 25usize), ("dcd", &psf, &dcd, 5)]
+    {
+        let scene_path = dir.join(format!("{name}.toml"));
+        std::fs::write(
+            &scene_path,
+            format!(
+                "[camera]\nwidth = 256\nheight = 256\n[render]\nmodel = \"emission\"\n[[include]]\npath = \"{}\"\ntrajectory = \"{}\"\n",
+                topology.display(),
+                trajectory.display()
+            ),
+        )
+        .expect("write");
+        let frames = SceneFrames::load(&scene_path, &SceneLoadOptions::default()).expect("loads");
+        let traj = open_trajectory_file(trajectory).expect("opens");
+        let mut positions = Vec::new();
+        let decode = best_of(20, || {
+            traj.read_positions(frame, &mut positions).expect("decodes");
+        });
+        let build = best_of(5, || {
+            frames.frame(frame).expect("frame");
+        });
+        let scene = frames.frame(frame).expect("frame");
+        let draw = best_of(3, || {
+            render(&scene, &RenderOptions::default()).expect("renders");
+        });
+        let ratio = decode / draw;
+        println!(
+            "{name}: {} atoms, decode {:.3} ms, frame scene (decode + records + particles) {:.3} ms, render 256² emission {:.1} ms: decode/render = {:.3} %",
+            traj.atoms(),
+            decode * 1e3,
+            build * 1e3,
+            draw * 1e3,
+            100.0 * ratio
+        );
+        ratios.push((name, ratio));
+    }
+    let (_, xtc_ratio) = ratios[0];
+    assert!(
+        xtc_ratio <= 0.05,
+        "decoding an XTC frame costs {:.2} % of rendering it",
+        100.0 * xtc_ratio
+    );
+}

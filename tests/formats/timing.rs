@@ -1,0 +1,26 @@
+//! Load times of the largest files (run: `cargo test --test formats timing:: -- --ignored --nocapture`).
+//! Prints only; timings depend on the machine.
+
+use crate::support::*;
+
+#[test]
+#[ignore]
+fn load_times() {
+    for rel in [
+        "pdb/1aon.pdb",
+        "pdb/3SN6.cif",
+        "vrml/pymol_1uun_spheres.wrl",
+        "vrml/jmol_1rx1_spacefill.wrl",
+        "mmpld/part_rnk000000_v103.mmpld",
+    ] {
+        let Some(p) = shared(rel) else { continue };
+        let mut best = f64::INFINITY;
+        let mut n = 0;
+        for _ in 0..5 {
+            let t = std::time::Instant::now();
+            n = load(&p).records.len();
+            best = best.min(t.elapsed().as_secs_f64());
+        }
+        println!("{rel}: {n} particles, best of 5: {:.1} ms", best * 1e3);
+    }
+}

@@ -1,0 +1,17 @@
+//! The GPU approximations (docs/design.md §4) on whatever adapter wgpu finds (lavapipe in CI): the
+//! CPU–GPU contract and layouts, the methods against exact answers, bands, `pgt approx`, and the
+//! rasterising example.
+//!
+//! One module per topic; `support` (tests/support) is shared by every test binary.
+
+#[path = "../support/mod.rs"]
+mod support;
+
+mod bands;
+mod bench;
+mod cli;
+mod contract;
+mod layout;
+mod methods;
+mod raster;
+mod sorted_blend;
