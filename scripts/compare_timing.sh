@@ -5,15 +5,15 @@
 #
 #   scripts/compare_timing.sh OLD_PGT NEW_PGT [DIR] [REPS]
 #
-# DIR holds the pairs (written there first if missing, by the ignored test `write_4k_pairs` of
-# tests/compare/speed.rs): ldr_ref.png/ldr_approx.png and hdr_ref.exr/hdr_approx.exr.
+# DIR holds the pairs (written there first if missing, by `cargo bench --bench compare --
+# --write-pairs DIR`, benches/compare.rs): ldr_ref.png/ldr_approx.png and hdr_ref.exr/hdr_approx.exr.
 set -euo pipefail
 old=$1
 new=$2
 dir=${3:-/tmp/pgt-compare-timing}
 reps=${4:-3}
 if [ ! -e "$dir/hdr_approx.exr" ]; then
-    PGT_TIMING_DIR="$dir" cargo test --release --test compare speed::write_4k_pairs -- --ignored
+    cargo bench --bench compare -- --write-pairs "$dir"
 fi
 declare -A wall cpu
 for rep in $(seq "$reps"); do

@@ -10,7 +10,7 @@
 //! The `nv-flip` bindings to NVIDIA's C++ LDR-FLIP are kept as the oracle ([`flip_srgb8`],
 //! [`flip_ldr_8bit`], [`flip_hdr_8bit`]): they only accept 8-bit sRGB, so each image (each
 //! tone-mapped exposure) was quantised to 8 bits, which pgt no longer does; and they are
-//! single-threaded (tests/compare/speed.rs times both).
+//! single-threaded (`cargo bench --bench compare`, benches/compare.rs, times both).
 //!
 //! Checked against `flip-evaluator` (pip, `evaluate(ref, test, "LDR")` and `"HDR"`) on committed
 //! vectors in tests/compare/flip.rs, and against nv-flip on identical 8-bit input in

@@ -10,6 +10,5 @@ mod cli;
 mod flip;
 mod properties;
 mod sequence_frames;
-mod speed;
 mod ssim;
 mod sweep;

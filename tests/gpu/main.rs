@@ -8,7 +8,6 @@
 mod support;
 
 mod bands;
-mod bench;
 mod cli;
 mod contract;
 mod layout;

@@ -7,7 +7,6 @@
 #[path = "../support/mod.rs"]
 mod support;
 
-mod bench;
 mod camera_projection;
 mod ellipsoids;
 mod error;

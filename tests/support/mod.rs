@@ -2,8 +2,9 @@
 //! `tests/<group>/main.rs`): the shared data directory (`../shared/data` beside the clone), which
 //! CI provides and a bare checkout may not, how a test that cannot run here says so ([`skip`]),
 //! and, in the submodules, the GPU context with its scenes and oracles ([`gpu`]), the volume
-//! reference's scenes ([`volume`]) and a WebDriver client for the report's browser tests
-//! ([`webdriver`]).
+//! reference's scenes ([`volume`]), the comparison's image pairs and second SSIM
+//! ([`compare_pairs`]) and a WebDriver client for the report's browser tests ([`webdriver`]).
+//! The benchmarks in `benches/` include it too (`#[path = "../tests/support/mod.rs"]`).
 //!
 //! A test that needs a file of the shared data gets the path from [`shared`] (or
 //! [`shared_or_skip!`]): absent under `CI=true`, that is a failure (a broken setup must not pass
@@ -105,6 +106,7 @@ pub fn close3(a: glam::DVec3, b: [f64; 3], tol: f64) -> bool {
     (a.x - b[0]).abs() <= tol && (a.y - b[1]).abs() <= tol && (a.z - b[2]).abs() <= tol
 }
 
+pub mod compare_pairs;
 pub mod gpu;
 pub mod skip;
 pub mod volume;

@@ -1,14 +1,17 @@
-//! What decoding a trajectory frame costs next to rendering it (issue 32: decoding an XTC or DCD
-//! frame costs ≤ 5 % of rendering it). Run:
-//! `cargo test --release --test formats frames_timing:: -- --ignored --nocapture`.
-//! Prints the figures and checks the 5 % bound on the XTC workload of the issue (ngl_md.xtc with
-//! ngl_md.gro, 17,411 atoms, emission, 256²).
+//! `cargo bench --bench frames`: what decoding a trajectory frame costs next to rendering it
+//! (issue 32: decoding an XTC or DCD frame costs ≤ 5 % of rendering it). Prints the figures and
+//! checks the 5 % bound on the XTC workload of the issue (ngl_md.xtc with ngl_md.gro, 17,411
+//! atoms, emission, 256²). Needs `trajectories/` of the shared data (`../shared/data`, or
+//! `$PGT_SHARED_DATA`); without it the bench says what is absent and measures nothing.
 
-use crate::support::shared;
+#[path = "../tests/support/mod.rs"]
+mod support;
+
 use pgt::formats::topology::open_trajectory_file;
 use pgt::reference::{render, RenderOptions};
 use pgt::scene::{SceneFrames, SceneLoadOptions};
 use std::time::Instant;
+use support::shared;
 
 /// Best of `n` runs of `f`, seconds.
 fn best_of(n: usize, mut f: impl FnMut()) -> f64 {
@@ -21,9 +24,7 @@ fn best_of(n: usize, mut f: impl FnMut()) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-#[test]
-#[ignore]
-fn decoding_a_frame_next_to_rendering_it() {
+fn main() {
     let (Some(gro), Some(xtc), Some(psf), Some(dcd)) = (
         shared("trajectories/ngl_md.gro"),
         shared("trajectories/ngl_md.xtc"),

@@ -1,13 +1,18 @@
-//! Timings of the `thesis` method on random particle sets like the thesis's (chapter 6):
-//! radius 1.2–1.9 (Å, used as the length unit), uniform in a cube at about protein atom density (0.05 Å⁻³), the thesis's
-//! two directional lights, Θmax 0.5. Ignored by default (minutes on lavapipe):
+//! `cargo bench --bench gpu_thesis`: timings of the `thesis` method on random particle sets like
+//! the thesis's (chapter 6): radius 1.2–1.9 (Å, used as the length unit), uniform in a cube at
+//! about protein atom density (0.05 Å⁻³), the thesis's two directional lights, Θmax 0.5. Minutes
+//! on lavapipe; the environment variables below choose the sizes (their defaults shown):
 //!
-//!     PGT_BENCH_SIDE=64 PGT_BENCH_COUNTS=2758,73642 PGT_BENCH_N_EXACT=1,5,all \
-//!         cargo test --test gpu bench:: -- --ignored --nocapture
+//!     PGT_BENCH_SIDE=64 PGT_BENCH_SAMPLES=100 PGT_BENCH_COUNTS=2758,73642 \
+//!         PGT_BENCH_N_EXACT=1,5,all cargo bench --bench gpu_thesis
 //!
-//! Prints one line per (count, n_exact): GPU seconds and the timing source.
+//! Prints one line per (count, n_exact): GPU seconds and the timing source. Without a GPU adapter
+//! it says so and measures nothing.
 
-use crate::support::gpu;
+#[path = "../tests/support/mod.rs"]
+mod support;
+
+use support::gpu;
 
 use glam::DVec3;
 use pgt::approx::{render_approx_with, ApproxParams, Timing, N_EXACT_ALL};
@@ -32,9 +37,7 @@ impl SplitMix {
     }
 }
 
-#[test]
-#[ignore]
-fn thesis_timings_on_random_particles() {
+fn main() {
     let Some(ctx) = gpu::gpu() else { return };
     let side: u32 = env_or("PGT_BENCH_SIDE", "64").parse().unwrap();
     let samples: u32 = env_or("PGT_BENCH_SAMPLES", "100").parse().unwrap();

@@ -1,14 +1,17 @@
-//! Benchmark (run by hand, `#[ignore]`): adaptive Gauss–Kronrod against the thesis's Riemann
-//! sums on a protein-like random scene, lit model, the thesis's two directional lights.
+//! `cargo bench --bench integrators`: adaptive Gauss–Kronrod against the thesis's Riemann sums
+//! on a protein-like random scene, lit model, the thesis's two directional lights; the image side
+//! is `$PGT_BENCH_SIZE` (default 64):
 //!
-//!   PGT_BENCH_SIZE=64 cargo test --test reference bench:: -- --ignored --nocapture
+//!   PGT_BENCH_SIZE=64 cargo bench --bench integrators
 //!
 //! 2,758 spheres (the particle count of the thesis's 1UUN protein), radii uniform in
 //! [1.2, 1.9] Å, centres uniform in a cube of 2758·20 Å³ (one atom per 20 Å³, about a protein's
 //! density), Θmax = 0.3, random colours; the camera frames the bounding sphere (docs/design.md §1
 //! default). Errors are against an adaptive render at tol 1e-8.
 
-use crate::support::volume::*;
+#[path = "../tests/support/mod.rs"]
+mod support;
+
 use glam::DVec3;
 use pgt::optics::extinction::sigma_from_opacity;
 use pgt::optics::models;
@@ -17,6 +20,7 @@ use pgt::reference::{Integrator, RadianceEstimator, Sample};
 use pgt::scene::{default_camera, thesis_lights};
 use rayon::prelude::*;
 use std::time::Instant;
+use support::volume::*;
 
 const PARTICLES: usize = 2758;
 const VOLUME_PER_ATOM: f64 = 20.0;
@@ -39,9 +43,7 @@ fn run(s: &pgt::scene::Scene, integrator: Integrator) -> (Vec<Sample>, f64) {
     (rows.concat(), start.elapsed().as_secs_f64())
 }
 
-#[test]
-#[ignore]
-fn benchmark_adaptive_against_riemann() {
+fn main() {
     let size: u32 = std::env::var("PGT_BENCH_SIZE")
         .ok()
         .and_then(|v| v.parse().ok())
