@@ -708,7 +708,7 @@ fn read_binary(
     let data = bytes.len().saturating_sub(h.data_start) as u64;
     let before = element_bytes(&h.elements[..v]).unwrap_or(u64::MAX);
     let start = (h.data_start as u64).saturating_add(before);
-    let need = e.count.checked_mul(stride as u64).unwrap_or(u64::MAX);
+    let need = e.count.saturating_mul(stride as u64);
     let have = (bytes.len() as u64).saturating_sub(start);
     if before > data || need > have {
         let whole = have / stride.max(1) as u64;
@@ -1225,7 +1225,8 @@ mod tests {
 
     #[test]
     fn bad_values_name_the_vertex_and_field() {
-        let cases: Vec<(fn(&mut V), &str)> = vec![
+        type Edit = fn(&mut V);
+        let cases: Vec<(Edit, &str)> = vec![
             (|w| w.s[1] = 800.0, "scale_1 = 800"),
             (|w| w.s[2] = -800.0, "scale_2 = -800"),
             (|w| w.s[0] = f32::NAN, "scale_0 = NaN"),
