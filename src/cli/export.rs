@@ -11,6 +11,7 @@
 //!   bit, and checks that `opacity` agrees with it (`crate::formats::xyz_csv`).
 //! * **PLY**: `binary_little_endian 1.0`, one `vertex` element per particle with `double`
 //!   properties `x y z radius red green blue opacity sigma`; σ = ∞ is the IEEE 754 +∞ double.
+//!   pgt's PLY reader (`crate::formats::ply`) reads it back, σ bit for bit.
 //!
 //! Θmax = 1 − e^{−2rσ} (docs/design.md §1 inverted; for a particle given by κ it is the opacity that
 //! the resolved σ has along a diameter).

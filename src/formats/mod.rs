@@ -22,6 +22,7 @@ pub mod gro;
 pub mod mmcif;
 pub mod mmpld;
 pub mod pdb;
+pub mod ply;
 pub mod psf;
 pub mod random;
 pub mod record;
@@ -30,7 +31,7 @@ pub mod vrml;
 pub mod xtc;
 pub mod xyz_csv;
 
-pub use record::{ColorBy, EllipsoidRecord, IncludeSpec, ParticleRecord};
+pub use record::{ColorBy, EllipsoidRecord, IncludeSpec, ParticleRecord, ShColor, ShOrder};
 
 use crate::error::{PgtError, Result};
 use std::path::Path;
@@ -88,6 +89,7 @@ pub static FORMATS: &[&Format] = &[
     &xyz_csv::XYZ,
     &xyz_csv::CSV,
     &gro::FORMAT,
+    &ply::FORMAT,
 ];
 
 impl PartialEq for Format {

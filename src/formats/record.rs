@@ -77,6 +77,28 @@ pub enum ColorBy {
     Uniform,
 }
 
+/// Which colour a 3D Gaussian splatting PLY gives its particles (docs/design.md §9).
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ShColor {
+    /// The degree-0 term: 0.5 + C0·f_dc, clamped at 0.
+    #[default]
+    Dc,
+    /// Every degree the file has, for the direction from the scene camera to the centre.
+    View,
+}
+
+/// The order of the `f_rest_*` coefficients of a 3D Gaussian splatting PLY.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ShOrder {
+    /// The reference implementation's: every red coefficient, then green, then blue.
+    #[default]
+    ChannelMajor,
+    /// RGB of coefficient 1, then of coefficient 2, …: EVER's training code.
+    CoefficientMajor,
+}
+
 fn one() -> f64 {
     1.0
 }
@@ -119,8 +141,19 @@ pub struct IncludeSpec {
     pub frames: Option<super::frames::FrameRange>,
     /// Source frames between two scene frames (≥ 1; 1 by default).
     pub frame_step: Option<usize>,
+    /// 3DGS PLY: standard deviations per semi-axis (> 0); [`super::ply::DEFAULT_EXTENT`] by
+    /// default.
+    pub extent: Option<f64>,
+    /// 3DGS PLY: the DC colour (default) or the view-dependent one.
+    pub sh: Option<ShColor>,
+    /// 3DGS PLY: the order of `f_rest_*` (channel-major by default).
+    pub sh_order: Option<ShOrder>,
+    /// The scene camera's position, where `sh = "view"` needs it: set by scene validation,
+    /// never read from the file.
+    #[serde(skip)]
+    pub view_from: Option<glam::DVec3>,
     /// Forces a file format whatever the extension: a name of [`super::FORMATS`] (`"pdb"`,
-    /// `"mmcif"`, `"vrml"`, `"mmpld"`, `"xyz"`, `"csv"`, `"gro"`).
+    /// `"mmcif"`, `"vrml"`, `"mmpld"`, `"xyz"`, `"csv"`, `"gro"`, `"ply"`).
     #[serde(default, deserialize_with = "super::deserialize_format")]
     pub format: Option<&'static super::Format>,
 }
@@ -141,6 +174,10 @@ impl IncludeSpec {
             sequence: None,
             frames: None,
             frame_step: None,
+            extent: None,
+            sh: None,
+            sh_order: None,
+            view_from: None,
             format: None,
         }
     }

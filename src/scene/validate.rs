@@ -71,6 +71,9 @@ fn resolve_include(at: &At, base: &Path, mut spec: IncludeSpec) -> Result<Includ
         f64::MAX,
         "> 0",
     )?;
+    if let Some(k) = spec.extent {
+        at.in_range("include.extent", k, f64::MIN_POSITIVE, f64::MAX, "> 0")?;
+    }
     let has_path = !spec.path.as_os_str().is_empty();
     match (has_path, spec.sequence.is_some(), spec.trajectory.is_some()) {
         (false, false, _) => {
@@ -168,7 +171,10 @@ fn load_toml_and_particles(
     for inc in &file.include {
         let spec_at = at(inc.span());
         let written = inc.get_ref().path.clone();
-        let spec = resolve_include(&spec_at, base, inc.get_ref().clone())?;
+        let mut spec = resolve_include(&spec_at, base, inc.get_ref().clone())?;
+        if spec.sh == Some(crate::formats::ShColor::View) {
+            spec.view_from = Some(view_position(&spec_at, &file.camera)?);
+        }
         // A file that cannot be read is named with the scene's include line (a typo in the
         // path is the usual cause); errors inside a file that was read name that file's line.
         // Errors of a frame source (a trajectory, a sequence, a `frames` range) also name the
@@ -237,6 +243,21 @@ fn load_toml_and_particles(
             lambda: render.lambda,
         },
     })
+}
+
+/// The camera position an include with `sh = "view"` evaluates its colours for: the `[camera]`
+/// table's `position`, which a fixed camera must set (a framed camera is placed after the
+/// particles are read, an orbit or keyframes move it).
+fn view_position(at: &At, table: &Option<Spanned<CameraTable>>) -> Result<DVec3> {
+    let t = table.as_ref().map(|t| t.get_ref());
+    match t {
+        Some(t) if t.orbit.is_none() && t.keyframes.is_empty() && t.position.is_some() => {
+            at.vec3("camera.position", t.position.unwrap_or_default())
+        }
+        _ => Err(at.err(
+            "include.sh = \"view\" evaluates the colours for the camera's position: set [camera] position (and look_at) for a fixed camera; a framed, orbiting or keyframed camera has no one position when the file is read",
+        )),
+    }
 }
 
 /// The camera of frame 0, with a degenerate one named at the camera table's line.
