@@ -14,6 +14,7 @@ mod frames;
 mod fuzz_smoke;
 mod mmpld;
 mod pdb;
+mod ply;
 mod text;
 mod toml_fuzz_smoke;
 mod vrml;

@@ -217,8 +217,9 @@ fn thesis_report_loads_in_headless_chromium_with_every_image_and_plot() {
     let text = std::fs::read_to_string(&page).expect("reports/thesis/index.html is committed");
     let sources = image_sources(&text);
     // Per data set: the four plots (time and error against samples and time, 1 − SSIM
-    // against the GT), the reference and five runs, and the attributions' bars and maps.
-    for set in ["1uun", "random"] {
+    // against the GT), the attributions' bars, maps and their colour bar, the 512² images and
+    // the study's plot.
+    for set in ["1uun", "cool_random"] {
         for plot in [
             "time.svg",
             "error_time.svg",
@@ -234,6 +235,14 @@ fn thesis_report_loads_in_headless_chromium_with_every_image_and_plot() {
         }
         let bars = format!("{set}/attribution_thesis_samples_100_n_exact_5.svg");
         assert!(sources.contains(&bars), "{bars} is not on the page");
+        let scale = format!("{set}/attribution_thesis_samples_100_n_exact_5_scale.svg");
+        assert!(sources.contains(&scale), "{scale} is not on the page");
+        for src in [
+            format!("512/{set}_reference.png"),
+            format!("study_{set}.svg"),
+        ] {
+            assert!(sources.contains(&src), "{src} is not on the page");
+        }
     }
     for src in &sources {
         assert!(
@@ -256,14 +265,14 @@ fn thesis_report_loads_in_headless_chromium_with_every_image_and_plot() {
     // A missing plot is caught by the same mark (the check can fail).
     let dir = tempfile::tempdir().unwrap();
     copy_report(&report, dir.path());
-    std::fs::remove_file(dir.path().join("random/error_time.svg")).unwrap();
+    std::fs::remove_file(dir.path().join("cool_random/error_time.svg")).unwrap();
     let dom = run_chromium(
         &exe,
         &dir.path().join("index.html"),
         &["--dump-dom".to_string()],
     );
     assert!(
-        dom.contains("data-pgt-images=\"missing\"") && dom.contains("random/error_time.svg"),
+        dom.contains("data-pgt-images=\"missing\"") && dom.contains("cool_random/error_time.svg"),
         "{dom}"
     );
 }

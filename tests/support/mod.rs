@@ -109,6 +109,7 @@ pub fn close3(a: glam::DVec3, b: [f64; 3], tol: f64) -> bool {
 pub mod compare_pairs;
 pub mod gpu;
 pub mod skip;
+pub mod splat;
 pub mod volume;
 pub mod webdriver;
 

@@ -1,12 +1,11 @@
 //! 3D Gaussian splatting PLY (docs/design.md §9, "3D Gaussian splatting PLY"): the real files of
 //! `../shared/data/splats` against `tests/data/ply_vectors.json` (computed with numpy alone by
 //! `scripts/ply_vectors.py`), `pgt info`, the include options, bad files through the CLI (exit 2,
-//! the file named, nothing written), a Gaussian of equal scales rendered as the sphere it is, and
-//! (ignored, run by hand) the load time of a million Gaussians.
+//! the file named, nothing written), and a Gaussian of equal scales rendered as the sphere it is. The load time of a
+//! million Gaussians is `cargo bench --bench load`.
 
-mod common;
-
-use common::*;
+use crate::support::splat::splat_file;
+use crate::support::*;
 use glam::DVec3;
 use pgt::formats::{load_particles, IncludeSpec, ShColor};
 use std::path::Path;
@@ -17,43 +16,6 @@ fn pgt(args: &[&str]) -> Output {
         .args(args)
         .output()
         .expect("pgt runs")
-}
-
-/// The standard layout's property names with `n_rest` f_rest coefficients.
-fn standard_names(n_rest: usize) -> Vec<String> {
-    let mut n: Vec<String> = [
-        "x", "y", "z", "nx", "ny", "nz", "f_dc_0", "f_dc_1", "f_dc_2",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
-    n.extend((0..n_rest).map(|k| format!("f_rest_{k}")));
-    for s in [
-        "opacity", "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3",
-    ] {
-        n.push(s.to_string());
-    }
-    n
-}
-
-/// A binary little-endian 3DGS PLY with the standard layout: `rows` holds each vertex's values
-/// in [`standard_names`] order.
-fn splat_file(n_rest: usize, rows: impl ExactSizeIterator<Item = Vec<f32>>) -> Vec<u8> {
-    let mut head = format!(
-        "ply\nformat binary_little_endian 1.0\nelement vertex {}\n",
-        rows.len()
-    );
-    for n in standard_names(n_rest) {
-        head.push_str(&format!("property float {n}\n"));
-    }
-    head.push_str("end_header\n");
-    let mut b = head.into_bytes();
-    for row in rows {
-        for x in row {
-            b.extend(x.to_le_bytes());
-        }
-    }
-    b
 }
 
 /// One Gaussian: centre, f_dc, opacity logit, log scales, quaternion, no f_rest.
@@ -397,33 +359,6 @@ fn a_sample_file_renders_from_the_command_line() {
     ]);
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert!(out.exists());
-}
-
-/// The load time of a million Gaussians in the standard layout (62 floats, 248 MB), for
-/// docs/performance.md (the issue asks ≤ 2 s on 2 cores; speed is measured, not asserted):
-/// `cargo test --test formats_ply -- --ignored --nocapture`.
-#[test]
-#[ignore]
-fn a_million_gaussians_load_in_time() {
-    let n = 1_000_000usize;
-    let dir = tempfile::tempdir().expect("tempdir");
-    let path = dir.path().join("million.ply");
-    let rows = (0..n).map(|i| {
-        let t = i as f32 * 1e-6;
-        let mut r = vec![t, -t, 2.0 * t, 0.0, 0.0, 0.0, 0.1, 0.2, 0.3];
-        r.extend((0..45).map(|k| k as f32 * 1e-3));
-        r.extend([t - 0.5, -3.0 + t, -2.5, -2.0, 1.0, t, 0.5, -0.25]);
-        r
-    });
-    let bytes = splat_file(45, rows);
-    assert_eq!(bytes.len() / 1_000_000, 248, "62 floats a vertex");
-    std::fs::write(&path, &bytes).expect("write");
-    drop(bytes);
-    let start = std::time::Instant::now();
-    let l = load_particles(&IncludeSpec::bare(&path)).expect("load");
-    let seconds = start.elapsed().as_secs_f64();
-    assert_eq!(l.records.len(), n);
-    println!("{n} Gaussians (standard layout, 248 MB): read and converted in {seconds:.3} s");
 }
 
 /// `pgt export -o F.ply` reads back as the particles it was written from, bit for bit: spheres
