@@ -25,6 +25,10 @@ use pyo3::prelude::*;
 
 #[pymodule]
 fn _pgt(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    // As the CLI's main does: keeps Mesa's device-select layer from printing an XDG_RUNTIME_DIR
+    // error on every GPU call where no Wayland session exists. Importing the module is the
+    // earliest point the package runs, before it starts any thread of its own.
+    pgt::approx::context::quiet_device_select_probe();
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add(
         "DEFAULT_PIXELS_PER_DEGREE",
