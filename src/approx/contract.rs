@@ -40,11 +40,12 @@ pub const FALLOFF_NONE: u32 = 1;
 pub const LOOP_LIMIT: u32 = 65535;
 
 /// Loop iterations of one pixel in one pass at which pgt reports the pixel (and, for a
-/// multi-pass method on a Cpu adapter, redoes the pass with less work): half of
+/// multi-pass method on a Cpu adapter, redoes the pass with less work): an eighth of
 /// [`LOOP_LIMIT`], because lavapipe counts the loops of a group of 8 SIMD lanes together, each
-/// loop as long as its slowest lane, so its count runs ahead of pgt's (measured: its limit
-/// struck when pgt's count read 43,000).
-pub const LOOP_BUDGET: u32 = 32768;
+/// loop as long as its slowest lane, so its count runs ahead of pgt's by a factor that grows
+/// with how far the lanes' work differs: past 2 where neighbouring pixels' shadow rays cross very
+/// different numbers of particles (a dense set such as "cool random"; docs/performance.md).
+pub const LOOP_BUDGET: u32 = 8192;
 
 /// Side of the square compute workgroup (`@workgroup_size(WORKGROUP_SIDE, WORKGROUP_SIDE, 1)`).
 pub const WORKGROUP_SIDE: u32 = 8;
