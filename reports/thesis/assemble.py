@@ -76,11 +76,6 @@ def channels(d):
     return {k: d[k] for k in ("R", "G", "B", "mean")} if d else None
 
 
-def run_key(r):
-    p = r["params"]
-    return (r["method"], p.get("samples"), p.get("n_exact"), p.get("rest_model", 0))
-
-
 def gt_values(sweep, convention=None):
     """{(rest_model, n): {R, G, B, mean}} of the thesis-cpu runs against the GT, as stored
     (convention None) or under a convention."""
@@ -119,7 +114,7 @@ def cpu_table(name):
     return sweep, summary, rows
 
 
-def copy_images(name, summary, rows):
+def copy_images(name, rows):
     """The reference and the N = 1 and N = all images at 512x512, into 512/ (committed)."""
     out = os.path.join(HERE, "512")
     os.makedirs(out, exist_ok=True)
@@ -562,7 +557,7 @@ def main():
             "cpu_threads": summary["threads"],
             "cpu_wall_seconds": wall("cpu_" + name),
             "reference_seconds": summary["reference_seconds"],
-            "images": copy_images(name, summary, rows),
+            "images": copy_images(name, rows),
             "gpu": gpu_dataset(name),
             "study": study(name),
         }

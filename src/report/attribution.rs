@@ -38,9 +38,9 @@ fn map_scale(a: &AttributionResult) -> Scale {
     Scale::zero_to_max(&highs)
 }
 
-/// The colour bar of a run's error maps; `id` tells the bars of one page apart.
-fn map_colorbar(a: &AttributionResult, id: &str) -> String {
-    colorbar_svg(map_scale(a), ColorMap::Magma, "|before − after|", id)
+/// The colour bar of a run's error maps on their `scale`; `id` tells the bars of one page apart.
+fn map_colorbar(scale: Scale, id: &str) -> String {
+    colorbar_svg(scale, ColorMap::Magma, "|before − after|", id)
 }
 
 /// `attribution_STEM_CAUSE.png`.
@@ -151,8 +151,8 @@ pub fn write_attribution_files(
         super::text::write_text(&dir.join(bar_file(a)), &bars_svg(a))?;
         // A standalone file for pages that show the maps outside the sweep's own page (the
         // thesis report); the sweep page inlines the same bar.
-        super::text::write_text(&dir.join(scale_file(a)), &map_colorbar(a, "bar"))?;
         let scale = map_scale(a);
+        super::text::write_text(&dir.join(scale_file(a)), &map_colorbar(scale, "bar"))?;
         for c in &a.causes {
             heatmap(&c.map, width, height, scale, ColorMap::Magma)
                 .write_png(&dir.join(map_file(a, &c.cause)))?;
@@ -197,8 +197,9 @@ pub fn attribution_section(attributions: &[AttributionResult]) -> String {
             "<tr><td>interaction</td><td>cross terms</td><td></td><td></td><td></td><td>{:.1}%</td></tr>\n</table>\n<div class=\"grid\">",
             100.0 * a.interaction
         );
+        let scale = map_scale(a);
         for (k, c) in a.causes.iter().enumerate() {
-            let bar = map_colorbar(a, &format!("bar-{}-{k}", a.stem));
+            let bar = map_colorbar(scale, &format!("bar-{}-{k}", a.stem));
             let _ = writeln!(
                 b,
                 "<figure><div class=\"heat\"><img src=\"{}\" alt=\"error map of {}\">{bar}</div><figcaption>{}: |before − after|, mean over R, G, B; magma, one scale per run</figcaption></figure>",

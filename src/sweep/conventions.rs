@@ -14,9 +14,10 @@
 use crate::image_io::RgbImage;
 
 /// How an image is normalised before a convention's comparison.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Deserialize)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum Normalize {
+    #[default]
     None,
     Max,
     ChannelMax,
@@ -31,14 +32,10 @@ pub const MAX_QUANTIZE_BITS: u32 = 24;
 pub struct Convention {
     /// The name `sweep.json` files the results under.
     pub name: String,
-    #[serde(default = "no_normalization")]
+    #[serde(default)]
     pub normalize: Normalize,
     /// Bits per channel after normalisation; `None`: the values as they are.
     pub quantize: Option<u32>,
-}
-
-fn no_normalization() -> Normalize {
-    Normalize::None
 }
 
 impl Convention {
@@ -85,9 +82,10 @@ impl Convention {
 
 /// The largest value of each channel (0 for an empty image or one without positive values).
 fn channel_maxima(image: &RgbImage) -> [f32; 3] {
-    image.pixels.iter().fold([0.0f32; 3], |m, p| {
-        std::array::from_fn(|c| if p[c] > m[c] { p[c] } else { m[c] })
-    })
+    image
+        .pixels
+        .iter()
+        .fold([0.0f32; 3], |m, p| std::array::from_fn(|c| m[c].max(p[c])))
 }
 
 #[cfg(test)]

@@ -373,6 +373,12 @@ impl Validator<'_> {
     /// Checks the `[[conventions]]`: names given once each, `quantize` in 1..=24 bits, and a
     /// run with a baseline for them to repeat.
     fn conventions(&self, tables: &[Spanned<Convention>], runs: &[Run]) -> Result<Vec<Convention>> {
+        if let Some(first) = tables.first() {
+            if runs.iter().all(|r| r.baseline.is_none()) {
+                let message = "conventions repeat the comparisons with a baseline run, and no [[approximations]] entry has a `baseline`";
+                return Err(self.src.error(self.src.line(first), message.into()));
+            }
+        }
         let mut out: Vec<Convention> = Vec::with_capacity(tables.len());
         for table in tables {
             let line = self.src.line(table);
@@ -391,10 +397,6 @@ impl Validator<'_> {
                     "conventions: quantize must be between 1 and {MAX_QUANTIZE_BITS} bits, got {bits}"
                 );
                 return Err(self.src.error(line, message));
-            }
-            if runs.iter().all(|r| r.baseline.is_none()) {
-                let message = "conventions repeat the comparisons with a baseline run, and no [[approximations]] entry has a `baseline`";
-                return Err(self.src.error(line, message.into()));
             }
             out.push(c.clone());
         }
