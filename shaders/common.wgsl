@@ -1,5 +1,5 @@
-// pgt prelude (docs/design.md §4): the scene buffers, the camera of docs/design.md §1, ray–sphere
-// intersection, one BVH traversal (all hits, first hit, any hit) and per-particle emission
+// pgt prelude (docs/design.md §4): the scene buffers, the camera of docs/design.md §1, ray–particle
+// intersection (spheres and ellipsoids), one BVH traversal (all hits, first hit, any hit) and per-particle emission
 // compositing. Every method file, pgt's own and users' (docs/user-shaders.md), is appended to
 // this prelude and defines
 //     fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32>
@@ -7,10 +7,10 @@
 // The shared declarations are generated from Rust (see below); tests/gpu/layout.rs checks
 // their layout with naga.
 
-// The constants (MAX_HITS, STACK_SIZE, T_FAR, SIGMA_INFINITE, NO_PARTICLE, PI, the light and
-// falloff codes, LOOP_LIMIT, LOOP_LIMIT_REPORT, WORKGROUP_SIDE, PARAM_SLOTS), the structs
-// Particle, BvhNode, Light, Frame, Stats and the bindings frame, particles, nodes,
-// leaf_indices, lights, output, stats are generated from src/approx/contract.rs and
+// The constants (MAX_HITS, STACK_SIZE, T_FAR, SIGMA_INFINITE, NO_PARTICLE, NO_ELLIPSOID, PI, the
+// light and falloff codes, LOOP_LIMIT, LOOP_LIMIT_REPORT, WORKGROUP_SIDE, PARAM_SLOTS), the
+// structs Particle, Ellipsoid, BvhNode, Light, Frame, Stats and the bindings frame, particles,
+// nodes, leaf_indices, lights, output, stats, ellipsoids are generated from src/approx/contract.rs and
 // src/approx/layout.rs and prepended to this file: their values and docs live there.
 
 // A method's parameter by slot; the slots are named by generated constants PARAM_<NAME>
@@ -86,6 +86,65 @@ fn intersect_sphere(ray: Ray, center: vec3<f32>, radius: f32) -> Chord {
     chord.t_exit = t_c + half;
     chord.hit = true;
     return chord;
+}
+
+// Particle shapes (docs/design.md §9): a sphere (p.ellipsoid == NO_ELLIPSOID) of p.radius, or
+// the ellipsoid ellipsoids[p.ellipsoid], whose map M = S⁻¹Rᵀ (by rows) takes a world offset
+// about the centre to the unit sphere. Methods ask intersect_particle and particle_surface,
+// never intersect_sphere directly, and so draw both shapes; a sphere's answers are the sphere
+// code's own.
+
+// M·v: a world offset (or direction) in the ellipsoid's unit-sphere coordinates.
+fn ellipsoid_to_unit(e: Ellipsoid, v: vec3<f32>) -> vec3<f32> {
+    return vec3<f32>(dot(e.row_x, v), dot(e.row_y, v), dot(e.row_z, v));
+}
+
+// M⁻¹·u = R·S·u: unit-sphere coordinates back to a world offset (column i of R·S is s_i²·row_i).
+fn ellipsoid_from_unit(e: Ellipsoid, u: vec3<f32>) -> vec3<f32> {
+    return e.row_x * (u.x * e.semi_x * e.semi_x) + e.row_y * (u.y * e.semi_y * e.semi_y)
+        + e.row_z * (u.z * e.semi_z * e.semi_z);
+}
+
+// The chord of a ray through an ellipsoid: the mapped ray M(o − c) + t·Md, written with the unit
+// direction Md/k and the parameter s = k·t (k = |Md|), crosses the unit sphere where
+// intersect_sphere says (its stable form carries over); t = s/k.
+fn intersect_ellipsoid(ray: Ray, center: vec3<f32>, e: Ellipsoid) -> Chord {
+    let d = ellipsoid_to_unit(e, ray.direction);
+    let k = length(d);
+    if (!(k > 0.0)) {
+        return Chord(0.0, 0.0, false);
+    }
+    let c = intersect_sphere(Ray(ellipsoid_to_unit(e, ray.origin - center), d / k), vec3<f32>(0.0), 1.0);
+    return Chord(c.t_enter / k, c.t_exit / k, c.hit);
+}
+
+// Where a ray's line crosses particle p, whatever its shape. (HAS_ELLIPSOIDS, an `override`, is
+// false for a scene of spheres: the test then folds away.)
+fn intersect_particle(ray: Ray, p: Particle) -> Chord {
+    if (!HAS_ELLIPSOIDS || p.ellipsoid == NO_ELLIPSOID) {
+        return intersect_sphere(ray, p.center, p.radius);
+    }
+    return intersect_ellipsoid(ray, p.center, ellipsoids[p.ellipsoid]);
+}
+
+// A point of a particle's surface and the outward unit normal there.
+struct SurfacePoint {
+    position: vec3<f32>,
+    outward: vec3<f32>,
+}
+
+// The surface point on the line from p's centre through x (x near the surface: this snaps a
+// computed hit onto it) and the outward normal there. An ellipsoid's normal is the gradient of
+// |M(x − c)|², Mᵀ·M(x − c), normalised.
+fn particle_surface(p: Particle, x: vec3<f32>) -> SurfacePoint {
+    if (!HAS_ELLIPSOIDS || p.ellipsoid == NO_ELLIPSOID) {
+        let outward = normalize(x - p.center);
+        return SurfacePoint(p.center + outward * p.radius, outward);
+    }
+    let e = ellipsoids[p.ellipsoid];
+    let u = normalize(ellipsoid_to_unit(e, x - p.center));
+    let gradient = e.row_x * u.x + e.row_y * u.y + e.row_z * u.z;
+    return SurfacePoint(p.center + ellipsoid_from_unit(e, u), normalize(gradient));
 }
 
 // Transmittance through a length of one particle's gas, exp(−σ·length); σ = +∞ (Θmax = 1)
@@ -221,8 +280,7 @@ fn traverse(ray: Ray, t_min: f32, t_max: f32, mode: u32, skip: u32, list: ptr<pr
                 if (i == skip) {
                     continue;
                 }
-                let p = particles[i];
-                let c = intersect_sphere(ray, p.center, p.radius);
+                let c = intersect_particle(ray, particles[i]);
                 if (!c.hit || c.t_exit <= t_min) {
                     continue;
                 }
@@ -339,7 +397,7 @@ fn lit_source(x: vec3<f32>) -> vec3<f32> {
 fn lit_opaque_surface(ray: Ray, index: u32, t0: f32, entering: bool) -> vec3<f32> {
     let p = particles[index];
     let x = ray_at(ray, t0);
-    let n = normalize(x - p.center);
+    let n = particle_surface(p, x).outward;
     let mu_v = max(dot(-ray.direction, n), 0.0);
     var q = vec3<f32>(0.0);
     for (var l = 0u; l < frame.light_count; l = l + 1u) {

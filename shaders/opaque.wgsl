@@ -1,5 +1,5 @@
 // Method `opaque` (docs/design.md §2 "Opaque mode", as src/reference/opaque.rs defines it): the first
-// sphere hit, Lambertian C/π plus normalised Blinn–Phong ks·(s+8)/(8π)·max(0, n·h)^s·cos, hard
+// particle hit (sphere or ellipsoid), Lambertian C/π plus normalised Blinn–Phong ks·(s+8)/(8π)·max(0, n·h)^s·cos, hard
 // shadows by one shadow ray per light through the BVH, plus ambient·C.
 
 // Shadow rays start at the surface; other spheres block only beyond this distance, relative to
@@ -12,12 +12,12 @@ fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {
         return frame.background;
     }
     let p = particles[hit.index];
-    let outward = normalize(ray_at(ray, hit.t) - p.center);
     // Snap the point onto the surface so the shadow ray starts exactly there.
-    let x = p.center + outward * p.radius;
-    let n = select(-outward, outward, hit.entering);
+    let surface = particle_surface(p, ray_at(ray, hit.t));
+    let x = surface.position;
+    let n = select(-surface.outward, surface.outward, hit.entering);
     var radiance = frame.ambient * p.color;
-    // Seen from inside its sphere, a wall's shadow ray towards the light crosses the sphere.
+    // Seen from inside its particle, a wall's shadow ray towards the light crosses the particle.
     if (!hit.entering) {
         return radiance;
     }

@@ -54,6 +54,19 @@ pub const WORKGROUP_SIDE: u32 = 8;
 /// uniform array's stride is 16 bytes).
 pub const PARAM_SLOTS: usize = 8;
 
+/// The most events one batch of the `ever` method holds (its `batch` parameter's maximum and
+/// the size of its batch arrays).
+pub const EVER_MAX_BATCH: u32 = 64;
+
+/// `Particle.ellipsoid` of a sphere: no entry in `ellipsoids`.
+pub const NO_ELLIPSOID: u32 = u32::MAX;
+
+/// The pipeline-overridable constant (WGSL `override`, default true) that says whether the scene
+/// has ellipsoids. pgt compiles each method twice as needed: with false for a scene of spheres,
+/// so that the shape test folds away and sphere scenes run the sphere code alone (a branch that
+/// is never taken still costs lavapipe, which executes both sides of a branch under a mask).
+pub const OVERRIDE_HAS_ELLIPSOIDS: &str = "HAS_ELLIPSOIDS";
+
 /// How a binding is declared in WGSL.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum BindingKind {
@@ -88,9 +101,12 @@ pub const BINDING_LIGHTS: u32 = 4;
 pub const BINDING_OUTPUT: u32 = 5;
 /// `stats` ([`GpuStats`](super::layout::GpuStats)).
 pub const BINDING_STATS: u32 = 6;
+/// `ellipsoids` ([`GpuEllipsoid`](super::layout::GpuEllipsoid)), indexed by
+/// `Particle.ellipsoid`.
+pub const BINDING_ELLIPSOIDS: u32 = 7;
 
 /// Every binding of group 0, in index order (the pipeline layout and the WGSL come from this).
-pub const BINDINGS: [Binding; 7] = [
+pub const BINDINGS: [Binding; 8] = [
     Binding {
         index: BINDING_FRAME,
         name: "frame",
@@ -132,6 +148,12 @@ pub const BINDINGS: [Binding; 7] = [
         name: "stats",
         kind: BindingKind::StorageReadWrite,
         wgsl_type: "Stats",
+    },
+    Binding {
+        index: BINDING_ELLIPSOIDS,
+        name: "ellipsoids",
+        kind: BindingKind::StorageRead,
+        wgsl_type: "array<Ellipsoid>",
     },
 ];
 

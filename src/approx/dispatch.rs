@@ -5,11 +5,16 @@
 //! queries where the adapter has them, wall time otherwise.
 
 use super::context::GpuContext;
-use super::contract::{BindingKind, BINDINGS, LOOP_BUDGET, WORKGROUP_SIDE};
-use super::layout::{GpuBvhNode, GpuFrame, GpuLight, GpuParticle, GpuStats, SceneBuffers};
+use super::contract::{
+    BindingKind, BINDINGS, LOOP_BUDGET, OVERRIDE_HAS_ELLIPSOIDS, WORKGROUP_SIDE,
+};
+use super::layout::{
+    GpuBvhNode, GpuEllipsoid, GpuFrame, GpuLight, GpuParticle, GpuStats, SceneBuffers,
+};
 use super::shader::{ShaderProgram, ENTRY_POINT};
 use crate::error::{PgtError, Result};
 use crate::image_io::RgbImage;
+use std::sync::OnceLock;
 use std::time::Instant;
 use wgpu::util::DeviceExt;
 
@@ -102,11 +107,16 @@ impl PassSchedule {
     }
 }
 
-/// A compiled method: shader module, bind group layout (from [`BINDINGS`]) and compute
-/// pipeline. Build it once and [`run`] it on any number of scenes and parameter values.
+/// A compiled method: shader module, bind group layout (from [`BINDINGS`]) and its compute
+/// pipelines, one for scenes of spheres and one for scenes with ellipsoids
+/// ([`OVERRIDE_HAS_ELLIPSOIDS`]), each compiled when a scene first needs it. Build it once and
+/// [`run`] it on any number of scenes and parameter values.
 pub struct Pipeline {
-    pipeline: wgpu::ComputePipeline,
+    module: wgpu::ShaderModule,
+    pipeline_layout: wgpu::PipelineLayout,
     layout: wgpu::BindGroupLayout,
+    /// [spheres only, with ellipsoids].
+    variants: [OnceLock<wgpu::ComputePipeline>; 2],
 }
 
 impl std::fmt::Debug for Pipeline {
@@ -157,16 +167,39 @@ impl Pipeline {
                 bind_group_layouts: &[Some(&layout)],
                 immediate_size: 0,
             });
-            let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("pgt method"),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(ENTRY_POINT),
-                compilation_options: Default::default(),
-                cache: None,
-            });
-            Pipeline { pipeline, layout }
+            Pipeline {
+                module,
+                pipeline_layout,
+                layout,
+                variants: [OnceLock::new(), OnceLock::new()],
+            }
         })
+    }
+
+    /// The compute pipeline for a scene with (`true`) or without ellipsoids, compiled on first
+    /// use.
+    fn variant(&self, ctx: &GpuContext, ellipsoids: bool) -> Result<&wgpu::ComputePipeline> {
+        let slot = &self.variants[ellipsoids as usize];
+        if let Some(p) = slot.get() {
+            return Ok(p);
+        }
+        let constants = [(OVERRIDE_HAS_ELLIPSOIDS, if ellipsoids { 1.0 } else { 0.0 })];
+        let compiled = ctx.checked("creating the compute pipeline", || {
+            ctx.device
+                .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                    label: Some("pgt method"),
+                    layout: Some(&self.pipeline_layout),
+                    module: &self.module,
+                    entry_point: Some(ENTRY_POINT),
+                    compilation_options: wgpu::PipelineCompilationOptions {
+                        constants: &constants,
+                        ..Default::default()
+                    },
+                    cache: None,
+                })
+        })?;
+        // Another thread may have compiled it meanwhile: either copy serves.
+        Ok(slot.get_or_init(|| compiled))
     }
 }
 
@@ -268,6 +301,7 @@ fn buffer(ctx: &GpuContext, label: &str, size: u64, usage: wgpu::BufferUsages) -
 /// The scene's buffers, shared by every band.
 struct SceneOnGpu {
     particles: wgpu::Buffer,
+    ellipsoids: wgpu::Buffer,
     nodes: wgpu::Buffer,
     indices: wgpu::Buffer,
     lights: wgpu::Buffer,
@@ -310,7 +344,8 @@ impl Band {
             bytes,
             U::STORAGE | U::COPY_SRC | U::COPY_DST,
         );
-        // In BINDINGS order: frame, particles, nodes, leaf_indices, lights, output, stats.
+        // In BINDINGS order: frame, particles, nodes, leaf_indices, lights, output, stats,
+        // ellipsoids.
         let resources = [
             &frame_buf,
             &scene.particles,
@@ -319,6 +354,7 @@ impl Band {
             &scene.lights,
             &output,
             &scene.stats,
+            &scene.ellipsoids,
         ];
         let entries: Vec<wgpu::BindGroupEntry> = BINDINGS
             .iter()
@@ -391,6 +427,7 @@ impl Upload {
             limit,
             &[
                 ("particle", bytes::<GpuParticle>(scene.particles.len())),
+                ("ellipsoid", bytes::<GpuEllipsoid>(scene.ellipsoids.len())),
                 ("BVH node", bytes::<GpuBvhNode>(scene.nodes.len())),
                 ("BVH index", bytes::<u32>(scene.leaf_indices.len())),
                 ("light", bytes::<GpuLight>(scene.lights.len())),
@@ -412,6 +449,7 @@ impl Upload {
         ctx.checked("uploading the scene", || {
             let shared = SceneOnGpu {
                 particles: storage(ctx, "pgt particles", &scene.particles),
+                ellipsoids: storage(ctx, "pgt ellipsoids", &scene.ellipsoids),
                 nodes: storage(ctx, "pgt bvh nodes", &scene.nodes),
                 indices: storage(ctx, "pgt bvh indices", &scene.leaf_indices),
                 lights: storage(ctx, "pgt lights", &scene.lights),
@@ -500,7 +538,7 @@ fn copy_bands<'a>(
 /// ticks from the first band's start to the last band's end.
 fn run_pass(
     ctx: &GpuContext,
-    pipeline: &Pipeline,
+    pipeline: &wgpu::ComputePipeline,
     up: &Upload,
     frame: &GpuFrame,
 ) -> Result<(GpuStats, Option<u64>)> {
@@ -536,7 +574,7 @@ fn run_pass(
                     },
                 ),
             });
-            pass.set_pipeline(&pipeline.pipeline);
+            pass.set_pipeline(pipeline);
             pass.set_bind_group(0, &band.bind_group, &[]);
             pass.dispatch_workgroups(band.groups.0, band.groups.1, 1);
         }
@@ -632,6 +670,7 @@ pub fn run_with_progress(
     progress: &mut dyn FnMut(PassProgress),
 ) -> Result<DispatchOutput> {
     let up = Upload::with_limit(ctx, pipeline, scene, frame, limit)?;
+    let compiled = pipeline.variant(ctx, !scene.ellipsoids.is_empty())?;
     let mut schedule = PassSchedule::new(ctx.adapter.is_cpu);
     let start = Instant::now();
     let mut gpu_ticks: Option<f64> = up.timestamps.as_ref().map(|_| 0.0);
@@ -639,7 +678,7 @@ pub fn run_with_progress(
     loop {
         let mut pass_frame = *frame;
         (pass_frame.pair_begin, pass_frame.pair_end) = schedule.range();
-        let (stats, ticks) = run_pass(ctx, pipeline, &up, &pass_frame)?;
+        let (stats, ticks) = run_pass(ctx, compiled, &up, &pass_frame)?;
         if let (Some(total), Some(t)) = (gpu_ticks.as_mut(), ticks) {
             *total += t as f64;
         }

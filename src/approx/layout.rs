@@ -11,10 +11,10 @@
 //! image is, however far the scene is from the world origin.
 
 use super::contract::{
-    FALLOFF_INVERSE_SQUARE, FALLOFF_NONE, LIGHT_DIRECTIONAL, LIGHT_POINT, PARAM_SLOTS,
-    SIGMA_INFINITE,
+    FALLOFF_INVERSE_SQUARE, FALLOFF_NONE, LIGHT_DIRECTIONAL, LIGHT_POINT, NO_ELLIPSOID,
+    PARAM_SLOTS, SIGMA_INFINITE,
 };
-use crate::geometry::Bvh;
+use crate::geometry::{Bvh, Ellipsoid};
 use crate::scene::{Falloff, Light, Scene};
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
@@ -89,9 +89,43 @@ gpu_struct! {
         pub ks: f32,
         /// Blinn–Phong exponent.
         pub shininess: f32,
-        pub _pad0: f32,
+        /// The shape (docs/design.md §9): [`NO_ELLIPSOID`] for a sphere of `radius`, else the
+        /// index of its [`GpuEllipsoid`] in `ellipsoids` (`radius` is then the bounding radius).
+        pub ellipsoid: u32,
         pub _pad1: f32,
         pub _pad2: f32,
+    }
+}
+
+gpu_struct! {
+    /// WGSL `struct Ellipsoid`, 48 bytes: the map M = S⁻¹Rᵀ of docs/design.md §9 from a world
+    /// offset about the centre to unit-sphere coordinates, by rows (row i is the body's axis i
+    /// in world coordinates divided by its semi-axis), and the semi-axes s_i (M⁻¹ = R·S has the
+    /// columns s_i²·row_i).
+    plain "Ellipsoid" pub struct GpuEllipsoid {
+        pub row_x: [f32; 3],
+        pub semi_x: f32,
+        pub row_y: [f32; 3],
+        pub semi_y: f32,
+        pub row_z: [f32; 3],
+        pub semi_z: f32,
+    }
+}
+
+impl GpuEllipsoid {
+    /// The ellipsoid's map in f32 (rows computed in f64, then rounded).
+    pub fn new(e: &Ellipsoid) -> GpuEllipsoid {
+        let r = glam::DMat3::from_quat(e.rotation());
+        let s = e.semi_axes();
+        let row = |i: usize| (r.col(i) / s[i]).as_vec3().to_array();
+        GpuEllipsoid {
+            row_x: row(0),
+            semi_x: s.x as f32,
+            row_y: row(1),
+            semi_y: s.y as f32,
+            row_z: row(2),
+            semi_z: s.z as f32,
+        }
     }
 }
 
@@ -190,6 +224,8 @@ gpu_struct! {
 #[derive(Debug, Clone)]
 pub struct SceneBuffers {
     pub particles: Vec<GpuParticle>,
+    /// The ellipsoids' maps, in particle order (empty in a scene of spheres).
+    pub ellipsoids: Vec<GpuEllipsoid>,
     pub nodes: Vec<GpuBvhNode>,
     pub leaf_indices: Vec<u32>,
     pub lights: Vec<GpuLight>,
@@ -226,10 +262,18 @@ impl SceneBuffers {
     /// Converts the scene and its BVH (built by the foundation's binned SAH) to the GPU layout.
     pub fn new(scene: &Scene, bvh: &Bvh) -> SceneBuffers {
         let origin = scene.camera.position;
+        let mut ellipsoids = Vec::new();
         let particles = scene
             .particles
             .iter()
             .map(|p| GpuParticle {
+                ellipsoid: match &p.ellipsoid {
+                    None => NO_ELLIPSOID,
+                    Some(e) => {
+                        ellipsoids.push(GpuEllipsoid::new(e));
+                        ellipsoids.len() as u32 - 1
+                    }
+                },
                 center: rel(p.center, origin),
                 radius: p.radius as f32,
                 color: p.color.as_vec3().to_array(),
@@ -288,6 +332,7 @@ impl SceneBuffers {
             .collect();
         SceneBuffers {
             particles,
+            ellipsoids,
             nodes,
             leaf_indices: bvh.indices.clone(),
             lights,

@@ -4,7 +4,9 @@
 //! slots.
 
 use super::contract::*;
-use super::layout::{GpuBvhNode, GpuFrame, GpuLight, GpuParticle, GpuStats, WgslStruct};
+use super::layout::{
+    GpuBvhNode, GpuEllipsoid, GpuFrame, GpuLight, GpuParticle, GpuStats, WgslStruct,
+};
 use std::fmt::Write as _;
 
 /// A WGSL `const` written from a Rust constant.
@@ -23,6 +25,7 @@ pub fn constants() -> Vec<WgslConst> {
         F32("T_FAR", T_FAR),
         F32("SIGMA_INFINITE", SIGMA_INFINITE),
         U32("NO_PARTICLE", NO_PARTICLE),
+        U32("NO_ELLIPSOID", NO_ELLIPSOID),
         F32("PI", std::f32::consts::PI),
         U32("LIGHT_DIRECTIONAL", LIGHT_DIRECTIONAL),
         U32("LIGHT_POINT", LIGHT_POINT),
@@ -32,6 +35,7 @@ pub fn constants() -> Vec<WgslConst> {
         U32("LOOP_LIMIT_REPORT", LOOP_BUDGET),
         U32("WORKGROUP_SIDE", WORKGROUP_SIDE),
         U32("PARAM_SLOTS", PARAM_SLOTS as u32),
+        U32("EVER_MAX_BATCH", EVER_MAX_BATCH),
     ]
 }
 
@@ -71,8 +75,10 @@ pub fn wgsl_declarations() -> String {
         out.push_str(&c.declaration());
         out.push('\n');
     }
+    let _ = writeln!(out, "override {OVERRIDE_HAS_ELLIPSOIDS}: bool = true;");
     out.push('\n');
     struct_declaration::<GpuParticle>(&mut out);
+    struct_declaration::<GpuEllipsoid>(&mut out);
     struct_declaration::<GpuBvhNode>(&mut out);
     struct_declaration::<GpuLight>(&mut out);
     struct_declaration::<GpuFrame>(&mut out);

@@ -211,31 +211,3 @@ fn export_writes_the_ellipsoid_columns_and_reads_back() {
     assert!(o.status.success());
     assert_eq!(std::fs::read_to_string(&again).unwrap(), text);
 }
-
-#[test]
-fn gpu_methods_refuse_ellipsoids_by_name() {
-    let dir = tempfile::tempdir().unwrap();
-    let scene = write(
-        dir.path(),
-        "e.toml",
-        &format!("{HEAD}[[particles]]\ncenter = [0.0, 0.0, 0.0]\nsemi_axes = [2.0, 0.1, 0.5]\n"),
-    );
-    let out = dir.path().join("a.exr");
-    for method in ["emission", "sorted-blend"] {
-        let o = pgt(&[
-            "approx",
-            &scene,
-            "--method",
-            method,
-            "-o",
-            out.to_str().unwrap(),
-        ]);
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert_eq!(o.status.code(), Some(2), "{err}");
-        assert!(
-            err.contains(&format!("the {method} method does not draw ellipsoids yet")),
-            "{err}"
-        );
-        assert!(!out.exists());
-    }
-}

@@ -66,7 +66,14 @@ fn repetitions(text: &str) -> Vec<String> {
             }
         }
     }
-    for name in ["Particle", "BvhNode", "Light", "Frame", "Stats"] {
+    for name in [
+        "Particle",
+        "Ellipsoid",
+        "BvhNode",
+        "Light",
+        "Frame",
+        "Stats",
+    ] {
         if code.contains(&format!("struct {name} ")) || code.contains(&format!("struct {name}{{")) {
             found.push(format!("declares struct {name}"));
         }

@@ -4,7 +4,7 @@
 //! Rust's. naga computes the WGSL layout; this compares every named member's offset and every
 //! struct's size with `offset_of!` and `size_of`. No GPU needed.
 
-use pgt::approx::layout::{GpuBvhNode, GpuFrame, GpuLight, GpuParticle, GpuStats};
+use pgt::approx::layout::{GpuBvhNode, GpuEllipsoid, GpuFrame, GpuLight, GpuParticle, GpuStats};
 use pgt::approx::shader::prelude_source;
 use std::mem::{offset_of, size_of};
 
@@ -59,6 +59,7 @@ fn particle_members() -> Vec<(&'static str, usize)> {
         ("albedo", offset_of!(GpuParticle, albedo)),
         ("ks", offset_of!(GpuParticle, ks)),
         ("shininess", offset_of!(GpuParticle, shininess)),
+        ("ellipsoid", offset_of!(GpuParticle, ellipsoid)),
     ]
 }
 
@@ -70,6 +71,19 @@ fn rust_and_wgsl_struct_layouts_agree() {
         "Particle",
         size_of::<GpuParticle>(),
         &particle_members(),
+    );
+    check(
+        &module,
+        "Ellipsoid",
+        size_of::<GpuEllipsoid>(),
+        &[
+            ("row_x", offset_of!(GpuEllipsoid, row_x)),
+            ("semi_x", offset_of!(GpuEllipsoid, semi_x)),
+            ("row_y", offset_of!(GpuEllipsoid, row_y)),
+            ("semi_y", offset_of!(GpuEllipsoid, semi_y)),
+            ("row_z", offset_of!(GpuEllipsoid, row_z)),
+            ("semi_z", offset_of!(GpuEllipsoid, semi_z)),
+        ],
     );
     check(
         &module,
@@ -136,12 +150,12 @@ fn rust_and_wgsl_struct_layouts_agree() {
 
 #[test]
 fn the_check_catches_a_shifted_member() {
-    // The subtle mismatch: padding moved in front of `shininess`. Same size, same member order,
-    // only one offset differs (52 instead of 48); the check must still fail.
+    // The subtle mismatch: padding moved in front of `ellipsoid`. Same size, same member order,
+    // only one offset differs (56 instead of 52); the check must still fail.
     let prelude = prelude_source();
     let wrong = prelude.replace(
-        "    shininess: f32,\n    _pad0: f32,",
-        "    _pad0: f32,\n    shininess: f32,",
+        "    ellipsoid: u32,\n    _pad1: f32,",
+        "    _pad1: f32,\n    ellipsoid: u32,",
     );
     assert_ne!(wrong, prelude, "the replacement must apply");
     let module = naga::front::wgsl::parse_str(&wrong).expect("still valid WGSL");

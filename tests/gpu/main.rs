@@ -10,6 +10,7 @@ mod support;
 mod bands;
 mod cli;
 mod contract;
+mod ellipsoids;
 mod layout;
 mod methods;
 mod raster;

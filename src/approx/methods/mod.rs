@@ -63,22 +63,9 @@ pub trait ApproxMethod: Sync {
     }
 }
 
-/// No GPU method draws ellipsoids yet (docs/design.md §9; the GPU layout holds spheres): a
-/// scene with any is refused, naming the method `name` and the scene.
-pub fn check_shapes(name: &str, scene: &Scene) -> Result<()> {
-    match scene.particles.iter().position(|p| p.ellipsoid.is_some()) {
-        None => Ok(()),
-        Some(i) => Err(PgtError::Usage(format!(
-            "the {name} method does not draw ellipsoids yet (the GPU layout holds spheres only); {} has ellipsoids (particle {i} is the first): render it with the CPU reference (`pgt render`) instead",
-            scene.source.display()
-        ))),
-    }
-}
-
 /// The refusal of [`Computes`]: the method `name`, computing `computes`, on `scene`. The
 /// message names the method, the scene's mode or model, and the flag or the methods that fit.
 pub fn check_computes(name: &str, computes: Computes, scene: &Scene) -> Result<()> {
-    check_shapes(name, scene)?;
     let (mode, model) = (scene.render.mode, scene.render.model);
     if computes.covers(mode, model) {
         return Ok(());
@@ -143,6 +130,7 @@ registry! {
     opaque::Opaque,
     thesis::Thesis,
     sorted_blend::SortedBlend,
+    ever::Ever,
 }
 
 /// The registered method called `name`.
