@@ -124,6 +124,13 @@ fn intersect_particle(ray: Ray, p: Particle) -> Chord {
     if (!HAS_ELLIPSOIDS || p.ellipsoid == NO_ELLIPSOID) {
         return intersect_sphere(ray, p.center, p.radius);
     }
+    // Most candidates miss: the bounding sphere (radius = the longest semi-axis) rejects a ray
+    // whose line passes farther from the centre before the ray is mapped.
+    let f = ray.origin - p.center;
+    let l = f - dot(f, ray.direction) * ray.direction;
+    if (dot(l, l) >= p.radius * p.radius) {
+        return Chord(0.0, 0.0, false);
+    }
     return intersect_ellipsoid(ray, p.center, ellipsoids[p.ellipsoid]);
 }
 

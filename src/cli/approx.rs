@@ -278,11 +278,11 @@ pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
     };
     let pixels = scene.camera.width as f64 * scene.camera.height as f64;
     eprintln!(
-        "approximated {} ({}x{}, {} spheres, {} lights) with {}{} on {}: {} s GPU ({}, {passes}), {}",
+        "approximated {} ({}x{}, {}, {} lights) with {}{} on {}: {} s GPU ({}, {passes}), {}",
         output.display(),
         scene.camera.width,
         scene.camera.height,
-        scene.particles.len(),
+        super::render::particles_text(&scene),
         scene.lights.len(),
         out.method.name(),
         describe_params(&out.method, &out.params),

@@ -147,8 +147,8 @@ pub fn run(args: BenchArgs) -> anyhow::Result<Outcome> {
         }
         let (name, scene) = workload_scene(w, args.size, &args.data)?;
         eprintln!(
-            "bench: {name}, {} spheres, {}x{}",
-            scene.particles.len(),
+            "bench: {name}, {}, {}x{}",
+            super::render::particles_text(&scene),
             args.size,
             args.size
         );
@@ -410,7 +410,7 @@ fn particle(center: DVec3, radius: f64, color: DVec3) -> Particle {
 /// r·k·(1, u, v) with u, v uniform in [1/4, 1] and k = (uv)^{−1/3}, a uniformly random unit
 /// quaternion (normalised Gaussian components, by Box–Muller), σ for Θmax = [`OPACITY`] along
 /// the shortest diameter.
-fn as_ellipsoids(particles: &mut [Particle]) {
+pub fn as_ellipsoids(particles: &mut [Particle]) {
     let mut rng = SplitMix64::new(1);
     for p in particles {
         let (u, v) = (0.25 + 0.75 * rng.next_f64(), 0.25 + 0.75 * rng.next_f64());

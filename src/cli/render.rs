@@ -5,7 +5,7 @@ use super::Outcome;
 use crate::image_io::write_image;
 use crate::parts::PartOf;
 use crate::reference::{self, Integrator, RenderOptions};
-use crate::scene::{Model, RenderMode, SceneLoadOptions};
+use crate::scene::{Model, RenderMode, Scene, SceneLoadOptions};
 use clap::{Args, ValueEnum};
 use std::path::PathBuf;
 
@@ -133,18 +133,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
     write_image(&args.output, &out.image, &layers, args.exposure)?;
     let s = &out.stats;
     let rays = s.primary_rays + s.shadow_rays;
-    let ellipsoids = scene
-        .particles
-        .iter()
-        .filter(|p| p.ellipsoid.is_some())
-        .count();
-    let particles = match ellipsoids {
-        0 => format!("{} spheres", scene.particles.len()),
-        n => format!(
-            "{} particles, {n} of them ellipsoids",
-            scene.particles.len()
-        ),
-    };
+    let particles = particles_text(&scene);
     let mut line = format!(
         "rendered {} ({}x{}, {particles}, {} lights) in {:.2} s: {} primary + {} shadow rays, {:.3} Mrays/s",
         args.output.display(),
@@ -251,4 +240,20 @@ fn render_frames(
         );
     }
     Ok(Outcome::Success)
+}
+
+/// "11032 spheres", or "4 particles, 3 of them ellipsoids": the particles of a summary line.
+pub(crate) fn particles_text(scene: &Scene) -> String {
+    let ellipsoids = scene
+        .particles
+        .iter()
+        .filter(|p| p.ellipsoid.is_some())
+        .count();
+    match ellipsoids {
+        0 => format!("{} spheres", scene.particles.len()),
+        n => format!(
+            "{} particles, {n} of them ellipsoids",
+            scene.particles.len()
+        ),
+    }
 }
