@@ -9,6 +9,7 @@ pub mod cutter;
 pub mod emission;
 pub mod exponential;
 pub mod extinction;
+pub mod gaussian;
 pub mod intervals;
 pub mod kinks;
 pub mod light;
