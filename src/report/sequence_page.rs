@@ -404,15 +404,15 @@ const PLAYER_SCRIPT: &str = r#"<script>
     if (e === 31) { return m ? NaN : s * Infinity; }
     return s * (1 + m / 1024) * Math.pow(2, e - 15);
   }
-  // base64 of zlib of the float16 byte planes (low bytes, then high bytes) → Float32Array.
+  // base64 of zlib of little-endian float16 (R, G, B interleaved, row-major) → Float32Array.
   function decode(b64) {
     if (!b64) { return Promise.resolve(null); }
     var bin = atob(b64), bytes = new Uint8Array(bin.length);
     for (var i = 0; i < bin.length; i++) { bytes[i] = bin.charCodeAt(i); }
     var stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream("deflate"));
     return new Response(stream).arrayBuffer().then(function (buf) {
-      var b = new Uint8Array(buf), n = b.length / 2, out = new Float32Array(n);
-      for (var k = 0; k < n; k++) { out[k] = half(b[k] | (b[n + k] << 8)); }
+      var dv = new DataView(buf), out = new Float32Array(buf.byteLength / 2);
+      for (var k = 0; k < out.length; k++) { out[k] = half(dv.getUint16(2 * k, true)); }
       return out;
     });
   }

@@ -632,6 +632,22 @@ fn sequence_report_plays_its_frames() {
         src("pgt-r"),
         format!("frames/r_{:06}.png", target.parse::<usize>().unwrap())
     );
+    // The probe: a pixel of the approximation pane shows that frame's values (its file loads
+    // from file://; sequence_probe_shows_each_frames_values checks them against the EXRs).
+    let b = s.eval("var b = document.getElementById('pgt-a').getBoundingClientRect(); return [b.left + b.width / 2, b.top + b.height / 2];");
+    let (x, y) = (b[0].as_f64().unwrap(), b[1].as_f64().unwrap());
+    s.hover(x, y);
+    wait_until(
+        &s,
+        &format!("document.getElementById('pgt-probe').getAttribute('data-frame') === '{target}'"),
+    );
+    for key in ["reference", "approximation", "temporal"] {
+        let row = sequence_probe_row(&s, key);
+        assert!(
+            row.iter().all(|v| v.is_some_and(f64::is_finite)),
+            "{key}: {row:?}"
+        );
+    }
 }
 
 /// Waits until the JS expression `ready` is true in the page.
