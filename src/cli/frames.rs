@@ -80,7 +80,7 @@ const UNITS_PER_FRAME: u64 = 1000;
 enum Share {
     /// The reference: blocks done of the frame's blocks (0 of 0 before it has started).
     Blocks(u64, u64),
-    /// A GPU method: passes ended (their number is not known in advance).
+    /// A GPU method: passes ended (their number is not known in advance; 0 before the first).
     Passes(u32),
 }
 
@@ -116,7 +116,7 @@ fn bar_state(done: usize, total: usize, in_flight: &[(usize, Share)]) -> (u64, S
                 position += d.min(t) * UNITS_PER_FRAME / t;
                 format!("frame {frame} {}%", d.min(t) * 100 / t)
             }
-            Share::Blocks(..) => format!("frame {frame} starting"),
+            Share::Blocks(..) | Share::Passes(0) => format!("frame {frame} starting"),
             Share::Passes(n) => format!("frame {frame} pass {n}"),
         };
         if k < NAMED_IN_FLIGHT {
@@ -218,10 +218,10 @@ impl Drop for FrameProgress {
 }
 
 impl FrameWatch for FrameProgress {
-    fn started(&self, frame: usize, control: &Arc<RenderControl>) {
+    fn started(&self, frame: usize, control: Option<&Arc<RenderControl>>) {
         if let Ok(mut l) = self.live.lock() {
-            l.in_flight
-                .insert(frame, InFlight::Reference(Arc::clone(control)));
+            let what = control.map_or(InFlight::Passes(0), |c| InFlight::Reference(Arc::clone(c)));
+            l.in_flight.insert(frame, what);
         }
     }
 
@@ -278,6 +278,8 @@ mod tests {
         let (position, message) = bar_state(1, 3, &[(1, Share::Passes(7))]);
         assert_eq!(position, UNITS_PER_FRAME);
         assert_eq!(message, "1/3 frames, frame 1 pass 7");
+        let (_, message) = bar_state(1, 3, &[(1, Share::Passes(0))]);
+        assert_eq!(message, "1/3 frames, frame 1 starting");
         // Many frames side by side: three named, the rest counted; the bar never passes the end.
         let many: Vec<(usize, Share)> = (0..5).map(|f| (f, Share::Blocks(9, 9))).collect();
         let (position, message) = bar_state(0, 5, &many);
@@ -289,7 +291,8 @@ mod tests {
     fn the_watch_counts_frames_and_forgets_those_that_ended() {
         let p = FrameProgress::new("render", 2);
         let control = Arc::new(RenderControl::default());
-        p.started(0, &control);
+        p.started(0, Some(&control));
+        p.started(1, None);
         p.pass(
             1,
             PassProgress {

@@ -65,8 +65,9 @@ impl FrameDone {
 /// What a sequence render tells its caller as it goes (the CLI's progress). Calls come from any
 /// worker, several frames at a time where frames render side by side.
 pub trait FrameWatch: Sync {
-    /// The reference starts frame `frame`; `control` counts its blocks until it ends.
-    fn started(&self, _frame: usize, _control: &Arc<RenderControl>) {}
+    /// Frame `frame` starts: the reference's with the `control` that counts its blocks until it
+    /// ends, a GPU method's with none (its passes follow).
+    fn started(&self, _frame: usize, _control: Option<&Arc<RenderControl>>) {}
     /// A GPU method ended a pass of frame `frame`.
     fn pass(&self, _frame: usize, _progress: PassProgress) {}
     /// Frame `d.frame()` ended: rendered and written, or skipped.
@@ -281,7 +282,7 @@ fn render_one(
         ..*options
     };
     let control = Arc::new(RenderControl::default());
-    watch.started(frame, &control);
+    watch.started(frame, Some(&control));
     let out =
         reference::render_controlled(&scene, &frame_options, &control).map_err(in_frame(frame))?;
     write_frame(
@@ -360,6 +361,7 @@ pub fn approx_frames(
         let d = if already_rendered(&path, &hash) {
             FrameDone::Skipped { frame, path }
         } else {
+            watch.started(frame, None);
             let r = pipeline
                 .render_with_progress(&ctx, &scene, params, &mut |p| watch.pass(frame, p))
                 .map_err(in_frame(frame))?;
