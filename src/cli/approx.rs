@@ -316,7 +316,7 @@ fn approx_frames(
         &pattern,
         &params,
         args.exposure,
-        &mut |d| progress.done(d),
+        &progress,
     );
     progress.finish();
     let out = out?;

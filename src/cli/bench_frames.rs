@@ -17,7 +17,7 @@
 use crate::parts::render_hash;
 use crate::reference::{self, RenderOptions};
 use crate::scene::{SceneFrames, SceneLoadOptions};
-use crate::sequence::render::{render_frames, write_frame};
+use crate::sequence::render::{render_frames, write_frame, FrameDone};
 use crate::sequence::SequencePattern;
 use std::fmt::Write as _;
 use std::path::Path;
@@ -121,7 +121,7 @@ pub fn bench_frames(
         let start = Instant::now();
         let pattern = SequencePattern::parse(&dir.path().join("seq/f_%04d.exr"))?;
         let seq = load()?;
-        render_frames(&seq, &list, &pattern, &options, 0.0, &|_| {})?;
+        render_frames(&seq, &list, &pattern, &options, 0.0, &|_: &FrameDone| {})?;
         let sequence = start.elapsed().as_secs_f64();
 
         let start = Instant::now();

@@ -211,7 +211,7 @@ fn render_frames(
         &pattern,
         &render_options,
         args.exposure,
-        &|d| progress.done(d),
+        &progress,
     );
     progress.finish();
     let summary = summary?;

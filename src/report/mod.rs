@@ -19,6 +19,7 @@ pub use html::{write_report, ReportInputs, ReportOptions};
 pub use summary::Summary;
 pub mod plot;
 pub mod sequence_page;
+pub mod sequence_probe;
 pub mod sweep_page;
 pub mod text;
 pub mod viewer;

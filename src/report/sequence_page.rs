@@ -3,7 +3,10 @@
 //! frames (SVG) with the worst frames listed as links, and one page. The page reads without
 //! JavaScript (a table of every frame with its images); with it, a player shows the three
 //! images of one frame side by side and steps, plays, or jumps to a frame from the slider, the
-//! table or a worst-frame link.
+//! table or a worst-frame link. A pixel probe under the player shows, for the frame shown, the
+//! linear R, G, B of the reference, the approximation and e_t at the pixel hovered or clicked in
+//! any pane; its values are per-frame files that the player loads when it shows a frame
+//! ([`super::sequence_probe`] says how they are encoded and why).
 //!
 //! The temporal-error maps share one scale, 0 … 2 × the pop threshold (magma), so that frames
 //! compare at a glance and a pop is in the upper half of the colour bar.
@@ -13,6 +16,7 @@ use super::colormap::{ColorMap, Scale};
 use super::heatmap::heatmap;
 use super::html::page;
 use super::plot::{line_plot_svg, PlotSpec, Series};
+use super::sequence_probe::write_probe_frame;
 use super::summary::short;
 use super::text::escape;
 use crate::error::Result;
@@ -65,6 +69,14 @@ pub fn write_frame_images(dir: &Path, view: &FrameView, pop_threshold: f64) -> R
         )
         .write_png(&dir.join(frame_file("t", f)))?;
     }
+    write_probe_frame(
+        dir,
+        FRAMES_DIR,
+        f,
+        view.reference,
+        view.approximation,
+        view.temporal.map(|t| &t.map),
+    )?;
     Ok(())
 }
 
@@ -275,7 +287,7 @@ fn player_section(cmp: &SequenceComparison) -> String {
     let frames: Vec<String> = cmp.frames.iter().map(|f| f.frame.to_string()).collect();
     format!(
         r#"<section id="pgt-player" hidden data-frames="{list}">
-<style>#pgt-player figure img {{ width: 20em; }}</style>
+<style>#pgt-player figure img {{ width: 20em; image-rendering: pixelated; cursor: crosshair; }}</style>
 <h2>Player</h2>
 <div class="controls"><button type="button" data-step="-1">◀ step</button><button type="button" id="pgt-play">play</button><button type="button" data-step="1">step ▶</button>
 <input type="range" id="pgt-slider" min="0" max="{max}" value="0"> <span id="pgt-frame">frame {f0}</span></div>
@@ -284,9 +296,14 @@ fn player_section(cmp: &SequenceComparison) -> String {
 <figure><img id="pgt-a" src="{a0}" alt="approximation"><figcaption>Approximation</figcaption></figure>
 <figure><div class="heat"><img id="pgt-t" src="{t0}" alt="temporal error"><span class="colorbar">{bar}</span></div><figcaption>Temporal error e<sub>t</sub> against the previous frame (mean over R, G, B; magma, 0 … {hi}; none for the first frame)</figcaption></figure>
 </div>
+<p class="help">Hover or click a pixel of any pane to probe it: the linear values of the frame shown (float16, three significant digits).</p>
+<table id="pgt-probe"><tr><th id="pgt-probe-pixel">pixel</th><th>R</th><th>G</th><th>B</th></tr>
+{rows}</table>
+<p id="pgt-probe-note"></p>
 </section>
 "#,
         list = frames.join(" "),
+        rows = probe_rows(),
         max = cmp.frames.len() - 1,
         f0 = first.frame,
         r0 = frame_file("r", first.frame),
@@ -298,6 +315,23 @@ fn player_section(cmp: &SequenceComparison) -> String {
         bar = colorbar_svg(scale, ColorMap::Magma, "temporal error", "bar-temporal"),
         hi = short(scale.hi),
     )
+}
+
+/// The probe table's rows: reference, approximation and e_t, a cell per channel.
+fn probe_rows() -> String {
+    let mut rows = String::new();
+    for (key, name) in [
+        ("reference", "reference"),
+        ("approximation", "approximation"),
+        ("temporal", "e<sub>t</sub>"),
+    ] {
+        let _ = write!(rows, "<tr><td>{name}</td>");
+        for c in 0..3 {
+            let _ = write!(rows, "<td data-probe=\"{key}-{c}\">—</td>");
+        }
+        rows += "</tr>\n";
+    }
+    rows
 }
 
 fn frames_table(cmp: &SequenceComparison) -> String {
@@ -352,7 +386,79 @@ const PLAYER_SCRIPT: &str = r#"<script>
     document.getElementById("pgt-a").src = file("a", f);
     var t = document.getElementById("pgt-t");
     if (i > 0) { t.src = file("t", f); t.style.visibility = "visible"; } else { t.style.visibility = "hidden"; }
+    shown = f;
+    load(f);
+    showProbe();
   }
+
+  // The pixel probe (src/report/sequence_probe.rs): frame f's values are frames/p_NNNNNN.js,
+  // loaded by <script src> the first time the frame is shown; it calls pgtProbeFrame.
+  var probe = document.getElementById("pgt-probe");
+  var note = document.getElementById("pgt-probe-note");
+  var values = {}, requested = {}, pixel = null, shown = frames[0];
+  var canDecode = typeof DecompressionStream === "function" && typeof Response === "function";
+  if (!canDecode) { probe.hidden = true; note.textContent = "This browser cannot decompress the probe's values (no DecompressionStream)."; }
+  function half(h) {
+    var s = (h & 0x8000) ? -1 : 1, e = (h >> 10) & 0x1f, m = h & 0x3ff;
+    if (e === 0) { return s * m * Math.pow(2, -24); }
+    if (e === 31) { return m ? NaN : s * Infinity; }
+    return s * (1 + m / 1024) * Math.pow(2, e - 15);
+  }
+  // base64 of zlib of little-endian float16 (R, G, B interleaved, row-major) → Float32Array.
+  function decode(b64) {
+    if (!b64) { return Promise.resolve(null); }
+    var bin = atob(b64), bytes = new Uint8Array(bin.length);
+    for (var i = 0; i < bin.length; i++) { bytes[i] = bin.charCodeAt(i); }
+    var stream = new Blob([bytes]).stream().pipeThrough(new DecompressionStream("deflate"));
+    return new Response(stream).arrayBuffer().then(function (buf) {
+      var dv = new DataView(buf), out = new Float32Array(buf.byteLength / 2);
+      for (var k = 0; k < out.length; k++) { out[k] = half(dv.getUint16(2 * k, true)); }
+      return out;
+    });
+  }
+  window.pgtProbeFrame = function (f, d) {
+    Promise.all([decode(d.reference), decode(d.approximation), decode(d.temporal)]).then(function (v) {
+      values[f] = { width: d.width, reference: v[0], approximation: v[1], temporal: v[2] };
+      if (f === shown) { showProbe(); }
+    });
+  };
+  function load(f) {
+    if (!canDecode || requested[f]) { return; }
+    requested[f] = true;
+    var s = document.createElement("script");
+    s.src = "frames/p_" + String(f).padStart(6, "0") + ".js";
+    document.head.appendChild(s);
+  }
+  function fmt(v) { return isFinite(v) ? Number(v).toPrecision(4) : String(v); }
+  function setCells(key, data, i) {
+    for (var c = 0; c < 3; c++) {
+      probe.querySelector('td[data-probe="' + key + "-" + c + '"]').textContent = data ? fmt(data[i + c]) : "—";
+    }
+  }
+  function showProbe() {
+    if (!pixel) { return; }
+    var d = values[shown];
+    document.getElementById("pgt-probe-pixel").textContent = "frame " + shown + ", pixel (" + pixel.x + ", " + pixel.y + ")";
+    probe.setAttribute("data-x", String(pixel.x));
+    probe.setAttribute("data-y", String(pixel.y));
+    var i = d ? 3 * (pixel.y * d.width + pixel.x) : 0;
+    setCells("reference", d && d.reference, i);
+    setCells("approximation", d && d.approximation, i);
+    setCells("temporal", d && d.temporal, i);
+    // The frame whose values the cells hold (none while its file loads).
+    probe.setAttribute("data-frame", d ? String(shown) : "");
+  }
+  ["pgt-r", "pgt-a", "pgt-t"].forEach(function (id) {
+    var img = document.getElementById(id);
+    function at(ev) {
+      var box = img.getBoundingClientRect(), w = img.naturalWidth, h = img.naturalHeight;
+      var x = Math.floor((ev.clientX - box.left) / box.width * w);
+      var y = Math.floor((ev.clientY - box.top) / box.height * h);
+      if (x >= 0 && y >= 0 && x < w && y < h) { pixel = { x: x, y: y }; showProbe(); }
+    }
+    img.addEventListener("mousemove", at);
+    img.addEventListener("click", at);
+  });
   function stop() { if (timer) { clearInterval(timer); timer = null; play.textContent = "play"; } }
   slider.addEventListener("input", function () { stop(); show(Number(slider.value)); });
   Array.prototype.forEach.call(section.querySelectorAll("[data-step]"), function (b) {

@@ -12,16 +12,20 @@
 //! The reference renders small frames side by side (one worker each) and large frames one after
 //! the other with all workers on the frame's pixels ([`frames_side_by_side`]); either way one
 //! frame's scene is held per worker, never the whole sequence.
+//!
+//! A [`FrameWatch`] follows the work: each frame as it starts (with the [`RenderControl`] that
+//! counts its blocks, or its GPU passes) and as it ends; the CLI draws its progress from it.
 
 use super::{exr_text_attributes, SequencePattern};
+use crate::approx::dispatch::PassProgress;
 use crate::approx::{ApproxParams, ApproxPipeline, GpuContext, Method};
 use crate::error::{PgtError, Result};
 use crate::image_io::{write_exr_with_header, write_image, ImageFormat, RgbImage};
-use crate::reference::{self, RenderOptions, RenderStats};
+use crate::reference::{self, RenderControl, RenderOptions, RenderStats};
 use crate::scene::{Scene, SceneFrames};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 
 /// The header attribute that holds a frame's render hash (the parts' attribute).
 pub use crate::parts::RENDER_HASH_ATTRIBUTE as HASH_ATTRIBUTE;
@@ -55,6 +59,25 @@ impl FrameDone {
         match self {
             FrameDone::Rendered { frame, .. } | FrameDone::Skipped { frame, .. } => *frame,
         }
+    }
+}
+
+/// What a sequence render tells its caller as it goes (the CLI's progress). Calls come from any
+/// worker, several frames at a time where frames render side by side.
+pub trait FrameWatch: Sync {
+    /// Frame `frame` starts: the reference's with the `control` that counts its blocks until it
+    /// ends, a GPU method's with none (its passes follow).
+    fn started(&self, _frame: usize, _control: Option<&Arc<RenderControl>>) {}
+    /// A GPU method ended a pass of frame `frame`.
+    fn pass(&self, _frame: usize, _progress: PassProgress) {}
+    /// Frame `d.frame()` ended: rendered and written, or skipped.
+    fn done(&self, d: &FrameDone);
+}
+
+/// A closure watches the ends of frames only.
+impl<F: Fn(&FrameDone) + Sync> FrameWatch for F {
+    fn done(&self, d: &FrameDone) {
+        self(d)
     }
 }
 
@@ -165,8 +188,8 @@ fn in_frame(frame: usize) -> impl Fn(PgtError) -> PgtError {
     move |e| e.context(format!("frame {frame}"))
 }
 
-/// Renders the reference of each frame of `list` into `pattern`'s files, calling `done` as each
-/// frame ends (from any worker). Frames start in the order of `list`; the first error, by frame
+/// Renders the reference of each frame of `list` into `pattern`'s files, telling `watch` as each
+/// frame starts and ends (from any worker). Frames start in the order of `list`; the first error, by frame
 /// order, ends the sequence: frames not yet started are not started, frames written stay.
 pub fn render_frames(
     frames: &SceneFrames,
@@ -174,7 +197,7 @@ pub fn render_frames(
     pattern: &SequencePattern,
     options: &RenderOptions,
     exposure: f32,
-    done: &(dyn Fn(&FrameDone) + Sync),
+    watch: &dyn FrameWatch,
 ) -> Result<SequenceSummary> {
     let workers = options
         .threads
@@ -186,9 +209,17 @@ pub fn render_frames(
         if failed.load(Ordering::Relaxed) {
             return None;
         }
-        let result = render_one(frames, frame, pattern, options, side_by_side, exposure);
+        let result = render_one(
+            frames,
+            frame,
+            pattern,
+            options,
+            side_by_side,
+            exposure,
+            watch,
+        );
         match &result {
-            Ok(d) => done(d),
+            Ok(d) => watch.done(d),
             Err(_) => failed.store(true, Ordering::Relaxed),
         }
         Some(result)
@@ -232,6 +263,7 @@ fn render_one(
     options: &RenderOptions,
     side_by_side: bool,
     exposure: f32,
+    watch: &dyn FrameWatch,
 ) -> Result<FrameDone> {
     // The frame sources' errors name the frame already.
     let scene = frames.frame(frame)?;
@@ -249,7 +281,10 @@ fn render_one(
         progress: false,
         ..*options
     };
-    let out = reference::render(&scene, &frame_options).map_err(in_frame(frame))?;
+    let control = Arc::new(RenderControl::default());
+    watch.started(frame, Some(&control));
+    let out =
+        reference::render_controlled(&scene, &frame_options, &control).map_err(in_frame(frame))?;
     write_frame(
         &path,
         frame,
@@ -294,14 +329,14 @@ pub fn approx_hash(
 }
 
 /// Renders each frame of `list` with a GPU method, one after the other on one device and one
-/// compiled pipeline, calling `done` after each frame.
+/// compiled pipeline, telling `watch` after each pass and each frame.
 pub fn approx_frames(
     frames: &SceneFrames,
     list: &[usize],
     pattern: &SequencePattern,
     params: &ApproxParams,
     exposure: f32,
-    done: &mut dyn FnMut(&FrameDone),
+    watch: &dyn FrameWatch,
 ) -> Result<ApproxSequence> {
     let method = params
         .method
@@ -326,8 +361,9 @@ pub fn approx_frames(
         let d = if already_rendered(&path, &hash) {
             FrameDone::Skipped { frame, path }
         } else {
+            watch.started(frame, None);
             let r = pipeline
-                .render(&ctx, &scene, params)
+                .render_with_progress(&ctx, &scene, params, &mut |p| watch.pass(frame, p))
                 .map_err(in_frame(frame))?;
             out.hit_overflow_pixels += r.hit_overflow_pixels as u64;
             out.loop_limited_pixels += r.loop_limited_pixels as u64;
@@ -339,7 +375,7 @@ pub fn approx_frames(
                 seconds: r.gpu_seconds,
             }
         };
-        done(&d);
+        watch.done(&d);
         out.summary.frames.push(d);
     }
     Ok(out)

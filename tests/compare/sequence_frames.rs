@@ -499,3 +499,91 @@ fn camera_and_export_show_one_frame_of_a_moving_scene() {
         "{err}"
     );
 }
+
+/// docs/design.md §10, the sequence report's pixel probe: every frame's probe file holds the
+/// frame's reference and approximation as the EXR files hold them and its e_t, each as float16
+/// (src/report/sequence_probe.rs), decoded here the way the player decodes them.
+#[test]
+fn the_sequence_reports_probe_files_hold_each_frames_values() {
+    let dir = tempfile::tempdir().unwrap();
+    write_xyz(&dir.path().join("traj.xyz"), 4, None);
+    let scene = write_scene(dir.path(), None, "");
+    let (rd, ad) = (dir.path().join("r"), dir.path().join("a"));
+    ok(&[
+        "render",
+        s(&scene),
+        "--frames",
+        "0..4",
+        "-o",
+        s(&rd.join("f_%02d.exr")),
+    ]);
+    ok(&[
+        "render",
+        s(&scene),
+        "--frames",
+        "0..4",
+        "--spp",
+        "2",
+        "-o",
+        s(&ad.join("f_%02d.exr")),
+    ]);
+    let report = dir.path().join("report");
+    ok(&[
+        "compare",
+        s(&rd),
+        s(&ad),
+        "--no-flip",
+        "--report",
+        s(&report),
+    ]);
+    let page = std::fs::read_to_string(report.join("index.html")).unwrap();
+    assert!(page.contains("id=\"pgt-probe\""), "no probe table");
+    let half = |v: f64| {
+        pgt::report::sequence_probe::f16_bits_to_f32(pgt::report::viewer::f32_to_f16_bits(v as f32))
+    };
+    let frames: Vec<(RgbImage, RgbImage)> = (0..4)
+        .map(|k| {
+            (
+                image(&rd.join(format!("f_{k:02}.exr"))),
+                image(&ad.join(format!("f_{k:02}.exr"))),
+            )
+        })
+        .collect();
+    for (k, (r, a)) in frames.iter().enumerate() {
+        let path = report.join(format!("frames/p_{k:06}.js"));
+        let p = pgt::report::sequence_probe::read_probe_frame(&path)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        assert_eq!(p.frame, k);
+        for (shown, file, what) in [
+            (&p.reference, r, "reference"),
+            (&p.approximation, a, "approximation"),
+        ] {
+            assert_eq!((shown.width, shown.height), (file.width, file.height));
+            for (i, (s, f)) in shown.pixels.iter().zip(&file.pixels).enumerate() {
+                assert_eq!(*s, f.map(|v| half(v as f64)), "frame {k} {what} pixel {i}");
+            }
+        }
+        let Some(t) = &p.temporal else {
+            assert_eq!(k, 0, "frame {k} has no e_t");
+            continue;
+        };
+        assert!(k > 0, "the first frame has an e_t");
+        let (rp, ap) = (&frames[k - 1].0, &frames[k - 1].1);
+        let mut nonzero = 0;
+        for i in 0..t.pixels.len() {
+            for c in 0..3 {
+                let e = ((a.pixels[i][c] as f64 - ap.pixels[i][c] as f64)
+                    - (r.pixels[i][c] as f64 - rp.pixels[i][c] as f64))
+                    .abs();
+                // e_t is stored as f32 before its float16: at most one float16 step apart.
+                let shown = t.pixels[i][c] as f64;
+                assert!(
+                    (shown - half(e) as f64).abs() <= e * 2f64.powi(-10) + 2f64.powi(-24),
+                    "frame {k} e_t pixel {i} channel {c}: {shown}, the frames give {e}"
+                );
+                nonzero += usize::from(e > 0.0);
+            }
+        }
+        assert!(nonzero > 0, "frame {k}: the test's e_t is zero everywhere");
+    }
+}

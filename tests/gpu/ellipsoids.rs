@@ -90,7 +90,7 @@ fn an_ellipsoid_with_equal_axes_draws_as_the_sphere_in_every_method() {
                 DVec3::splat(p.radius),
                 DQuat::from_axis_angle(DVec3::new(1.0, 2.0, 3.0).normalize(), 0.7 * i as f64),
             )),
-            ..p.clone()
+            ..*p
         })
         .collect();
     let cases = [

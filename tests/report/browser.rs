@@ -632,4 +632,201 @@ fn sequence_report_plays_its_frames() {
         src("pgt-r"),
         format!("frames/r_{:06}.png", target.parse::<usize>().unwrap())
     );
+    // The probe: a pixel of the approximation pane shows that frame's values (its file loads
+    // from file://; sequence_probe_shows_each_frames_values checks them against the EXRs).
+    let b = s.eval("var b = document.getElementById('pgt-a').getBoundingClientRect(); return [b.left + b.width / 2, b.top + b.height / 2];");
+    let (x, y) = (b[0].as_f64().unwrap(), b[1].as_f64().unwrap());
+    s.hover(x, y);
+    wait_until(
+        &s,
+        &format!("document.getElementById('pgt-probe').getAttribute('data-frame') === '{target}'"),
+    );
+    for key in ["reference", "approximation", "temporal"] {
+        let row = sequence_probe_row(&s, key);
+        assert!(
+            row.iter().all(|v| v.is_some_and(f64::is_finite)),
+            "{key}: {row:?}"
+        );
+    }
+}
+
+/// Waits until the JS expression `ready` is true in the page.
+fn wait_until(s: &webdriver::Session, ready: &str) {
+    let deadline = std::time::Instant::now() + std::time::Duration::from_secs(20);
+    while s.eval(&format!("return !!({ready});")) != serde_json::json!(true) {
+        assert!(std::time::Instant::now() < deadline, "never true: {ready}");
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+}
+
+/// The probe's cells for `key` (reference, approximation, temporal) of the sequence player,
+/// parsed; `None` for a cell showing "—".
+fn sequence_probe_row(s: &webdriver::Session, key: &str) -> Vec<Option<f64>> {
+    (0..3)
+        .map(|c| {
+            let t = s.text(&format!("#pgt-probe td[data-probe=\"{key}-{c}\"]"));
+            (t != "—").then(|| {
+                t.parse::<f64>()
+                    .unwrap_or_else(|_| panic!("probe {key}-{c} shows '{t}'"))
+            })
+        })
+        .collect()
+}
+
+/// A value the probe shows (four significant digits of a float16) equals the file's float.
+fn assert_near_half(shown: &[Option<f64>], expected: [f64; 3], what: &str) {
+    for c in 0..3 {
+        let v = shown[c].unwrap_or_else(|| panic!("{what} channel {c} shows no value"));
+        let tol = 1.5e-3 * expected[c].abs() + 1e-6;
+        assert!(
+            (v - expected[c]).abs() <= tol,
+            "{what} channel {c}: probe shows {v}, the files hold {}",
+            expected[c]
+        );
+    }
+}
+
+/// docs/design.md §10: the sequence player's pixel probe. Two small sequences written here are
+/// compared with `--report`; in headless chromium, hovering a pixel of the reference pane shows
+/// that frame's reference and approximation values (no e_t for the first frame); stepping and the
+/// slider change the frame under the same pixel, and the probe follows with the new frame's
+/// values and its e_t = |(A_t − A_{t−1}) − (R_t − R_{t−1})|; hovering the e_t pane probes there.
+#[test]
+fn sequence_probe_shows_each_frames_values() {
+    let Some((browser, driver)) = webdriver::browser_and_driver() else {
+        return;
+    };
+    let (w, h, n) = (32u32, 24u32, 4usize);
+    let dir = tempfile::tempdir().unwrap();
+    let (rd, ad) = (dir.path().join("ref"), dir.path().join("approx"));
+    std::fs::create_dir_all(&rd).unwrap();
+    std::fs::create_dir_all(&ad).unwrap();
+    let mut frames = Vec::new();
+    for k in 0..n {
+        let r = test_image(w, h, 0.4 * k as f32);
+        let a = test_image(w, h, 0.4 * k as f32 + 0.15 * (k % 2) as f32);
+        write_image(&rd.join(format!("f_{k:03}.exr")), &r, &[], 0.0).unwrap();
+        write_image(&ad.join(format!("f_{k:03}.exr")), &a, &[], 0.0).unwrap();
+        frames.push((r, a));
+    }
+    let rep = dir.path().join("report");
+    let o = Command::new(env!("CARGO_BIN_EXE_pgt"))
+        .args(["compare", &rd.to_string_lossy(), &ad.to_string_lossy()])
+        .args(["--no-flip", "--report", &rep.to_string_lossy()])
+        .output()
+        .unwrap();
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    let value = |img: &RgbImage, (x, y): (u32, u32)| img.get(x, y).map(|v| v as f64);
+    let temporal = |k: usize, (x, y): (u32, u32)| {
+        let (r, a) = (&frames[k].0, &frames[k].1);
+        let (rp, ap) = (&frames[k - 1].0, &frames[k - 1].1);
+        let g = |i: &RgbImage| i.get(x, y).map(|v| v as f64);
+        let (r, a, rp, ap) = (g(r), g(a), g(rp), g(ap));
+        [0, 1, 2].map(|c| ((a[c] - ap[c]) - (r[c] - rp[c])).abs())
+    };
+
+    let s = webdriver::Session::start(&browser, &driver, 1400, 1000);
+    s.open(
+        &rep.join("index.html"),
+        "document.body.getAttribute('data-pgt-images') === 'ok'",
+    );
+    s.eval("document.getElementById('pgt-player').scrollIntoView(); return 0;");
+    let centre = |pane: &str, (x, y): (u32, u32)| -> (f64, f64) {
+        let b = s.eval(&format!(
+            "var b = document.getElementById('{pane}').getBoundingClientRect(); return [b.left, b.top, b.width, b.height];"
+        ));
+        let b: Vec<f64> = b
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|v| v.as_f64().unwrap())
+            .collect();
+        (
+            b[0] + (x as f64 + 0.5) * b[2] / w as f64,
+            b[1] + (y as f64 + 0.5) * b[3] / h as f64,
+        )
+    };
+    let shows_frame = |k: usize| {
+        wait_until(
+            &s,
+            &format!("document.getElementById('pgt-probe').getAttribute('data-frame') === '{k}'"),
+        )
+    };
+
+    // Frame 0, hovered in the reference pane: its values, no e_t.
+    let p = (5, 17);
+    let (x, y) = centre("pgt-r", p);
+    s.hover(x, y);
+    shows_frame(0);
+    assert_eq!(
+        s.text("#pgt-probe-pixel"),
+        format!("frame 0, pixel ({}, {})", p.0, p.1)
+    );
+    assert_near_half(
+        &sequence_probe_row(&s, "reference"),
+        value(&frames[0].0, p),
+        "reference 0",
+    );
+    assert_near_half(
+        &sequence_probe_row(&s, "approximation"),
+        value(&frames[0].1, p),
+        "approx 0",
+    );
+    assert_eq!(sequence_probe_row(&s, "temporal"), vec![None; 3]);
+
+    // A step: the same pixel, frame 1's values and e_t, without moving the mouse.
+    s.click("[data-step='1']");
+    shows_frame(1);
+    assert_near_half(
+        &sequence_probe_row(&s, "reference"),
+        value(&frames[1].0, p),
+        "reference 1",
+    );
+    assert_near_half(
+        &sequence_probe_row(&s, "approximation"),
+        value(&frames[1].1, p),
+        "approx 1",
+    );
+    assert_near_half(&sequence_probe_row(&s, "temporal"), temporal(1, p), "e_t 1");
+
+    // The slider to the last frame, then a pixel of the e_t pane.
+    s.eval(&format!(
+        "var r = document.getElementById('pgt-slider'); r.value = '{}'; r.dispatchEvent(new Event('input')); return 0;",
+        n - 1
+    ));
+    shows_frame(n - 1);
+    let q = (28, 3);
+    let (x, y) = centre("pgt-t", q);
+    s.hover(x, y);
+    wait_until(
+        &s,
+        &format!(
+            "document.getElementById('pgt-probe').getAttribute('data-x') === '{}'",
+            q.0
+        ),
+    );
+    assert_eq!(
+        s.text("#pgt-probe-pixel"),
+        format!("frame {}, pixel ({}, {})", n - 1, q.0, q.1)
+    );
+    assert_near_half(
+        &sequence_probe_row(&s, "reference"),
+        value(&frames[n - 1].0, q),
+        "reference last",
+    );
+    assert_near_half(
+        &sequence_probe_row(&s, "approximation"),
+        value(&frames[n - 1].1, q),
+        "approx last",
+    );
+    assert_near_half(
+        &sequence_probe_row(&s, "temporal"),
+        temporal(n - 1, q),
+        "e_t last",
+    );
 }
