@@ -225,10 +225,12 @@ pub fn render_with_control(
             .map(|&(tx, ty)| {
                 let mut out = Vec::with_capacity((BLOCK * BLOCK) as usize);
                 let mut shadow_rays = 0u64;
-                if control.is_stopped() {
-                    return (out, shadow_rays);
-                }
                 for py in ty * BLOCK..((ty + 1) * BLOCK).min(h) {
+                    // A row at a time: a block of a slow scene takes seconds, a row a sixteenth
+                    // of that, so a stop is seen soon (the block's partial rows are dropped).
+                    if control.is_stopped() {
+                        return (out, shadow_rays);
+                    }
                     for px in tx * BLOCK..((tx + 1) * BLOCK).min(w) {
                         let (radiance, error, rays, unconverged) =
                             render_pixel(camera, estimator, px, py, k);
