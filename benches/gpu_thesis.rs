@@ -14,38 +14,17 @@ mod support;
 
 use support::gpu;
 
-use glam::DVec3;
 use pgt::approx::{render_approx_with, ApproxParams, Timing, N_EXACT_ALL};
-use pgt::geometry::Camera;
-use pgt::optics::models;
-use pgt::scene::RenderMode;
-
-fn env_or(name: &str, default: &str) -> String {
-    std::env::var(name).unwrap_or_else(|_| default.to_string())
-}
-
-/// A small deterministic generator (SplitMix64): the benchmark needs no statistical quality,
-/// only the same scene every run.
-struct SplitMix(u64);
-impl SplitMix {
-    fn next(&mut self) -> f64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 fn main() {
     let Some(ctx) = gpu::gpu() else { return };
-    let side: u32 = env_or("PGT_BENCH_SIDE", "64").parse().unwrap();
-    let samples: u32 = env_or("PGT_BENCH_SAMPLES", "100").parse().unwrap();
-    let counts: Vec<usize> = env_or("PGT_BENCH_COUNTS", "2758,73642")
+    let side: u32 = gpu::env_or("PGT_BENCH_SIDE", "64").parse().unwrap();
+    let samples: u32 = gpu::env_or("PGT_BENCH_SAMPLES", "100").parse().unwrap();
+    let counts: Vec<usize> = gpu::env_or("PGT_BENCH_COUNTS", "2758,73642")
         .split(',')
         .map(|c| c.trim().parse().unwrap())
         .collect();
-    let n_exacts: Vec<u32> = env_or("PGT_BENCH_N_EXACT", "1,5,all")
+    let n_exacts: Vec<u32> = gpu::env_or("PGT_BENCH_N_EXACT", "1,5,all")
         .split(',')
         .map(|n| match n.trim() {
             "all" => N_EXACT_ALL,
@@ -53,36 +32,9 @@ fn main() {
         })
         .collect();
     for count in counts {
-        let cube = (count as f64 / 0.05).cbrt();
-        let mut rng = SplitMix(count as u64);
-        let particles: Vec<_> = (0..count)
-            .map(|_| {
-                let c = [
-                    (rng.next() - 0.5) * cube,
-                    (rng.next() - 0.5) * cube,
-                    (rng.next() - 0.5) * cube,
-                ];
-                let r = 1.2 + 0.7 * rng.next();
-                gpu::particle(c, r, [rng.next(), rng.next(), rng.next()], 0.5)
-            })
-            .collect();
-        let mut s = gpu::scene(
-            particles,
-            pgt::scene::thesis_lights(),
-            RenderMode::Volume,
-            models::LIT,
-        );
-        // From −z, framing the cube (its bounding sphere) with fov_y 40°, like the default camera.
-        let distance = 0.5 * cube * 3f64.sqrt() / (20f64.to_radians().sin());
-        s.camera = Camera::new(
-            DVec3::new(0.0, 0.0, -distance),
-            DVec3::ZERO,
-            DVec3::Y,
-            40.0,
-            side,
-            side,
-        );
-        // Warm-up: lavapipe compiles the shader at its first dispatch, inside the first timing.
+        let s = gpu::random_cube_scene(count, side);
+        // Warm-up: a first run, so that the first timing is like the others (pgt keeps the
+        // pipeline's compile out of the GPU time itself).
         let warm = ApproxParams::for_method("thesis", &[("samples", 1), ("n_exact", 1)]).unwrap();
         render_approx_with(ctx, &s, &warm).unwrap();
         for n_exact in n_exacts.iter().copied() {

@@ -202,22 +202,7 @@ fn opaque_ellipsoids_match_the_reference_except_on_silhouettes() {
     let gpu = render_approx_with(ctx, &s, &method("opaque", &[])).unwrap();
     let reference = reference::render(&s, &RenderOptions::default()).unwrap();
     let mask = silhouette_mask(&s, &bvh);
-    let mut worst = 0.0f64;
-    let mut compared = 0;
-    for (i, (g, r)) in gpu
-        .image
-        .pixels
-        .iter()
-        .zip(&reference.image.pixels)
-        .enumerate()
-    {
-        if !mask[i] {
-            compared += 1;
-            for c in 0..3 {
-                worst = worst.max((g[c] as f64 - r[c] as f64).abs());
-            }
-        }
-    }
+    let (worst, compared) = max_error_off_mask(&gpu.image, &reference.image, &mask);
     eprintln!("opaque ellipsoids: max abs error {worst:.3e} over {compared} pixels");
     assert!(compared > 1500, "{compared}");
     assert!(worst <= 1e-4, "max abs error {worst}");

@@ -341,3 +341,74 @@ pub fn silhouette_mask(scene: &Scene, bvh: &Bvh) -> Vec<bool> {
         })
         .collect()
 }
+
+/// A small deterministic generator (SplitMix64): the benchmarks need no statistical quality,
+/// only the same scene every run.
+struct SplitMix(u64);
+
+impl SplitMix {
+    fn next(&mut self) -> f64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        ((z ^ (z >> 31)) >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// The GPU benchmarks' random set, like the thesis's (chapter 6): `count` particles of radius
+/// 1.2–1.9 (Å, used as the length unit), uniform in a cube at about protein atom density
+/// (0.05 Å⁻³), Θmax 0.5, the thesis's two lights, lit; seen from −z, framing the cube's bounding
+/// sphere with fov_y 40° (like the default camera), `side`² pixels.
+pub fn random_cube_scene(count: usize, side: u32) -> Scene {
+    let cube = (count as f64 / 0.05).cbrt();
+    let mut rng = SplitMix(count as u64);
+    let particles = (0..count)
+        .map(|_| {
+            let c = [
+                (rng.next() - 0.5) * cube,
+                (rng.next() - 0.5) * cube,
+                (rng.next() - 0.5) * cube,
+            ];
+            let r = 1.2 + 0.7 * rng.next();
+            particle(c, r, [rng.next(), rng.next(), rng.next()], 0.5)
+        })
+        .collect();
+    let mut s = scene(
+        particles,
+        pgt::scene::thesis_lights(),
+        RenderMode::Volume,
+        pgt::optics::models::LIT,
+    );
+    let distance = 0.5 * cube * 3f64.sqrt() / (20f64.to_radians().sin());
+    s.camera = Camera::new(
+        DVec3::new(0.0, 0.0, -distance),
+        DVec3::ZERO,
+        DVec3::Y,
+        40.0,
+        side,
+        side,
+    );
+    s
+}
+
+/// The benchmarks' settings: the environment variable `name`, or `default`.
+pub fn env_or(name: &str, default: &str) -> String {
+    std::env::var(name).unwrap_or_else(|_| default.to_string())
+}
+
+/// (worst absolute channel difference, pixels compared) of two images over the pixels that
+/// `mask` does not mark.
+pub fn max_error_off_mask(a: &RgbImage, b: &RgbImage, mask: &[bool]) -> (f64, usize) {
+    let mut worst = 0.0f64;
+    let mut compared = 0;
+    for ((x, y), masked) in a.pixels.iter().zip(&b.pixels).zip(mask) {
+        if !masked {
+            compared += 1;
+            for c in 0..3 {
+                worst = worst.max((x[c] as f64 - y[c] as f64).abs());
+            }
+        }
+    }
+    (worst, compared)
+}
