@@ -10,7 +10,7 @@ use crate::scene::{SceneFrames, SceneLoadOptions};
 use crate::sequence::render::{FrameDone, FrameWatch};
 use crate::sequence::{frames_in, frames_of_part, FrameRange, SequencePattern};
 use std::collections::BTreeMap;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
@@ -138,18 +138,17 @@ struct Live {
     done: usize,
     in_flight: BTreeMap<usize, InFlight>,
     last_line: Instant,
+    /// The file of the frame that ended last.
+    last_path: Option<PathBuf>,
 }
 
 /// Progress over frames, watching a sequence render ([`FrameWatch`]): on a terminal a bar over
 /// the frames that also moves with the frames in flight (the reference's blocks done of each,
-/// a GPU method's passes), redrawn every [`TICK`]; off one, a line at most every ten seconds as
-/// frames end.
+/// a GPU method's passes), redrawn every [`TICK`]; off one, every [`LINE_EVERY`] a line with the
+/// same words and the last frame written, also while one long frame renders.
 pub struct FrameProgress {
     bar: Option<indicatif::ProgressBar>,
-    what: &'static str,
-    total: usize,
     live: Arc<Mutex<Live>>,
-    start: Instant,
     stop: Arc<AtomicBool>,
     ticker: Mutex<Option<std::thread::JoinHandle<()>>>,
 }
@@ -161,6 +160,7 @@ impl FrameProgress {
             done: 0,
             in_flight: BTreeMap::new(),
             last_line: start,
+            last_path: None,
         }));
         let stop = Arc::new(AtomicBool::new(false));
         let bar = super::stderr_is_terminal().then(|| {
@@ -173,29 +173,43 @@ impl FrameProgress {
             );
             bar
         });
-        let ticker = bar.clone().map(|bar| {
-            let (live, stop) = (Arc::clone(&live), Arc::clone(&stop));
+        let ticker = {
+            let (live, stop, bar) = (Arc::clone(&live), Arc::clone(&stop), bar.clone());
             std::thread::spawn(move || {
                 while !stop.load(Ordering::Relaxed) {
-                    if let Ok(l) = live.lock() {
+                    if let Ok(mut l) = live.lock() {
                         let shares: Vec<(usize, Share)> =
                             l.in_flight.iter().map(|(f, s)| (*f, s.share())).collect();
                         let (position, message) = bar_state(l.done, total, &shares);
-                        bar.set_position(position);
-                        bar.set_message(message);
+                        match &bar {
+                            Some(bar) => {
+                                bar.set_position(position);
+                                bar.set_message(message);
+                            }
+                            None => {
+                                let now = Instant::now();
+                                if now >= l.last_line + LINE_EVERY {
+                                    l.last_line = now;
+                                    let last = l.last_path.as_ref().map_or(String::new(), |p| {
+                                        format!(", the last {}", p.display())
+                                    });
+                                    eprintln!(
+                                        "{what}: {:.0} s, {message}{last}",
+                                        (now - start).as_secs_f64()
+                                    );
+                                }
+                            }
+                        }
                     }
                     std::thread::sleep(TICK);
                 }
             })
-        });
+        };
         FrameProgress {
             bar,
-            what,
-            total,
             live,
-            start,
             stop,
-            ticker: Mutex::new(ticker),
+            ticker: Mutex::new(Some(ticker)),
         }
     }
 
@@ -238,24 +252,10 @@ impl FrameWatch for FrameProgress {
         };
         l.in_flight.remove(&d.frame());
         l.done += 1;
-        if self.bar.is_some() {
-            return;
-        }
-        let now = Instant::now();
-        if now >= l.last_line + LINE_EVERY {
-            l.last_line = now;
-            let path = match d {
-                FrameDone::Rendered { path, .. } | FrameDone::Skipped { path, .. } => path,
-            };
-            eprintln!(
-                "{}: {:.0} s, {}/{} frames done, the last {}",
-                self.what,
-                (now - self.start).as_secs_f64(),
-                l.done,
-                self.total,
-                path.display()
-            );
-        }
+        let path = match d {
+            FrameDone::Rendered { path, .. } | FrameDone::Skipped { path, .. } => path,
+        };
+        l.last_path = Some(path.clone());
     }
 }
 
