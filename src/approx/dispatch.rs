@@ -177,11 +177,15 @@ impl Pipeline {
     }
 
     /// The compute pipeline for a scene with (`true`) or without ellipsoids, compiled on first
-    /// use.
-    fn variant(&self, ctx: &GpuContext, ellipsoids: bool) -> Result<&wgpu::ComputePipeline> {
+    /// use, and whether this call compiled it (its first dispatch is then still to come).
+    fn variant(
+        &self,
+        ctx: &GpuContext,
+        ellipsoids: bool,
+    ) -> Result<(&wgpu::ComputePipeline, bool)> {
         let slot = &self.variants[ellipsoids as usize];
         if let Some(p) = slot.get() {
-            return Ok(p);
+            return Ok((p, false));
         }
         let constants = [(OVERRIDE_HAS_ELLIPSOIDS, if ellipsoids { 1.0 } else { 0.0 })];
         let compiled = ctx.checked("creating the compute pipeline", || {
@@ -199,7 +203,7 @@ impl Pipeline {
                 })
         })?;
         // Another thread may have compiled it meanwhile: either copy serves.
-        Ok(slot.get_or_init(|| compiled))
+        Ok((slot.get_or_init(|| compiled), true))
     }
 }
 
@@ -533,9 +537,11 @@ fn copy_bands<'a>(
     })
 }
 
-/// One dispatch that computes nothing (a band of no rows: every invocation returns at once),
-/// waited for, so that the pipeline's compilation stays out of the timed passes: lavapipe
-/// compiles a pipeline at its first dispatch, which took 1–5 s of a 0.02–0.08 s image.
+/// A freshly compiled pipeline's first dispatch, one that computes nothing (a band of no rows:
+/// every invocation returns at once), waited for, so that the pipeline's compilation stays out
+/// of the timed passes: lavapipe compiles a pipeline at its first dispatch, which took 1–5 s of
+/// a 0.02–0.08 s image. Later renders with the same pipeline (a sweep's runs, a sequence's
+/// frames) need none.
 fn warm_up(
     ctx: &GpuContext,
     pipeline: &wgpu::ComputePipeline,
@@ -708,8 +714,10 @@ pub fn run_with_progress(
     progress: &mut dyn FnMut(PassProgress),
 ) -> Result<DispatchOutput> {
     let up = Upload::with_limit(ctx, pipeline, scene, frame, limit)?;
-    let compiled = pipeline.variant(ctx, !scene.ellipsoids.is_empty())?;
-    warm_up(ctx, compiled, &up, frame)?;
+    let (compiled, fresh) = pipeline.variant(ctx, !scene.ellipsoids.is_empty())?;
+    if fresh {
+        warm_up(ctx, compiled, &up, frame)?;
+    }
     let mut schedule = PassSchedule::new(ctx.adapter.is_cpu);
     let start = Instant::now();
     let mut gpu_ticks: Option<f64> = up.timestamps.as_ref().map(|_| 0.0);

@@ -113,11 +113,11 @@ gpu_struct! {
 }
 
 impl GpuEllipsoid {
-    /// The ellipsoid's map in f32 (rows computed in f64, then rounded).
+    /// The ellipsoid's map (the reference's own M, [`Ellipsoid::to_unit_matrix`]) in f32.
     pub fn new(e: &Ellipsoid) -> GpuEllipsoid {
-        let r = glam::DMat3::from_quat(e.rotation());
+        let m = e.to_unit_matrix();
         let s = e.semi_axes();
-        let row = |i: usize| (r.col(i) / s[i]).as_vec3().to_array();
+        let row = |i: usize| m.row(i).as_vec3().to_array();
         GpuEllipsoid {
             row_x: row(0),
             semi_x: s.x as f32,

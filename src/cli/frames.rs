@@ -178,26 +178,24 @@ impl FrameProgress {
             std::thread::spawn(move || {
                 while !stop.load(Ordering::Relaxed) {
                     if let Ok(mut l) = live.lock() {
-                        let shares: Vec<(usize, Share)> =
-                            l.in_flight.iter().map(|(f, s)| (*f, s.share())).collect();
-                        let (position, message) = bar_state(l.done, total, &shares);
-                        match &bar {
-                            Some(bar) => {
+                        let now = Instant::now();
+                        // Off a terminal the words are made only when a line is due.
+                        if bar.is_some() || now >= l.last_line + LINE_EVERY {
+                            let shares: Vec<(usize, Share)> =
+                                l.in_flight.iter().map(|(f, s)| (*f, s.share())).collect();
+                            let (position, message) = bar_state(l.done, total, &shares);
+                            if let Some(bar) = &bar {
                                 bar.set_position(position);
                                 bar.set_message(message);
-                            }
-                            None => {
-                                let now = Instant::now();
-                                if now >= l.last_line + LINE_EVERY {
-                                    l.last_line = now;
-                                    let last = l.last_path.as_ref().map_or(String::new(), |p| {
-                                        format!(", the last {}", p.display())
-                                    });
-                                    eprintln!(
-                                        "{what}: {:.0} s, {message}{last}",
-                                        (now - start).as_secs_f64()
-                                    );
-                                }
+                            } else {
+                                l.last_line = now;
+                                let last = l.last_path.as_ref().map_or(String::new(), |p| {
+                                    format!(", the last {}", p.display())
+                                });
+                                eprintln!(
+                                    "{what}: {:.0} s, {message}{last}",
+                                    (now - start).as_secs_f64()
+                                );
                             }
                         }
                     }

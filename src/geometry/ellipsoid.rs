@@ -59,6 +59,11 @@ impl Ellipsoid {
         self.semi_axes.max_element()
     }
 
+    /// M = S⁻¹Rᵀ, the map from a world offset about the centre to unit-sphere coordinates.
+    pub fn to_unit_matrix(&self) -> DMat3 {
+        self.to_unit
+    }
+
     /// The shortest semi-axis: Θmax is the opacity along the diameter of this length.
     pub fn shortest_semi_axis(&self) -> f64 {
         self.semi_axes.min_element()

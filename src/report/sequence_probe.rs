@@ -116,15 +116,7 @@ pub fn read_probe_frame(path: &Path) -> Result<ProbeFrame> {
 
 /// The value of IEEE binary16 bits (exact: every half is a float).
 pub fn f16_bits_to_f32(h: u16) -> f32 {
-    let sign = if h & 0x8000 != 0 { -1.0 } else { 1.0 };
-    let exp = i32::from((h >> 10) & 0x1f);
-    let man = f32::from(h & 0x3ff);
-    sign * match exp {
-        0 => man * 2f32.powi(-24),
-        31 if man == 0.0 => f32::INFINITY,
-        31 => f32::NAN,
-        e => (1.0 + man / 1024.0) * 2f32.powi(e - 15),
-    }
+    half::f16::from_bits(h).to_f32()
 }
 
 /// Standard base64 (with padding) back to bytes; `None` on a character outside the alphabet.
