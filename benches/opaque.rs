@@ -22,6 +22,7 @@ fn random_scene(n: usize, size: u32) -> Scene {
             let color = DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64());
             Particle {
                 ellipsoid: None,
+                profile: pgt::optics::Profile::Constant,
                 center: c,
                 radius: 1.2 + 0.7 * rng.next_f64(),
                 color,

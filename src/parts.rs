@@ -111,6 +111,7 @@ impl Fnv128 {
             ks,
             shininess,
             ellipsoid,
+            profile,
         } = *p;
         self.vec3(center);
         self.f64(radius);
@@ -131,6 +132,7 @@ impl Fnv128 {
                 }
             }
         }
+        self.word(profile as u64);
     }
 }
 

@@ -87,7 +87,9 @@ impl Method {
     pub fn check_scene(&self, scene: &Scene) -> Result<()> {
         match self {
             Method::Builtin(m) => m.check_scene(scene),
-            Method::User(_) => Ok(()),
+            // A user shader sees no density profile in its buffers, so it is given only
+            // constant-density scenes.
+            Method::User(_) => super::methods::check_profile("user-shader", false, scene),
         }
     }
 

@@ -396,6 +396,7 @@ fn bare_scene(particles: Vec<Particle>, size: u32) -> Scene {
 fn particle(center: DVec3, radius: f64, color: DVec3) -> Particle {
     Particle {
         ellipsoid: None,
+        profile: crate::optics::Profile::Constant,
         center,
         radius,
         color,

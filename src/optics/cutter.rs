@@ -289,6 +289,7 @@ pub(crate) mod tests {
     pub(crate) fn particle(sigma: f64, color: DVec3) -> Particle {
         Particle {
             ellipsoid: None,
+            profile: crate::optics::Profile::Constant,
             center: DVec3::ZERO,
             radius: 1.0,
             color,

@@ -231,6 +231,7 @@ mod tests {
     fn particle(sigma: f64, color: DVec3) -> Particle {
         Particle {
             ellipsoid: None,
+            profile: crate::optics::Profile::Constant,
             center: DVec3::ZERO,
             radius: 1.0,
             color,

@@ -453,6 +453,7 @@ mod tests {
     fn sphere(c: DVec3, r: f64) -> Particle {
         Particle {
             ellipsoid: None,
+            profile: crate::optics::Profile::Constant,
             center: c,
             radius: r,
             color: DVec3::ONE,

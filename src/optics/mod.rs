@@ -21,4 +21,4 @@ pub mod transmittance;
 
 pub use light::{Falloff, Incident, Light, LightWeight};
 pub use model::{LightNeed, Model, OpticalModel};
-pub use particle::Particle;
+pub use particle::{Particle, Profile};

@@ -1,5 +1,6 @@
 //! A particle as the renderers see it (docs/design.md §1, §9): a sphere or an ellipsoid with its
-//! extinction σ already resolved from Θmax or κ (`extinction`), and its colours.
+//! extinction σ already resolved from Θmax or κ (`extinction`), its density profile (constant or
+//! Gaussian) and its colours.
 
 use crate::geometry::{Ellipsoid, Shape};
 use glam::DVec3;
@@ -27,6 +28,31 @@ pub struct Particle {
     /// `Some` for an ellipsoid (its semi-axes and orientation about `center`), `None` for a
     /// sphere.
     pub ellipsoid: Option<Ellipsoid>,
+    /// How the density varies inside the particle (docs/design.md §9).
+    pub profile: Profile,
+}
+
+/// The density profile of a particle (docs/design.md §9 "Gaussian density").
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Profile {
+    /// σ inside the sphere or ellipsoid, 0 outside (the thesis).
+    #[default]
+    Constant,
+    /// σ·exp(−½·m(x)²), m the Mahalanobis distance whose axes are the radius or the semi-axes
+    /// taken as standard deviations; `sigma` is the peak density at the centre. The support is
+    /// unbounded: the shape is the 1-σ ellipsoid, not an edge.
+    Gaussian,
+}
+
+impl Profile {
+    /// The name in scene files (`density = "gaussian"`).
+    pub fn name(self) -> &'static str {
+        match self {
+            Profile::Constant => "constant",
+            Profile::Gaussian => "gaussian",
+        }
+    }
 }
 
 impl Particle {

@@ -158,6 +158,12 @@ pub fn estimator_for<'a>(
             options.spp
         )));
     }
+    if scene.has_gaussians() {
+        return Err(PgtError::Usage(
+            "the reference does not render particles of Gaussian density yet (docs/design.md §9)"
+                .into(),
+        ));
+    }
     match scene.render.mode {
         RenderMode::Opaque => Ok(Box::new(opaque::OpaqueRenderer::new(scene))),
         RenderMode::Volume => {

@@ -138,6 +138,7 @@ mod tests {
     fn particle(center: DVec3, radius: f64) -> Particle {
         Particle {
             ellipsoid: None,
+            profile: crate::optics::Profile::Constant,
             center,
             radius,
             color: DVec3::ONE,

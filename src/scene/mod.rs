@@ -15,7 +15,7 @@ pub use validate::checked_tol_override;
 // builds on optics, never the reverse); re-exported so that `scene::Light` etc. keep working.
 pub use crate::optics::light::{Falloff, Incident, Light, LightWeight};
 pub use crate::optics::model::Model;
-pub use crate::optics::particle::Particle;
+pub use crate::optics::particle::{Particle, Profile};
 
 use crate::error::{PgtError, Result};
 use crate::geometry::Camera;
@@ -198,6 +198,13 @@ impl Scene {
     /// Whether any particle is an ellipsoid (docs/design.md §9).
     pub fn has_ellipsoids(&self) -> bool {
         self.particles.iter().any(|p| p.ellipsoid.is_some())
+    }
+
+    /// Whether any particle has a Gaussian density (docs/design.md §9).
+    pub fn has_gaussians(&self) -> bool {
+        self.particles
+            .iter()
+            .any(|p| p.profile == Profile::Gaussian)
     }
 
     fn bvh_over(&self, keep: impl Fn(usize) -> bool) -> crate::geometry::Bvh {

@@ -613,6 +613,7 @@ fn inline_particle(
             at.in_range(&name("shininess"), v, 0.0, f64::MAX, "≥ 0")
         })?,
         ellipsoid,
+        profile: crate::optics::Profile::Constant,
     })
 }
 
@@ -661,6 +662,7 @@ fn record_particle(
         ks: d.ks,
         shininess: d.shininess,
         ellipsoid,
+        profile: crate::optics::Profile::Constant,
     })
 }
 

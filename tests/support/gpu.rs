@@ -44,6 +44,7 @@ pub const SIDE: u32 = 48;
 pub fn particle(center: [f64; 3], radius: f64, color: [f64; 3], opacity: f64) -> Particle {
     Particle {
         ellipsoid: None,
+        profile: pgt::optics::Profile::Constant,
         center: DVec3::from(center),
         radius,
         color: DVec3::from(color),

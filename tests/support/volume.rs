@@ -44,6 +44,7 @@ impl Rng {
 pub fn particle(center: DVec3, radius: f64, color: DVec3, sigma: f64) -> Particle {
     Particle {
         ellipsoid: None,
+        profile: pgt::optics::Profile::Constant,
         center,
         radius,
         color,

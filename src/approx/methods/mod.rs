@@ -56,11 +56,38 @@ pub trait ApproxMethod: Sync {
     }
     /// The render mode and optical models it computes (see [`Computes`] for the rule).
     fn computes(&self) -> Computes;
-    /// Refuses scenes the method does not compute ([`check_computes`]) or has no meaning for,
-    /// with a message that says what to do.
-    fn check_scene(&self, scene: &Scene) -> Result<()> {
-        check_computes(self.name(), self.computes(), scene)
+    /// Whether it draws particles of Gaussian density (docs/design.md §9); a method that does
+    /// not is given only constant-density scenes.
+    fn draws_gaussians(&self) -> bool {
+        false
     }
+    /// Refuses scenes the method does not compute ([`check_computes`], [`check_profile`]) or has
+    /// no meaning for, with a message that says what to do.
+    fn check_scene(&self, scene: &Scene) -> Result<()> {
+        check_computes(self.name(), self.computes(), scene)?;
+        check_profile(self.name(), self.draws_gaussians(), scene)
+    }
+}
+
+/// The refusal of Gaussian particles by a method that draws constant density only (it would
+/// draw each Gaussian as its solid 1-σ ellipsoid), naming the methods that draw them.
+pub fn check_profile(name: &str, draws_gaussians: bool, scene: &Scene) -> Result<()> {
+    if draws_gaussians || !scene.has_gaussians() {
+        return Ok(());
+    }
+    let others: Vec<&str> = METHODS
+        .iter()
+        .filter(|m| m.draws_gaussians())
+        .map(|m| m.name())
+        .collect();
+    let instead = if others.is_empty() {
+        "no built-in method draws them yet".to_string()
+    } else {
+        format!("use a method that draws them: {}", others.join(", "))
+    };
+    Err(PgtError::Usage(format!(
+        "the {name} method draws particles of constant density; this scene has Gaussian particles (density = \"gaussian\", docs/design.md §9): {instead}"
+    )))
 }
 
 /// The refusal of [`Computes`]: the method `name`, computing `computes`, on `scene`. The

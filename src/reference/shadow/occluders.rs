@@ -683,6 +683,7 @@ mod tests {
             .map(|i| {
                 let mut p = Particle {
                     ellipsoid: None,
+                    profile: crate::optics::Profile::Constant,
                     center: v(6.0),
                     radius: 0.3 + 0.5 * v(1.0).x.abs(),
                     color: DVec3::ONE,

@@ -12,6 +12,7 @@ use crate::scene::{LightWeight, RenderMode, RenderSettings};
 fn sphere(center: DVec3, radius: f64, color: DVec3, opacity: f64) -> Particle {
     Particle {
         ellipsoid: None,
+        profile: crate::optics::Profile::Constant,
         center,
         radius,
         color,
