@@ -596,7 +596,19 @@ struct Options {
 }
 
 fn options(spec: &IncludeSpec) -> Result<Options> {
-    let extent = spec.extent.unwrap_or(DEFAULT_EXTENT);
+    let gaussian = spec.density == Some(crate::optics::Profile::Gaussian);
+    if gaussian && spec.extent.is_some() {
+        return Err(PgtError::in_file(
+            &spec.path,
+            "include.extent applies to constant density: a Gaussian's semi-axes are its standard deviations (density = \"gaussian\")",
+        ));
+    }
+    // A Gaussian's semi-axes are the standard deviations themselves (docs/design.md §9).
+    let extent = if gaussian {
+        1.0
+    } else {
+        spec.extent.unwrap_or(DEFAULT_EXTENT)
+    };
     if !(extent.is_finite() && extent > 0.0) {
         return Err(PgtError::in_file(
             &spec.path,

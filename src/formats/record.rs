@@ -142,8 +142,12 @@ pub struct IncludeSpec {
     /// Source frames between two scene frames (≥ 1; 1 by default).
     pub frame_step: Option<usize>,
     /// 3DGS PLY: standard deviations per semi-axis (> 0); [`super::ply::DEFAULT_EXTENT`] by
-    /// default.
+    /// default. Not with `density = "gaussian"`, whose semi-axes are the standard deviations.
     pub extent: Option<f64>,
+    /// The density profile of the file's particles (docs/design.md §9); `[defaults]`' by
+    /// default.
+    #[serde(default)]
+    pub density: Option<crate::optics::Profile>,
     /// 3DGS PLY: the DC colour (default) or the view-dependent one.
     pub sh: Option<ShColor>,
     /// 3DGS PLY: the order of `f_rest_*` (channel-major by default).
@@ -175,6 +179,7 @@ impl IncludeSpec {
             frames: None,
             frame_step: None,
             extent: None,
+            density: None,
             sh: None,
             sh_order: None,
             view_from: None,

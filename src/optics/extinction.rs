@@ -24,6 +24,17 @@ impl Extinction {
             Extinction::Kappa(k) => lambda * k,
         }
     }
+
+    /// The peak density σᵢ of a Gaussian particle (docs/design.md §9): from an opacity by the
+    /// mapping of `optics::gaussian::sigma_from_peak_opacity` with `shortest` the shortest
+    /// standard deviation; σ = λκ for a κ given directly, as for every shape.
+    #[inline]
+    pub fn peak_sigma(self, shortest: f64, lambda: f64) -> f64 {
+        match self {
+            Extinction::Opacity(o) => super::gaussian::sigma_from_peak_opacity(o, shortest),
+            Extinction::Kappa(k) => lambda * k,
+        }
+    }
 }
 
 /// σ = −ln(1 − Θmax)/(2r) (docs/design.md §1, thesis eq. 5.1 with σ = λκ): the extinction that makes

@@ -1,6 +1,7 @@
 //! The exact reference renderer (docs/design.md §3): f64 throughout, parallel over blocks of pixels with
 //! rayon, bit-identical for any thread count (each pixel is a pure function of the scene).
 
+pub mod gaussian;
 pub mod opaque;
 pub mod quadrature;
 pub mod riemann;
@@ -159,10 +160,10 @@ pub fn estimator_for<'a>(
         )));
     }
     if scene.has_gaussians() {
-        return Err(PgtError::Usage(
-            "the reference does not render particles of Gaussian density yet (docs/design.md §9)"
-                .into(),
-        ));
+        return Ok(Box::new(gaussian::GaussianRenderer::new(
+            scene,
+            options.integrator,
+        )?));
     }
     match scene.render.mode {
         RenderMode::Opaque => Ok(Box::new(opaque::OpaqueRenderer::new(scene))),

@@ -73,6 +73,7 @@ pub(super) struct RenderTable {
     pub emission_weight: Option<f64>,
     pub ambient: Option<f64>,
     pub tol: Option<f64>,
+    pub gaussian_cutoff: Option<f64>,
 }
 
 /// One `[[lights]]` table. A flat struct rather than a tagged enum: serde buffers tagged enums,
@@ -106,6 +107,8 @@ pub(super) struct ParticleDefaults {
     pub albedo: Option<[f64; 3]>,
     pub ks: Option<f64>,
     pub shininess: Option<f64>,
+    /// The density profile (docs/design.md §9), `"constant"` by default.
+    pub density: Option<crate::optics::Profile>,
 }
 
 #[derive(Debug, Deserialize)]
@@ -123,4 +126,5 @@ pub(super) struct ParticleTable {
     pub albedo: Option<[f64; 3]>,
     pub ks: Option<f64>,
     pub shininess: Option<f64>,
+    pub density: Option<crate::optics::Profile>,
 }

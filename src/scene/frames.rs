@@ -30,6 +30,8 @@ struct Playing {
     range: std::ops::Range<usize>,
     /// The file the records' locations point into (a trajectory's topology, else the source).
     record_path: std::path::PathBuf,
+    /// The include's `density`.
+    density: Option<crate::optics::Profile>,
 }
 
 /// A scene file (or bare particle file) as a sequence of frames.
@@ -172,7 +174,7 @@ impl SceneFrames {
             let source_index = p.selection.source_index(index).unwrap_or(p.selection.start);
             let frame = p.source.read_frame(source_index)?;
             for rec in &frame.particles.records {
-                particles.push(self.maker.particle(&p.record_path, rec)?);
+                particles.push(self.maker.particle(&p.record_path, rec, p.density)?);
             }
             warnings.extend(frame.particles.warnings);
         }
@@ -218,5 +220,6 @@ fn open_playing(scene: &Scene, group: &IncludeGroup) -> Result<Option<Playing>> 
         selection,
         range: group.range.clone(),
         record_path,
+        density: spec.density,
     }))
 }

@@ -51,6 +51,9 @@ pub struct RenderSettings {
     pub ambient: f64,
     /// Absolute radiance tolerance of the reference quadrature, per pixel and channel.
     pub tol: f64,
+    /// k, the standard deviations at which the reference cuts Gaussian particles
+    /// (docs/design.md §9); `None`: chosen from `tol`.
+    pub gaussian_cutoff: Option<f64>,
 }
 
 impl Default for RenderSettings {
@@ -64,6 +67,7 @@ impl Default for RenderSettings {
             emission_weight: 1.0,
             ambient: 0.0,
             tol: 1e-5,
+            gaussian_cutoff: None,
         }
     }
 }

@@ -12,7 +12,7 @@ use crate::formats::EllipsoidRecord;
 use crate::geometry::{Camera, CameraPath, Ellipsoid, Keyframe};
 use crate::optics::extinction::Extinction;
 use crate::optics::light::{Falloff, Light};
-use crate::optics::particle::Particle;
+use crate::optics::particle::{Particle, Profile};
 use glam::DVec3;
 use std::path::Path;
 use toml::Spanned;
@@ -47,8 +47,13 @@ pub(super) struct ParticleMaker {
 
 impl ParticleMaker {
     /// A particle of the file `path`, checked with the location the format recorded.
-    pub fn particle(&self, path: &Path, rec: &ParticleRecord) -> Result<Particle> {
-        record_particle(path, rec, &self.defaults, self.lambda)
+    pub fn particle(
+        &self,
+        path: &Path,
+        rec: &ParticleRecord,
+        density: Option<Profile>,
+    ) -> Result<Particle> {
+        record_particle(path, rec, &self.defaults, self.lambda, density)
     }
 }
 
@@ -175,6 +180,9 @@ fn load_toml_and_particles(
         if spec.sh == Some(crate::formats::ShColor::View) {
             spec.view_from = Some(view_position(&spec_at, &file.camera)?);
         }
+        // The readers see the density the particles get (a splatting file's semi-axes are its
+        // standard deviations for Gaussians).
+        spec.density = Some(spec.density.unwrap_or(resolved_defaults.density));
         // A file that cannot be read is named with the scene's include line (a typo in the
         // path is the usual cause); errors inside a file that was read name that file's line.
         // Errors of a frame source (a trajectory, a sequence, a `frames` range) also name the
@@ -198,6 +206,7 @@ fn load_toml_and_particles(
                 rec,
                 &resolved_defaults,
                 render.lambda,
+                spec.density,
             )?);
         }
         includes.push(IncludeGroup {
@@ -354,6 +363,7 @@ fn given_table(p: ParticleInput) -> ParticleTable {
         albedo: None,
         ks: None,
         shininess: None,
+        density: None,
     }
 }
 
@@ -375,7 +385,7 @@ pub(super) fn load_bare(path: &Path, options: &SceneLoadOptions) -> Result<Loade
     let particles = loaded
         .records
         .iter()
-        .map(|rec| record_particle(path, rec, &defaults, render.lambda))
+        .map(|rec| record_particle(path, rec, &defaults, render.lambda, None))
         .collect::<Result<Vec<_>>>()?;
     let mut warnings = loaded.warnings;
     if particles.is_empty() {
@@ -434,6 +444,10 @@ fn render_settings(at: &At, t: &RenderTable) -> Result<RenderSettings> {
             at.in_range("render.ambient", v, 0.0, f64::MAX, "≥ 0")
         })?,
         tol: t.tol.map_or(Ok(d.tol), |v| check_tol(at, v))?,
+        gaussian_cutoff: t
+            .gaussian_cutoff
+            .map(|k| at.in_range("render.gaussian_cutoff", k, 0.5, 40.0, "in [0.5, 40]"))
+            .transpose()?,
     })
 }
 
@@ -483,6 +497,7 @@ struct ResolvedDefaults {
     albedo: Option<DVec3>,
     ks: f64,
     shininess: f64,
+    density: Profile,
 }
 
 /// Θmax used when neither the particle nor `[defaults]` sets opacity or kappa.
@@ -516,12 +531,22 @@ impl ResolvedDefaults {
             shininess: d.shininess.map_or(Ok(DEFAULT_SHININESS), |v| {
                 at.in_range("defaults.shininess", v, 0.0, f64::MAX, "≥ 0")
             })?,
+            density: d.density.unwrap_or_default(),
         })
     }
 
     /// σ from the particle's own opacity/kappa, else the defaults, else Θmax =
-    /// [`DEFAULT_OPACITY`] (docs/design.md §1); the equation itself is [`Extinction::sigma`].
-    fn sigma(&self, opacity: Option<f64>, kappa: Option<f64>, radius: f64, lambda: f64) -> f64 {
+    /// [`DEFAULT_OPACITY`] (docs/design.md §1); the equation itself is [`Extinction::sigma`],
+    /// for a Gaussian [`Extinction::peak_sigma`] (docs/design.md §9). `radius` is the shortest
+    /// semi-axis (the shortest standard deviation of a Gaussian).
+    fn sigma(
+        &self,
+        opacity: Option<f64>,
+        kappa: Option<f64>,
+        radius: f64,
+        lambda: f64,
+        profile: Profile,
+    ) -> f64 {
         let extinction = match (opacity, kappa) {
             (Some(o), _) => Extinction::Opacity(o),
             (None, Some(k)) => Extinction::Kappa(k),
@@ -531,7 +556,10 @@ impl ResolvedDefaults {
                 (None, None) => Extinction::Opacity(DEFAULT_OPACITY),
             },
         };
-        extinction.sigma(radius, lambda)
+        match profile {
+            Profile::Constant => extinction.sigma(radius, lambda),
+            Profile::Gaussian => extinction.peak_sigma(radius, lambda),
+        }
     }
 }
 
@@ -598,11 +626,13 @@ fn inline_particle(
     let color = p
         .color
         .map_or(Ok(d.color), |c| at.non_negative3(&name("color"), c))?;
+    let profile = p.density.unwrap_or(d.density);
+    check_gaussian_opacity(&at, &name("opacity"), profile, opacity.or(d.opacity))?;
     Ok(Particle {
         center,
         radius,
         color,
-        sigma: d.sigma(opacity, kappa, sigma_radius, lambda),
+        sigma: d.sigma(opacity, kappa, sigma_radius, lambda, profile),
         albedo: p.albedo.map_or(Ok(d.albedo.unwrap_or(color)), |a| {
             at.non_negative3(&name("albedo"), a)
         })?,
@@ -613,7 +643,7 @@ fn inline_particle(
             at.in_range(&name("shininess"), v, 0.0, f64::MAX, "≥ 0")
         })?,
         ellipsoid,
-        profile: crate::optics::Profile::Constant,
+        profile,
     })
 }
 
@@ -623,6 +653,7 @@ fn record_particle(
     rec: &ParticleRecord,
     d: &ResolvedDefaults,
     lambda: f64,
+    density: Option<Profile>,
 ) -> Result<Particle> {
     let at = At {
         path,
@@ -650,6 +681,10 @@ fn record_particle(
         .opacity
         .map(|o| at.in_range("particle opacity", o, 0.0, 1.0, "in [0, 1]"))
         .transpose()?;
+    let profile = density.unwrap_or(d.density);
+    if rec.sigma.is_none() {
+        check_gaussian_opacity(&at, "particle opacity", profile, opacity.or(d.opacity))?;
+    }
     Ok(Particle {
         center,
         radius,
@@ -657,13 +692,29 @@ fn record_particle(
         // A σ the file gives is the particle's σ exactly (crate::formats::xyz_csv, "σ and opacity").
         sigma: rec
             .sigma
-            .unwrap_or_else(|| d.sigma(opacity, None, sigma_radius, lambda)),
+            .unwrap_or_else(|| d.sigma(opacity, None, sigma_radius, lambda, profile)),
         albedo: d.albedo.unwrap_or(color),
         ks: d.ks,
         shininess: d.shininess,
         ellipsoid,
-        profile: crate::optics::Profile::Constant,
+        profile,
     })
+}
+
+/// A Gaussian's opacity must be < 1: Θmax = 1 would be an infinite peak density, which has no
+/// meaning for a density without an edge (docs/design.md §9).
+fn check_gaussian_opacity(
+    at: &At,
+    field: &str,
+    profile: Profile,
+    opacity: Option<f64>,
+) -> Result<()> {
+    match (profile, opacity) {
+        (Profile::Gaussian, Some(o)) if o >= 1.0 => Err(at.err(format!(
+            "{field} is {o}: a Gaussian particle's opacity must be < 1 (1 would be an infinite peak density)"
+        ))),
+        _ => Ok(()),
+    }
 }
 
 /// The shape an ellipsoid record describes, checked by [`EllipsoidRecord::problem`] first: the

@@ -11,6 +11,7 @@ mod camera_projection;
 mod ellipsoids;
 mod error;
 mod exact;
+mod gaussians;
 mod limits;
 mod mc;
 mod scene_camera_paths;

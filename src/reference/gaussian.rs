@@ -1,0 +1,423 @@
+//! The exact renderer of particles of Gaussian density (docs/design.md §9 "Gaussian density"),
+//! emission model.
+//!
+//! Along a camera ray each Gaussian's density is a 1D Gaussian in t (`optics::gaussian`), so
+//! the optical depth through any number of them is a sum of closed forms (erf differences) and
+//!
+//!   L = L_bg·T(0,∞) + ∫₀^∞ T(0,t)·Σᵢ σᵢ(t)·Cᵢ dt
+//!
+//! is computed a segment at a time. The ray is cut at each Gaussian's window ends and at its
+//! centre t*; on a segment [a, b] with the Gaussians A whose windows cover it, for any colour
+//! C_ref,
+//!
+//!   ∫_a^b T(0,t)·Σ_A σᵢCᵢ dt = T(0,a)·[C_ref·(1 − e^{−τ(a,b)}) + ∫_a^b e^{−τ(a,t)}·Σ_A σᵢ(Cᵢ − C_ref) dt]
+//!
+//! because ∫ e^{−τ(a,t)}σ(t) dt = 1 − e^{−τ(a,b)} exactly. C_ref is the colour of the Gaussian
+//! with the most depth on the segment, so a segment where all have one colour is closed form
+//! and the rest is a small, smooth integrand for adaptive Gauss–Kronrod (`quadrature`), with
+//! tol/2 of the pixel's budget.
+//!
+//! **What is left out, and bounded into err.** The rendered medium is the true one less some
+//! density δσ ≥ 0: (1) every Gaussian whose k-σ ellipsoid the ray does not meet in front of
+//! the eye (k = `gaussian_cutoff`), (2) Gaussians the ray meets whose depth in front of the
+//! eye is so small that together they fit a budget, (3) each remaining Gaussian's tails outside
+//! its window |t − t*| ≤ wᵢ·s. With Δ the optical depth of δσ along the ray, per channel
+//!
+//!   |L_true − L_rendered| ≤ M·(1 − e^{−Δ}),   M = max(maxᵢ Cᵢ, L_bg),
+//!
+//! because the radiance of an emission–absorption medium is the expected colour where light is
+//! first emitted along the ray (or L_bg), and adding the independent medium δσ changes that
+//! only where δσ comes first, with probability ≤ 1 − e^{−Δ}, and then by at most M. (2) and
+//! (3) are summed exactly in closed form; for (1) each Gaussian i missed adds at most
+//! σᵢ·s_max,i·√(2π)·e^{−k²/2} (its line depth at Mahalanobis distance ≥ k, or the tail beyond
+//! its chord when the chord lies behind the eye), summed over the scene once. k defaults to
+//! the smallest value ≥ 3 that puts that sum's share below tol/8. A ray whose transmittance has
+//! fallen to T with T·M ≤ tol/8 stops: what lies beyond is in [0, T·M], taken as its midpoint
+//! with half of it in err.
+
+use super::quadrature::{integrate_adaptive, Piece};
+use super::volume::MAX_SEGMENTS;
+use super::{Integrator, RadianceEstimator, Sample};
+use crate::error::{PgtError, Result};
+use crate::geometry::{Bvh, Ellipsoid, Hit, Ray};
+use crate::optics::gaussian::GaussianAlongRay;
+use crate::optics::{models, Profile};
+use crate::scene::{RenderMode, Scene};
+use glam::{DQuat, DVec3};
+use std::cell::RefCell;
+
+/// √(2π).
+const SQRT_TAU: f64 = 2.506_628_274_631_000_5;
+
+/// The smallest cut-off k chosen automatically: the reference 3DGS rasteriser's footprint.
+const MIN_AUTO_CUTOFF: f64 = 3.0;
+
+/// One Gaussian as the renderer keeps it: the shape holds its standard deviations.
+#[derive(Debug, Clone, Copy)]
+struct Gaussian {
+    center: DVec3,
+    shape: Ellipsoid,
+    sigma: f64,
+    color: DVec3,
+}
+
+/// The renderer of a scene whose particles all have Gaussian density.
+pub struct GaussianRenderer {
+    gaussians: Vec<Gaussian>,
+    /// Over the k-σ ellipsoids of `gaussians` (indices into it).
+    bvh: Bvh,
+    background: DVec3,
+    /// M per channel: max(maxᵢ Cᵢ, L_bg).
+    bound: DVec3,
+    tol: f64,
+    /// The bound on the depth of the Gaussians a ray does not meet within k σ.
+    far_depth: f64,
+    cutoff: f64,
+}
+
+/// One candidate Gaussian of a ray: its profile and depth in front of the eye.
+#[derive(Debug, Clone, Copy)]
+struct Candidate {
+    index: u32,
+    profile: GaussianAlongRay,
+    /// The optical depth over [0, ∞).
+    front: f64,
+}
+
+/// An included Gaussian's window [lo, hi] along the ray.
+#[derive(Debug, Clone, Copy)]
+struct Window {
+    index: u32,
+    profile: GaussianAlongRay,
+    lo: f64,
+    hi: f64,
+}
+
+/// A segment that needs quadrature: its start, its reference colour, its Gaussians
+/// (`active[first..first + count]`).
+#[derive(Debug, Clone, Copy)]
+struct Deviation {
+    start: f64,
+    reference: DVec3,
+    first: usize,
+    count: usize,
+}
+
+#[derive(Default)]
+struct Scratch {
+    hits: Vec<Hit>,
+    candidates: Vec<Candidate>,
+    windows: Vec<Window>,
+    points: Vec<f64>,
+    active: Vec<usize>,
+    deviations: Vec<Deviation>,
+    pieces: Vec<Piece>,
+}
+
+thread_local! {
+    static SCRATCH: RefCell<Scratch> = RefCell::new(Scratch::default());
+}
+
+impl GaussianRenderer {
+    /// The renderer of `scene`, or the reason it cannot render it (a name for each: a mixed
+    /// scene, a model or mode other than the emission volume, an infinite peak density).
+    pub fn new(scene: &Scene, integrator: Integrator) -> Result<GaussianRenderer> {
+        let refuse = |why: String| Err(PgtError::Usage(why));
+        if scene
+            .particles
+            .iter()
+            .any(|p| p.profile != Profile::Gaussian)
+        {
+            return refuse(
+                "this scene mixes particles of constant and Gaussian density; the reference renders a scene of one kind (docs/design.md §9)".into(),
+            );
+        }
+        if scene.render.mode != RenderMode::Volume {
+            return refuse(
+                "Gaussian particles have no surface: the opaque mode does not draw them (use mode = \"volume\")".into(),
+            );
+        }
+        if scene.render.model != models::EMISSION {
+            return refuse(format!(
+                "the reference renders Gaussian particles in the emission model; the {} model is not implemented for them (docs/design.md §9): pass --model emission",
+                scene.render.model.name()
+            ));
+        }
+        if let Integrator::Riemann { .. } = integrator {
+            return refuse(
+                "the Riemann sums apply to particles of constant density; Gaussian particles are integrated adaptively".into(),
+            );
+        }
+        let mut gaussians = Vec::with_capacity(scene.particles.len());
+        for (i, p) in scene.particles.iter().enumerate() {
+            if !p.sigma.is_finite() {
+                return refuse(format!(
+                    "particle {i} is a Gaussian of infinite peak density (opacity 1); a Gaussian's opacity must be < 1"
+                ));
+            }
+            if p.sigma == 0.0 {
+                continue;
+            }
+            let shape = p
+                .ellipsoid
+                .unwrap_or_else(|| Ellipsoid::new(DVec3::splat(p.radius), DQuat::IDENTITY));
+            gaussians.push(Gaussian {
+                center: p.center,
+                shape,
+                sigma: p.sigma,
+                color: p.color,
+            });
+        }
+        let background = scene.render.background;
+        let bound = gaussians.iter().fold(background, |m, g| m.max(g.color));
+        let tol = scene.render.tol;
+        // Σᵢ σᵢ·s_max,i·√(2π): the line depth of every Gaussian through its centre along its
+        // longest axis, the factor of e^{−k²/2} in the bound on what is missed.
+        let line_depth: f64 = gaussians
+            .iter()
+            .map(|g| g.sigma * g.shape.semi_axes().max_element() * SQRT_TAU)
+            .sum();
+        let cutoff = scene
+            .render
+            .gaussian_cutoff
+            .unwrap_or_else(|| auto_cutoff(line_depth, bound.max_element(), tol));
+        let far_depth = line_depth * (-0.5 * cutoff * cutoff).exp();
+        let bvh = Bvh::build_shapes(
+            gaussians.iter().map(|g| g.center).collect(),
+            gaussians
+                .iter()
+                .map(|g| cutoff * g.shape.bounding_radius())
+                .collect(),
+            gaussians
+                .iter()
+                .map(|g| {
+                    Some(Ellipsoid::new(
+                        cutoff * g.shape.semi_axes(),
+                        g.shape.rotation(),
+                    ))
+                })
+                .collect(),
+            |_| true,
+        );
+        Ok(GaussianRenderer {
+            gaussians,
+            bvh,
+            background,
+            bound,
+            tol,
+            far_depth,
+            cutoff,
+        })
+    }
+
+    /// k, the cut-off in standard deviations.
+    pub fn cutoff(&self) -> f64 {
+        self.cutoff
+    }
+
+    /// The bound on the optical depth, along any ray, of the Gaussians it does not meet
+    /// within k σ.
+    pub fn far_depth(&self) -> f64 {
+        self.far_depth
+    }
+
+    fn radiance_with(&self, ray: &Ray, s: &mut Scratch) -> Sample {
+        let m_max = self.bound.max_element();
+        if m_max == 0.0 {
+            // Every colour and the background are black: L = 0 whatever the densities.
+            return Sample::default();
+        }
+        // Budgets of optical depth left out: tol/4 of radiance in all (M·Δ ≤ tol/4), half for
+        // the small Gaussians left out whole and half for the tails outside the windows.
+        let budget = self.tol / (4.0 * m_max);
+        let mut delta = self.far_depth;
+
+        self.bvh.all_hits(ray, 0.0, f64::INFINITY, &mut s.hits);
+        s.candidates.clear();
+        for h in &s.hits {
+            let g = &self.gaussians[h.index as usize];
+            let profile = GaussianAlongRay::new(ray, g.center, &g.shape, g.sigma);
+            let front = profile.optical_depth(0.0, f64::INFINITY);
+            s.candidates.push(Candidate {
+                index: h.index,
+                profile,
+                front,
+            });
+        }
+        // The smallest first, left out while they fit half the budget.
+        s.candidates
+            .sort_unstable_by(|a, b| a.front.total_cmp(&b.front).then(a.index.cmp(&b.index)));
+        let mut left_out = 0.0;
+        let mut first_kept = s.candidates.len();
+        for (k, c) in s.candidates.iter().enumerate() {
+            if left_out + c.front > 0.5 * budget {
+                first_kept = k;
+                break;
+            }
+            left_out += c.front;
+        }
+        delta += left_out;
+        let kept = &s.candidates[first_kept..];
+        let tail_budget = 0.5 * budget / kept.len().max(1) as f64;
+        s.windows.clear();
+        for c in kept {
+            let total = c.profile.total_depth();
+            // erfc(w/√2) ≤ e^{−w²/2}: this w leaves at most tail_budget outside the window.
+            let w = if total > tail_budget {
+                (2.0 * (total / tail_budget).ln()).sqrt()
+            } else {
+                0.0
+            };
+            delta += total * libm::erfc(w * std::f64::consts::FRAC_1_SQRT_2);
+            let p = c.profile;
+            let (lo, hi) = ((p.t_star - w * p.s).max(0.0), p.t_star + w * p.s);
+            if hi > lo {
+                s.windows.push(Window {
+                    index: c.index,
+                    profile: p,
+                    lo,
+                    hi,
+                });
+            }
+        }
+        s.windows
+            .sort_unstable_by(|a, b| a.lo.total_cmp(&b.lo).then(a.index.cmp(&b.index)));
+
+        s.points.clear();
+        for w in &s.windows {
+            s.points.push(w.lo);
+            s.points.push(w.hi);
+            if w.profile.t_star > w.lo && w.profile.t_star < w.hi {
+                s.points.push(w.profile.t_star);
+            }
+        }
+        s.points.sort_unstable_by(f64::total_cmp);
+        s.points.dedup();
+
+        let mut radiance = DVec3::ZERO;
+        let mut error = DVec3::ZERO;
+        let mut transmittance = 1.0;
+        let mut stopped = false;
+        s.active.clear();
+        s.deviations.clear();
+        s.pieces.clear();
+        for seg in s.points.windows(2) {
+            let (a, b) = (seg[0], seg[1]);
+            let first = s.active.len();
+            // Windows are sorted by their start: those that start at or before a.
+            for (k, w) in s.windows.iter().enumerate() {
+                if w.lo > a {
+                    break;
+                }
+                if w.hi >= b {
+                    s.active.push(k);
+                }
+            }
+            let count = s.active.len() - first;
+            if count == 0 {
+                continue;
+            }
+            if transmittance * m_max <= self.tol / 8.0 {
+                let rest = 0.5 * transmittance * self.bound;
+                radiance += rest;
+                error += rest;
+                stopped = true;
+                s.active.truncate(first);
+                break;
+            }
+            let mut tau = 0.0;
+            let mut heaviest = (0.0, s.active[first]);
+            for &k in &s.active[first..] {
+                let d = s.windows[k].profile.optical_depth(a, b);
+                tau += d;
+                if d > heaviest.0 {
+                    heaviest = (d, k);
+                }
+            }
+            let reference = self.color_of(&s.windows[heaviest.1]);
+            radiance += transmittance * reference * -(-tau).exp_m1();
+            if s.active[first..]
+                .iter()
+                .any(|&k| self.color_of(&s.windows[k]) != reference)
+            {
+                s.pieces.push(Piece {
+                    lo: a,
+                    hi: b,
+                    weight: transmittance,
+                    tag: s.deviations.len(),
+                });
+                s.deviations.push(Deviation {
+                    start: a,
+                    reference,
+                    first,
+                    count,
+                });
+            } else {
+                s.active.truncate(first);
+            }
+            transmittance *= (-tau).exp();
+        }
+        if !stopped {
+            radiance += transmittance * self.background;
+        }
+
+        let mut converged = true;
+        if !s.pieces.is_empty() {
+            let (windows, active, deviations) = (&s.windows, &s.active, &s.deviations);
+            let integrand = |tag: usize, t: f64| {
+                let d = &deviations[tag];
+                let mut tau = 0.0;
+                let mut sum = DVec3::ZERO;
+                for &k in &active[d.first..d.first + d.count] {
+                    let w = &windows[k];
+                    tau += w.profile.optical_depth(d.start, t);
+                    sum += w.profile.density(t) * (self.color_of(w) - d.reference);
+                }
+                (-tau).exp() * sum
+            };
+            let result = integrate_adaptive(
+                &s.pieces,
+                0.5 * self.tol,
+                MAX_SEGMENTS,
+                integrand,
+                |_, _, _| None,
+                |_, _, _| true,
+            );
+            radiance += result.value;
+            error += result.error;
+            converged = result.converged;
+        }
+        error += self.bound * -(-delta).exp_m1();
+        Sample {
+            radiance,
+            error,
+            shadow_rays: 0,
+            unconverged: !converged,
+        }
+    }
+
+    #[inline]
+    fn color_of(&self, w: &Window) -> DVec3 {
+        self.gaussians[w.index as usize].color
+    }
+}
+
+impl RadianceEstimator for GaussianRenderer {
+    fn radiance(&self, ray: &Ray) -> Sample {
+        SCRATCH.with(|s| self.radiance_with(ray, &mut s.borrow_mut()))
+    }
+
+    fn estimates_error(&self) -> bool {
+        true
+    }
+}
+
+/// The smallest k ≥ 3 with M·Σᵢ σᵢ·s_max,i·√(2π)·e^{−k²/2} ≤ tol/8.
+fn auto_cutoff(line_depth: f64, m_max: f64, tol: f64) -> f64 {
+    let ratio = 8.0 * m_max * line_depth / tol;
+    if ratio > 1.0 {
+        (2.0 * ratio.ln()).sqrt().max(MIN_AUTO_CUTOFF)
+    } else {
+        MIN_AUTO_CUTOFF
+    }
+}

@@ -1,0 +1,449 @@
+//! Particles of Gaussian density (docs/design.md §9) in the exact reference: one Gaussian and
+//! well-separated ones against their closed forms, overlapping ones against a brute-force
+//! Riemann sum of the 3D densities, coincident ones against one of twice σ, the opacity
+//! mapping through a scene file, the bound on the cut-off for k from 2 to 8, the coverage of
+//! err on a scene of a few thousand overlapping Gaussians, and the refusals by name.
+//!
+//! The oracles evaluate σ(x) = σᵢ·exp(−½(x − c)ᵀΣ⁻¹(x − c)) in 3D with Σ = R·S²·Rᵀ built here
+//! from the quaternion, never through `optics::gaussian`.
+
+use crate::support::volume::Rng;
+use glam::{DMat3, DQuat, DVec3};
+use pgt::geometry::{Camera, Ellipsoid, Ray};
+use pgt::optics::{models, Particle, Profile};
+use pgt::reference::gaussian::GaussianRenderer;
+use pgt::reference::{render, Integrator, RadianceEstimator, RenderOptions};
+use pgt::scene::{RenderMode, RenderSettings, Scene, SceneLoadOptions};
+use std::path::Path;
+
+const SQRT_TAU: f64 = 2.506_628_274_631_000_5;
+
+fn gaussian(center: DVec3, std: DVec3, rotation: DQuat, color: DVec3, sigma: f64) -> Particle {
+    Particle {
+        center,
+        radius: std.max_element(),
+        color,
+        sigma,
+        albedo: color,
+        ks: 0.0,
+        shininess: 32.0,
+        ellipsoid: (std.x != std.y || std.y != std.z).then(|| Ellipsoid::new(std, rotation)),
+        profile: Profile::Gaussian,
+    }
+}
+
+fn scene(particles: Vec<Particle>, size: u32, tol: f64, cutoff: Option<f64>) -> Scene {
+    Scene {
+        source: "gaussians".into(),
+        camera: Camera::new(
+            DVec3::new(0.0, 0.0, -12.0),
+            DVec3::ZERO,
+            DVec3::Y,
+            30.0,
+            size,
+            size,
+        ),
+        render: RenderSettings {
+            mode: RenderMode::Volume,
+            model: models::EMISSION,
+            background: DVec3::new(0.05, 0.1, 0.2),
+            tol,
+            gaussian_cutoff: cutoff,
+            ..RenderSettings::default()
+        },
+        lights: vec![],
+        particles,
+        warnings: vec![],
+    }
+}
+
+/// σ of one Gaussian at x, from its covariance in 3D.
+fn density(p: &Particle, x: DVec3) -> f64 {
+    let (std, rotation) = match &p.ellipsoid {
+        Some(e) => (e.semi_axes(), e.rotation()),
+        None => (DVec3::splat(p.radius), DQuat::IDENTITY),
+    };
+    let r = DMat3::from_quat(rotation);
+    let inv_var = DMat3::from_diagonal(DVec3::ONE / (std * std));
+    let inv_cov = r * inv_var * r.transpose();
+    let d = x - p.center;
+    p.sigma * (-0.5 * d.dot(inv_cov * d)).exp()
+}
+
+/// The emission integral by `n` midpoint steps over [0, t_max], each step exact for the
+/// constant density of its midpoint.
+fn riemann(particles: &[Particle], bg: DVec3, ray: &Ray, t_max: f64, n: usize) -> DVec3 {
+    let dt = t_max / n as f64;
+    let (mut l, mut t) = (DVec3::ZERO, 1.0);
+    for k in 0..n {
+        let x = ray.at((k as f64 + 0.5) * dt);
+        let (mut sigma, mut emitted) = (0.0, DVec3::ZERO);
+        for p in particles {
+            let s = density(p, x);
+            sigma += s;
+            emitted += s * p.color;
+        }
+        if sigma > 0.0 {
+            let a = -(-sigma * dt).exp_m1();
+            l += t * a * emitted / sigma;
+            t *= 1.0 - a;
+        }
+    }
+    l + t * bg
+}
+
+/// The optical depth of one Gaussian along the whole ray by composite Simpson on [0, t_max].
+fn line_depth(p: &Particle, ray: &Ray, t_max: f64, n: usize) -> f64 {
+    let h = t_max / n as f64;
+    let f = |k: usize| density(p, ray.at(k as f64 * h));
+    let mut sum = f(0) + f(n);
+    for k in 1..n {
+        sum += if k % 2 == 1 { 4.0 } else { 2.0 } * f(k);
+    }
+    sum * h / 3.0
+}
+
+fn turned(angle: f64) -> DQuat {
+    DQuat::from_axis_angle(DVec3::new(0.4, 1.0, -0.3).normalize(), angle)
+}
+
+fn renderer(s: &Scene) -> GaussianRenderer {
+    GaussianRenderer::new(s, Integrator::Adaptive).expect("a Gaussian scene")
+}
+
+#[test]
+fn one_gaussian_is_its_closed_form() {
+    let p = gaussian(
+        DVec3::new(0.2, -0.1, 1.0),
+        DVec3::new(1.1, 0.4, 0.7),
+        turned(0.8),
+        DVec3::new(0.9, 0.5, 0.2),
+        1.7,
+    );
+    let s = scene(vec![p], 16, 1e-9, None);
+    let r = renderer(&s);
+    let bg = s.render.background;
+    let mut checked = 0;
+    for (x, y) in [(8.0, 8.0), (5.5, 9.5), (11.2, 3.3), (2.0, 14.0), (8.5, 4.0)] {
+        let ray = s.camera.ray_at(x, y);
+        let tau = line_depth(&p, &ray, 40.0, 200_000);
+        let truth = p.color * -(-tau).exp_m1() + bg * (-tau).exp();
+        let got = r.radiance(&ray);
+        for c in 0..3 {
+            let diff = (got.radiance[c] - truth[c]).abs();
+            assert!(
+                diff <= got.error[c] + 1e-12,
+                "pixel ({x}, {y}) channel {c}: {} against {} (err {})",
+                got.radiance[c],
+                truth[c],
+                got.error[c]
+            );
+            assert!(got.error[c] <= 1e-9, "err {} above tol", got.error[c]);
+        }
+        if tau > 1e-3 {
+            checked += 1;
+        }
+    }
+    assert!(checked >= 3, "too few rays cross the Gaussian");
+}
+
+#[test]
+fn well_separated_gaussians_composite_in_their_closed_forms() {
+    // Three Gaussians 2.5 apart along the view with standard deviations ≤ 0.2: more than 12
+    // standard deviations apart, so along any ray each one's depth is its own.
+    let particles = vec![
+        gaussian(
+            DVec3::new(0.1, 0.0, -2.5),
+            DVec3::new(0.15, 0.2, 0.1),
+            turned(0.3),
+            DVec3::new(1.0, 0.2, 0.1),
+            6.0,
+        ),
+        gaussian(
+            DVec3::new(0.0, 0.05, 0.0),
+            DVec3::splat(0.2),
+            DQuat::IDENTITY,
+            DVec3::new(0.1, 1.0, 0.2),
+            4.0,
+        ),
+        gaussian(
+            DVec3::new(-0.05, 0.0, 2.5),
+            DVec3::new(0.2, 0.1, 0.2),
+            turned(1.2),
+            DVec3::new(0.2, 0.3, 1.0),
+            8.0,
+        ),
+    ];
+    let s = scene(particles.clone(), 64, 1e-9, None);
+    let r = renderer(&s);
+    let bg = s.render.background;
+    let mut covered = 0;
+    for (x, y) in [(32.0, 32.0), (32.6, 31.2), (33.5, 32.5), (31.0, 33.0)] {
+        let ray = s.camera.ray_at(x, y);
+        // Front to back: C₁(1 − e^{−τ₁}) + e^{−τ₁}(C₂(1 − e^{−τ₂}) + e^{−τ₂}(…)).
+        let mut truth = bg;
+        for p in particles.iter().rev() {
+            let tau = line_depth(p, &ray, 40.0, 200_000);
+            truth = p.color * -(-tau).exp_m1() + truth * (-tau).exp();
+        }
+        let got = r.radiance(&ray);
+        for c in 0..3 {
+            assert!(
+                (got.radiance[c] - truth[c]).abs() <= got.error[c] + 1e-12,
+                "({x}, {y}) channel {c}: {} against {}",
+                got.radiance[c],
+                truth[c]
+            );
+        }
+        if (truth - bg).abs().max_element() > 0.05 {
+            covered += 1;
+        }
+    }
+    assert!(covered >= 3, "the rays miss the Gaussians");
+}
+
+fn overlapping(rng: &mut Rng, n: usize, spread: f64) -> Vec<Particle> {
+    (0..n)
+        .map(|_| {
+            gaussian(
+                rng.vec3(-spread, spread),
+                DVec3::new(
+                    rng.range(0.2, 0.9),
+                    rng.range(0.2, 0.9),
+                    rng.range(0.2, 0.9),
+                ),
+                turned(rng.range(0.0, 3.0)),
+                rng.vec3(0.0, 1.0),
+                rng.range(0.3, 3.0),
+            )
+        })
+        .collect()
+}
+
+#[test]
+fn overlapping_gaussians_match_a_riemann_sum_of_1e5_steps() {
+    let mut rng = Rng::new(35);
+    let particles = overlapping(&mut rng, 8, 1.0);
+    let s = scene(particles.clone(), 16, 1e-8, None);
+    let r = renderer(&s);
+    let bg = s.render.background;
+    for (x, y) in [(8.0, 8.0), (6.5, 9.5), (10.0, 7.0), (7.3, 5.1)] {
+        let ray = s.camera.ray_at(x, y);
+        let fine = riemann(&particles, bg, &ray, 24.0, 100_000);
+        let coarse = riemann(&particles, bg, &ray, 24.0, 50_000);
+        // The midpoint sum's error falls as h²: at 10⁵ steps it is about a third of the
+        // difference to 5·10⁴.
+        let riemann_error = (fine - coarse).abs();
+        let got = r.radiance(&ray);
+        for c in 0..3 {
+            assert!(
+                (got.radiance[c] - fine[c]).abs() <= got.error[c] + riemann_error[c] + 1e-12,
+                "({x}, {y}) channel {c}: {} against the Riemann sum {} (err {}, Riemann {})",
+                got.radiance[c],
+                fine[c],
+                got.error[c],
+                riemann_error[c]
+            );
+        }
+        assert!(riemann_error.max_element() < 1e-6, "{riemann_error}");
+        assert!(
+            (fine - bg).abs().max_element() > 0.1,
+            "the ray misses the gas"
+        );
+    }
+}
+
+#[test]
+fn two_coincident_gaussians_equal_one_with_twice_sigma() {
+    let mut rng = Rng::new(7);
+    let base = overlapping(&mut rng, 3, 0.8);
+    let mut doubled = base.clone();
+    doubled.push(base[1]);
+    let mut twice = base.clone();
+    twice[1].sigma *= 2.0;
+    let options = RenderOptions::default();
+    let a = render(&scene(doubled, 12, 1e-8, Some(6.0)), &options).unwrap();
+    let b = render(&scene(twice, 12, 1e-8, Some(6.0)), &options).unwrap();
+    let (ea, eb) = (a.error.unwrap(), b.error.unwrap());
+    for i in 0..a.image.pixels.len() {
+        for c in 0..3 {
+            let diff = (a.image.pixels[i][c] - b.image.pixels[i][c]).abs();
+            assert!(
+                diff <= ea.pixels[i][c] + eb.pixels[i][c],
+                "pixel {i} channel {c}: {diff}"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_scene_files_opacity_is_seen_along_the_shortest_axis() {
+    // A Gaussian whose shortest standard deviation (0.2) lies along the view, opacity 0.6:
+    // the centre pixel is 0.6·C + 0.4·L_bg.
+    let text = r#"
+[camera]
+position = [0.0, 0.0, -10.0]
+look_at = [0.0, 0.0, 0.0]
+fov_y = 20.0
+width = 9
+height = 9
+[render]
+model = "emission"
+background = [0.2, 0.3, 0.4]
+tol = 1e-9
+[[particles]]
+center = [0.0, 0.0, 0.0]
+semi_axes = [0.2, 0.9, 0.5]
+rotation = [0.70710678118654752, 0.0, 0.70710678118654752, 0.0]
+color = [1.0, 0.5, 0.25]
+opacity = 0.6
+density = "gaussian"
+"#;
+    let s = Scene::from_toml_str(
+        text,
+        Path::new("opacity.toml"),
+        &SceneLoadOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(s.particles[0].profile, Profile::Gaussian);
+    let r = renderer(&s);
+    let got = r.radiance(&s.camera.ray_at(4.5, 4.5));
+    let want = 0.6 * DVec3::new(1.0, 0.5, 0.25) + 0.4 * DVec3::new(0.2, 0.3, 0.4);
+    assert!(
+        (got.radiance - want).abs().max_element() <= got.error.max_element() + 1e-12,
+        "{} against {want}",
+        got.radiance
+    );
+    // Seen along its longest axis the same Gaussian is more opaque than 0.6.
+    let side = text.replace(
+        "rotation = [0.70710678118654752, 0.0, 0.70710678118654752, 0.0]",
+        "rotation = [0.70710678118654752, 0.70710678118654752, 0.0, 0.0]",
+    );
+    let s =
+        Scene::from_toml_str(&side, Path::new("side.toml"), &SceneLoadOptions::default()).unwrap();
+    let got = renderer(&s).radiance(&s.camera.ray_at(4.5, 4.5));
+    assert!(got.radiance.x > want.x + 0.1, "{}", got.radiance);
+}
+
+#[test]
+fn the_cutoff_bound_holds_for_k_from_2_to_8() {
+    let mut rng = Rng::new(11);
+    let particles = overlapping(&mut rng, 60, 2.0);
+    let options = RenderOptions::default();
+    let truth = render(&scene(particles.clone(), 24, 1e-9, None), &options).unwrap();
+    let truth_err = truth.error.unwrap();
+    let mut errors = Vec::new();
+    for k in 2..=8 {
+        let s = scene(particles.clone(), 24, 1e-9, Some(k as f64));
+        let cut = render(&s, &options).unwrap();
+        let err = cut.error.unwrap();
+        let mut worst: f32 = 0.0;
+        for i in 0..cut.image.pixels.len() {
+            for c in 0..3 {
+                let diff = (cut.image.pixels[i][c] - truth.image.pixels[i][c]).abs();
+                assert!(
+                    diff <= err.pixels[i][c] + truth_err.pixels[i][c],
+                    "k {k}, pixel {i} channel {c}: off by {diff}, err {}",
+                    err.pixels[i][c]
+                );
+                worst = worst.max(diff);
+            }
+        }
+        errors.push((k, worst, cut.stats.max_error.unwrap()));
+    }
+    // The cut matters at k = 2 (the bound is not vacuous there) and err shrinks with k.
+    assert!(errors[0].1 > 1e-4, "k = 2 changes nothing: {errors:?}");
+    assert!(errors[0].2 > errors[6].2, "{errors:?}");
+}
+
+#[test]
+fn err_covers_the_truth_on_thousands_of_overlapping_gaussians() {
+    let mut rng = Rng::new(2024);
+    let particles: Vec<Particle> = (0..3000)
+        .map(|_| {
+            gaussian(
+                rng.vec3(-3.0, 3.0),
+                DVec3::new(
+                    rng.range(0.05, 0.3),
+                    rng.range(0.05, 0.3),
+                    rng.range(0.05, 0.3),
+                ),
+                turned(rng.range(0.0, 3.0)),
+                rng.vec3(0.0, 1.0),
+                rng.range(0.5, 6.0),
+            )
+        })
+        .collect();
+    let options = RenderOptions::default();
+    let coarse = render(&scene(particles.clone(), 40, 1e-3, None), &options).unwrap();
+    let tight = render(&scene(particles, 40, 1e-8, None), &options).unwrap();
+    let (ce, te) = (coarse.error.unwrap(), tight.error.unwrap());
+    let (mut covered, mut total, mut off) = (0usize, 0usize, 0.0f32);
+    for i in 0..coarse.image.pixels.len() {
+        for c in 0..3 {
+            let diff = (coarse.image.pixels[i][c] - tight.image.pixels[i][c]).abs();
+            total += 1;
+            if diff <= ce.pixels[i][c] + te.pixels[i][c] {
+                covered += 1;
+            }
+            off = off.max(diff);
+        }
+    }
+    assert!(
+        covered as f64 >= 0.999 * total as f64,
+        "err covers {covered} of {total} channels"
+    );
+    assert!(
+        off > 1e-6,
+        "the coarse render is as good as the tight one: nothing is tested"
+    );
+    assert!(tight.stats.max_error.unwrap() <= 1e-7);
+}
+
+#[test]
+fn what_the_reference_does_not_render_is_refused_by_name() {
+    let mut rng = Rng::new(3);
+    let particles = overlapping(&mut rng, 2, 1.0);
+    let refused = |s: &Scene, words: &str| {
+        let e = render(s, &RenderOptions::default()).err().expect("refused");
+        assert!(e.to_string().contains(words), "{e}");
+    };
+    let mut s = scene(particles.clone(), 4, 1e-5, None);
+    s.render.model = models::LIT;
+    refused(&s, "lit model");
+    let mut s = scene(particles.clone(), 4, 1e-5, None);
+    s.render.mode = RenderMode::Opaque;
+    refused(&s, "opaque mode");
+    let mut s = scene(particles.clone(), 4, 1e-5, None);
+    s.particles[0].profile = Profile::Constant;
+    refused(&s, "mixes particles of constant and Gaussian density");
+    let mut s = scene(particles, 4, 1e-5, None);
+    s.particles[1].sigma = f64::INFINITY;
+    refused(&s, "infinite peak density");
+    let e = Scene::from_toml_str(
+        "[defaults]\ndensity = \"gaussian\"\n[[particles]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nopacity = 1.0\n",
+        Path::new("full.toml"),
+        &SceneLoadOptions::default(),
+    )
+    .err()
+    .expect("opacity 1 refused");
+    assert!(e.to_string().contains("opacity must be < 1"), "{e}");
+    assert!(e.to_string().contains("full.toml"), "{e}");
+}
+
+/// The depth through a Gaussian's centre along its shortest axis is −ln(1 − o): the mapping
+/// as `[defaults] opacity` gives it, checked against the 3D density.
+#[test]
+fn the_peak_density_of_the_mapping_gives_the_files_opacity() {
+    let s = Scene::from_toml_str(
+        "[defaults]\ndensity = \"gaussian\"\nopacity = 0.35\n[[particles]]\ncenter = [1.0, 2.0, 3.0]\nsemi_axes = [0.5, 0.25, 1.0]\n",
+        Path::new("mapping.toml"),
+        &SceneLoadOptions::default(),
+    )
+    .unwrap();
+    let p = &s.particles[0];
+    let ray = Ray::new(p.center - 10.0 * DVec3::Y, DVec3::Y);
+    let tau = line_depth(p, &ray, 20.0, 100_000);
+    assert!((tau - -(0.65f64).ln()).abs() < 1e-10, "{tau}");
+    assert!((p.sigma * 0.25 * SQRT_TAU - -(0.65f64).ln()).abs() < 1e-14);
+}
