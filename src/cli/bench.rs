@@ -9,6 +9,7 @@
 //! | `million-lit` | the same, lit (not in the default list: minutes on two cores) |
 //! | `1uun-scatter` | 1UUN as `1uun`, single-scatter model, two point lights: one at the centre of the particles' bounding sphere (inside the gas) and one above it (not in the default list) |
 //! | `1uun-ellipsoids` | 1UUN as `1uun`, each atom an ellipsoid of the same volume: semi-axes r·k·(1, u, v), u and v uniform in [1/4, 1], k = (uv)^{−1/3}, a uniformly random orientation, Θmax 0.5 along the shortest diameter (SplitMix64 seed 1; not in the default list) |
+//! | `gaussians` | 100,000 Gaussians of `pgt gen random --count 100000` (centres in the 200-unit cube, standard deviations 0.5–2 as the radii), opacity 0.5 along the shortest axis (docs/design.md §9), emission model (not in the default list) |
 //! | `orbit`, `xtc` | sequences of frames: a frame of a sequence against a single render of it ([`super::bench_frames`]; not in the default list) |
 //!
 //! Every scene is the bare-file default (docs/design.md §1): the camera frames the bounding sphere,
@@ -49,6 +50,8 @@ const RIEMANN_SAMPLES: u32 = 100;
 const PROTEIN_ATOMS: usize = 2758;
 /// Å³ per atom of the stand-in: about a protein's density.
 const VOLUME_PER_ATOM: f64 = 20.0;
+/// Gaussians of the `gaussians` workload.
+const GAUSSIANS: usize = 100_000;
 /// Spheres of the `million` workloads.
 const MILLION: usize = 1_000_000;
 
@@ -70,6 +73,8 @@ pub enum Workload {
     /// 1UUN (or the protein-sized set) as ellipsoids of the atoms' volumes, lit.
     #[value(name = "1uun-ellipsoids")]
     ProteinEllipsoids,
+    /// 100,000 random Gaussians, emission model.
+    Gaussians,
     /// 1UUN chains A+B, lit, on an orbiting camera: a frame of the sequence against a single
     /// render.
     Orbit,
@@ -320,6 +325,16 @@ fn workload_scene(w: Workload, size: u32, data: &Path) -> anyhow::Result<(String
                 "random 73,642".into(),
                 bare_scene(random_set(THESIS_COUNT), size),
             ))
+        }
+        Workload::Gaussians => {
+            let mut particles = random_set(GAUSSIANS);
+            for p in &mut particles {
+                p.profile = crate::optics::Profile::Gaussian;
+                p.sigma = crate::optics::gaussian::sigma_from_peak_opacity(OPACITY, p.radius);
+            }
+            let mut s = bare_scene(particles, size);
+            s.render.model = models::EMISSION;
+            Ok(("gaussians 100,000".into(), s))
         }
         Workload::Million | Workload::MillionLit => {
             let mut s = bare_scene(random_set(MILLION), size);

@@ -40,7 +40,7 @@ use super::volume::MAX_SEGMENTS;
 use super::{Integrator, RadianceEstimator, Sample};
 use crate::error::{PgtError, Result};
 use crate::geometry::{Bvh, Ellipsoid, Hit, Ray};
-use crate::optics::gaussian::GaussianAlongRay;
+use crate::optics::gaussian::{DepthFrom, GaussianAlongRay};
 use crate::optics::{models, Profile};
 use crate::scene::{RenderMode, Scene};
 use glam::{DQuat, DVec3};
@@ -48,6 +48,11 @@ use std::cell::RefCell;
 
 /// √(2π).
 const SQRT_TAU: f64 = 2.506_628_274_631_000_5;
+
+/// The shortest piece of a ray, in mean standard deviations along the ray of its Gaussians:
+/// shorter pieces cost each Gaussian more evaluations (every piece its window meets starts with
+/// seven nodes), longer ones more splits (docs/performance.md, "Gaussian particles").
+const PIECE_WIDTH: f64 = 4.0;
 
 /// The smallest cut-off k chosen automatically: the reference 3DGS rasteriser's footprint.
 const MIN_AUTO_CUTOFF: f64 = 3.0;
@@ -93,11 +98,21 @@ struct Window {
     hi: f64,
 }
 
-/// A segment that needs quadrature: its start, its reference colour, its Gaussians
-/// (`active[first..first + count]`).
+/// A window's part of one piece: [x0, x1] = window ∩ piece, its depth there, and the depth
+/// from x0 to later points.
+#[derive(Debug, Clone, Copy)]
+struct Member {
+    window: usize,
+    x0: f64,
+    x1: f64,
+    from: DepthFrom,
+    depth: f64,
+}
+
+/// A piece that needs quadrature: its reference colour and its windows
+/// (`members[first..first + count]`).
 #[derive(Debug, Clone, Copy)]
 struct Deviation {
-    start: f64,
     reference: DVec3,
     first: usize,
     count: usize,
@@ -109,7 +124,7 @@ struct Scratch {
     candidates: Vec<Candidate>,
     windows: Vec<Window>,
     points: Vec<f64>,
-    active: Vec<usize>,
+    members: Vec<Member>,
     deviations: Vec<Deviation>,
     pieces: Vec<Piece>,
 }
@@ -283,37 +298,68 @@ impl GaussianRenderer {
         s.windows
             .sort_unstable_by(|a, b| a.lo.total_cmp(&b.lo).then(a.index.cmp(&b.index)));
 
+        // The pieces: the windows' ends and centres, thinned so that neighbouring cuts are at
+        // least PIECE_WIDTH mean standard deviations apart (the quadrature splits where a
+        // piece needs it; evaluations cost the windows that hold the node, not the piece's).
         s.points.clear();
+        let mut mean_s = 0.0;
         for w in &s.windows {
             s.points.push(w.lo);
             s.points.push(w.hi);
             if w.profile.t_star > w.lo && w.profile.t_star < w.hi {
                 s.points.push(w.profile.t_star);
             }
+            mean_s += w.profile.s;
         }
         s.points.sort_unstable_by(f64::total_cmp);
         s.points.dedup();
+        if let Some(&end) = s.points.last() {
+            let gap = PIECE_WIDTH * mean_s / s.windows.len() as f64;
+            let mut kept = 1;
+            for k in 1..s.points.len() {
+                if s.points[k] - s.points[kept - 1] >= gap {
+                    s.points[kept] = s.points[k];
+                    kept += 1;
+                }
+            }
+            s.points.truncate(kept);
+            if s.points[kept - 1] < end {
+                if kept > 1 {
+                    s.points[kept - 1] = end;
+                } else {
+                    s.points.push(end);
+                }
+            }
+        }
 
         let mut radiance = DVec3::ZERO;
         let mut error = DVec3::ZERO;
         let mut transmittance = 1.0;
         let mut stopped = false;
-        s.active.clear();
+        s.members.clear();
         s.deviations.clear();
         s.pieces.clear();
         for seg in s.points.windows(2) {
             let (a, b) = (seg[0], seg[1]);
-            let first = s.active.len();
-            // Windows are sorted by their start: those that start at or before a.
+            let first = s.members.len();
+            // Windows are sorted by their start: those that start before b and end after a.
             for (k, w) in s.windows.iter().enumerate() {
-                if w.lo > a {
+                if w.lo >= b {
                     break;
                 }
-                if w.hi >= b {
-                    s.active.push(k);
+                if w.hi > a {
+                    let (x0, x1) = (w.lo.max(a), w.hi.min(b));
+                    let from = w.profile.depth_from(x0);
+                    s.members.push(Member {
+                        window: k,
+                        x0,
+                        x1,
+                        from,
+                        depth: from.to(x1),
+                    });
                 }
             }
-            let count = s.active.len() - first;
+            let count = s.members.len() - first;
             if count == 0 {
                 continue;
             }
@@ -322,23 +368,19 @@ impl GaussianRenderer {
                 radiance += rest;
                 error += rest;
                 stopped = true;
-                s.active.truncate(first);
+                s.members.truncate(first);
                 break;
             }
-            let mut tau = 0.0;
-            let mut heaviest = (0.0, s.active[first]);
-            for &k in &s.active[first..] {
-                let d = s.windows[k].profile.optical_depth(a, b);
-                tau += d;
-                if d > heaviest.0 {
-                    heaviest = (d, k);
-                }
-            }
-            let reference = self.color_of(&s.windows[heaviest.1]);
-            radiance += transmittance * reference * -(-tau).exp_m1();
-            if s.active[first..]
+            let members = &s.members[first..];
+            let tau: f64 = members.iter().map(|m| m.depth).sum();
+            let heaviest = members
                 .iter()
-                .any(|&k| self.color_of(&s.windows[k]) != reference)
+                .fold(&members[0], |h, m| if m.depth > h.depth { m } else { h });
+            let reference = self.color_of(&s.windows[heaviest.window]);
+            radiance += transmittance * reference * -(-tau).exp_m1();
+            if members
+                .iter()
+                .any(|m| self.color_of(&s.windows[m.window]) != reference)
             {
                 s.pieces.push(Piece {
                     lo: a,
@@ -347,13 +389,12 @@ impl GaussianRenderer {
                     tag: s.deviations.len(),
                 });
                 s.deviations.push(Deviation {
-                    start: a,
                     reference,
                     first,
                     count,
                 });
             } else {
-                s.active.truncate(first);
+                s.members.truncate(first);
             }
             transmittance *= (-tau).exp();
         }
@@ -363,14 +404,21 @@ impl GaussianRenderer {
 
         let mut converged = true;
         if !s.pieces.is_empty() {
-            let (windows, active, deviations) = (&s.windows, &s.active, &s.deviations);
+            let (windows, members, deviations) = (&s.windows, &s.members, &s.deviations);
             let integrand = |tag: usize, t: f64| {
                 let d = &deviations[tag];
                 let mut tau = 0.0;
                 let mut sum = DVec3::ZERO;
-                for &k in &active[d.first..d.first + d.count] {
-                    let w = &windows[k];
-                    tau += w.profile.optical_depth(d.start, t);
+                for m in &members[d.first..d.first + d.count] {
+                    if t <= m.x0 {
+                        continue;
+                    }
+                    if t >= m.x1 {
+                        tau += m.depth;
+                        continue;
+                    }
+                    let w = &windows[m.window];
+                    tau += m.from.to(t);
                     sum += w.profile.density(t) * (self.color_of(w) - d.reference);
                 }
                 (-tau).exp() * sum

@@ -627,7 +627,7 @@ fn inline_particle(
         .color
         .map_or(Ok(d.color), |c| at.non_negative3(&name("color"), c))?;
     let profile = p.density.unwrap_or(d.density);
-    check_gaussian_opacity(&at, &name("opacity"), profile, opacity.or(d.opacity))?;
+    check_gaussian_opacity(at, &name("opacity"), profile, opacity.or(d.opacity))?;
     Ok(Particle {
         center,
         radius,

@@ -405,7 +405,9 @@ fn what_the_reference_does_not_render_is_refused_by_name() {
     let mut rng = Rng::new(3);
     let particles = overlapping(&mut rng, 2, 1.0);
     let refused = |s: &Scene, words: &str| {
-        let e = render(s, &RenderOptions::default()).err().expect("refused");
+        let Err(e) = render(s, &RenderOptions::default()) else {
+            panic!("not refused: {words}")
+        };
         assert!(e.to_string().contains(words), "{e}");
     };
     let mut s = scene(particles.clone(), 4, 1e-5, None);
@@ -420,13 +422,13 @@ fn what_the_reference_does_not_render_is_refused_by_name() {
     let mut s = scene(particles, 4, 1e-5, None);
     s.particles[1].sigma = f64::INFINITY;
     refused(&s, "infinite peak density");
-    let e = Scene::from_toml_str(
+    let Err(e) = Scene::from_toml_str(
         "[defaults]\ndensity = \"gaussian\"\n[[particles]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\nopacity = 1.0\n",
         Path::new("full.toml"),
         &SceneLoadOptions::default(),
-    )
-    .err()
-    .expect("opacity 1 refused");
+    ) else {
+        panic!("opacity 1 not refused")
+    };
     assert!(e.to_string().contains("opacity must be < 1"), "{e}");
     assert!(e.to_string().contains("full.toml"), "{e}");
 }
