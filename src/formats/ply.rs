@@ -1156,6 +1156,20 @@ mod tests {
     }
 
     #[test]
+    fn gaussian_density_takes_the_standard_deviations_and_refuses_extent() {
+        let mut s = spec();
+        s.density = Some(crate::optics::Profile::Gaussian);
+        let l = read(&s, &file("binary_little_endian", &[v()])).expect("ok");
+        let axes = DVec3::new((-1.0f64).exp(), 1.0, 0.5f64.exp());
+        assert_eq!(l.records[0].ellipsoid.expect("e").semi_axes, axes);
+        s.extent = Some(3.0);
+        let e = read(&s, &file("binary_little_endian", &[v()]))
+            .expect_err("extent refused")
+            .to_string();
+        assert!(e.contains("t.ply") && e.contains("extent"), "{e}");
+    }
+
+    #[test]
     fn a_file_cut_short_names_the_vertex() {
         let b = file("binary_little_endian", &[v(), v(), v()]);
         let e = err(&b[..b.len() - 10]);

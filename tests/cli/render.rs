@@ -319,3 +319,37 @@ fn model_names_come_from_the_registry() {
         assert!(exr.exists(), "{model}");
     }
 }
+
+#[test]
+fn gaussian_particles_render_exactly_and_what_cannot_draw_them_exits_2() {
+    let dir = tmp();
+    let exr = dir.path().join("gaussians.exr");
+    let scene = example("gaussians.toml");
+    let out = pgt(&["render", &scene, "-o", s(&exr), "--size", "24x24"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("error estimate max"), "{err}");
+    let err_layer = pgt::image_io::read_exr_layer(&exr, "err").expect("the err layer");
+    assert!(err_layer
+        .pixels
+        .iter()
+        .flatten()
+        .all(|&e| e > 0.0 && e <= 1e-5));
+    for (args, words) in [
+        (vec!["render", &scene, "--model", "lit"], "lit model"),
+        (vec!["render", &scene, "--mode", "opaque"], "no surface"),
+        (
+            vec!["approx", &scene, "--method", "emission"],
+            "Gaussian particles",
+        ),
+    ] {
+        let target = dir.path().join("refused.exr");
+        let mut full = args.clone();
+        full.extend(["-o", s(&target), "--size", "8x8"]);
+        let out = pgt(&full);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "{args:?}: {err}");
+        assert!(err.contains(words), "{args:?}: {err}");
+        assert!(!target.exists(), "{args:?} left a file behind");
+    }
+}
