@@ -206,7 +206,9 @@ impl Scene {
     ///   light_weight     "mean" or "sum" (lit model) ["mean"].
     ///   emission_weight  a in [0, 1] (single-scatter) [1].
     ///   ambient          opaque-mode ambient term [0].
-    ///   defaults         dict of the scene file's [defaults] (albedo, ks, shininess, ...).
+    ///   defaults         dict of the scene file's [defaults] (albedo, ks, shininess, ...);
+    ///                    {"density": "gaussian"} makes the particles Gaussians whose radii
+    ///                    or semi-axes are standard deviations (docs/design.md §9).
     ///
     /// Raises pgt.InputError (a ValueError) naming the argument for arrays of the wrong
     /// shape or dtype, NaN or infinity, and values out of range.

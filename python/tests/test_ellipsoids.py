@@ -129,3 +129,28 @@ def test_bad_ellipsoid_arrays_name_their_argument(kwargs, message):
     radii = args.pop("radii")
     with pytest.raises(pgt.InputError, match=message):
         pgt.Scene.from_arrays([[0, 0, 0], [1, 0, 0]], radii, **args)
+
+
+def test_gaussians_from_arrays_show_the_opacity_along_the_shortest_axis():
+    """defaults={"density": "gaussian"} makes the particles Gaussians (docs/design.md §9): seen along
+    its shortest standard deviation, a Gaussian of opacity 0.6 shows 0.6 C + 0.4 L_bg at its centre;
+    along its longest it is more opaque; the constant-density GPU methods refuse the scene."""
+    quarter_turn_y = np.array([[np.sqrt(0.5), 0.0, np.sqrt(0.5), 0.0]])
+    quarter_turn_x = np.array([[np.sqrt(0.5), np.sqrt(0.5), 0.0, 0.0]])
+    color, background = np.array([[1.0, 0.5, 0.25]]), (0.2, 0.3, 0.4)
+
+    def scene(rotation):
+        return pgt.Scene.from_arrays(
+            np.zeros((1, 3)), None, color, 0.6, semi_axes=np.array([[0.2, 0.9, 0.5]]),
+            rotations=rotation, camera={"position": [0.0, 0.0, -10.0], "look_at": [0.0, 0.0, 0.0], "fov_y": 20.0},
+            size=(9, 9), model="emission", background=background, tol=1e-9, defaults={"density": "gaussian"},
+        )
+
+    front = pgt.render(scene(quarter_turn_y))
+    want = 0.6 * color[0] + 0.4 * np.array(background)
+    assert np.abs(front.image[4, 4] - want).max() <= front.err[4, 4].max() + 1e-6, front.image[4, 4]
+    assert front.err.max() <= 1e-7
+    side = pgt.render(scene(quarter_turn_x))
+    assert side.image[4, 4, 0] > want[0] + 0.1, side.image[4, 4]
+    with pytest.raises(pgt.InputError, match="Gaussian particles"):
+        pgt.approx(scene(quarter_turn_y), "emission")

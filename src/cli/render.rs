@@ -242,8 +242,18 @@ fn render_frames(
     Ok(Outcome::Success)
 }
 
-/// "11032 spheres", or "4 particles, 3 of them ellipsoids": the particles of a summary line.
+/// "11032 spheres", "4 particles, 3 of them ellipsoids" or "1971 Gaussians": the particles of a
+/// summary line.
 pub(crate) fn particles_text(scene: &Scene) -> String {
+    let n = scene.particles.len();
+    if n > 0
+        && scene
+            .particles
+            .iter()
+            .all(|p| p.profile == crate::optics::Profile::Gaussian)
+    {
+        return format!("{n} Gaussians");
+    }
     let ellipsoids = scene
         .particles
         .iter()

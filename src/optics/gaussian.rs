@@ -83,13 +83,19 @@ impl GaussianAlongRay {
     /// The optical depth from `t0` to later points, with the work at `t0` done once
     /// ([`DepthFrom::to`]).
     pub fn depth_from(&self, t0: f64) -> DepthFrom {
+        let z0 = (t0 - self.t_star) / (std::f64::consts::SQRT_2 * self.s);
+        self.depth_from_tail(t0, libm::erfc(z0.abs()))
+    }
+
+    /// [`GaussianAlongRay::depth_from`] where erfc(|z₀|) at `t0` is known already (the `tail`
+    /// that [`DepthFrom::to_with_tail`] returned for `t0`).
+    pub fn depth_from_tail(&self, t0: f64, tail0: f64) -> DepthFrom {
         let scale = std::f64::consts::SQRT_2 * self.s;
-        let z0 = (t0 - self.t_star) / scale;
         DepthFrom {
             t_star: self.t_star,
             inv_scale: 1.0 / scale,
-            z0,
-            tail0: libm::erfc(z0.abs()),
+            z0: (t0 - self.t_star) / scale,
+            tail0,
             factor: self.peak * self.s * SQRT_HALF_PI,
         }
     }
@@ -115,6 +121,13 @@ impl DepthFrom {
     /// The optical depth over [t₀, t], t ≥ t₀.
     #[inline]
     pub fn to(&self, t: f64) -> f64 {
+        self.to_with_tail(t).0
+    }
+
+    /// The optical depth over [t₀, t], t ≥ t₀, and erfc(|z|) at t (for a later
+    /// [`GaussianAlongRay::depth_from_tail`] from t).
+    #[inline]
+    pub fn to_with_tail(&self, t: f64) -> (f64, f64) {
         let z1 = (t - self.t_star) * self.inv_scale;
         let tail1 = libm::erfc(z1.abs());
         let d = if self.z0 >= 0.0 {
@@ -126,7 +139,7 @@ impl DepthFrom {
             // matters for an absolute depth.
             (1.0 - tail1) + (1.0 - self.tail0)
         };
-        self.factor * d
+        (self.factor * d, tail1)
     }
 }
 

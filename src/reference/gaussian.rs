@@ -89,13 +89,15 @@ struct Candidate {
     front: f64,
 }
 
-/// An included Gaussian's window [lo, hi] along the ray.
+/// An included Gaussian's window [lo, hi] along the ray, and the last point where erfc of its
+/// profile was taken, with that value.
 #[derive(Debug, Clone, Copy)]
 struct Window {
     index: u32,
     profile: GaussianAlongRay,
     lo: f64,
     hi: f64,
+    tail_at: Option<(f64, f64)>,
 }
 
 /// A window's part of one piece: [x0, x1] = window ∩ piece, its depth there, and the depth
@@ -252,7 +254,13 @@ impl GaussianRenderer {
         for h in &s.hits {
             let g = &self.gaussians[h.index as usize];
             let profile = GaussianAlongRay::new(ray, g.center, &g.shape, g.sigma);
-            let front = profile.optical_depth(0.0, f64::INFINITY);
+            // Wholly in front of the eye (beyond 9 s the part behind is below 1e-18 of it) the
+            // depth in front is the whole line's, an upper bound, without an erfc.
+            let front = if profile.t_star >= 9.0 * profile.s {
+                profile.total_depth()
+            } else {
+                profile.optical_depth(0.0, f64::INFINITY)
+            };
             s.candidates.push(Candidate {
                 index: h.index,
                 profile,
@@ -277,13 +285,14 @@ impl GaussianRenderer {
         s.windows.clear();
         for c in kept {
             let total = c.profile.total_depth();
-            // erfc(w/√2) ≤ e^{−w²/2}: this w leaves at most tail_budget outside the window.
+            // The depth outside the window is total·erfc(w/√2) ≤ total·e^{−w²/2}, which this w
+            // makes tail_budget; the bound goes into Δ.
             let w = if total > tail_budget {
                 (2.0 * (total / tail_budget).ln()).sqrt()
             } else {
                 0.0
             };
-            delta += total * libm::erfc(w * std::f64::consts::FRAC_1_SQRT_2);
+            delta += total * (-0.5 * w * w).exp();
             let p = c.profile;
             let (lo, hi) = ((p.t_star - w * p.s).max(0.0), p.t_star + w * p.s);
             if hi > lo {
@@ -292,6 +301,7 @@ impl GaussianRenderer {
                     profile: p,
                     lo,
                     hi,
+                    tail_at: None,
                 });
             }
         }
@@ -343,19 +353,26 @@ impl GaussianRenderer {
             let (a, b) = (seg[0], seg[1]);
             let first = s.members.len();
             // Windows are sorted by their start: those that start before b and end after a.
-            for (k, w) in s.windows.iter().enumerate() {
+            for (k, w) in s.windows.iter_mut().enumerate() {
                 if w.lo >= b {
                     break;
                 }
                 if w.hi > a {
                     let (x0, x1) = (w.lo.max(a), w.hi.min(b));
-                    let from = w.profile.depth_from(x0);
+                    // The erfc at x0 is the one the last piece computed at its end, where the
+                    // window goes on.
+                    let from = match w.tail_at {
+                        Some((x, tail)) if x == x0 => w.profile.depth_from_tail(x0, tail),
+                        _ => w.profile.depth_from(x0),
+                    };
+                    let (depth, tail) = from.to_with_tail(x1);
+                    w.tail_at = Some((x1, tail));
                     s.members.push(Member {
                         window: k,
                         x0,
                         x1,
                         from,
-                        depth: from.to(x1),
+                        depth,
                     });
                 }
             }

@@ -328,7 +328,10 @@ fn gaussian_particles_render_exactly_and_what_cannot_draw_them_exits_2() {
     let out = pgt(&["render", &scene, "-o", s(&exr), "--size", "24x24"]);
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(out.status.success(), "{err}");
-    assert!(err.contains("error estimate max"), "{err}");
+    assert!(
+        err.contains("error estimate max") && err.contains("5 Gaussians"),
+        "{err}"
+    );
     let err_layer = pgt::image_io::read_exr_layer(&exr, "err").expect("the err layer");
     assert!(err_layer
         .pixels
