@@ -23,6 +23,7 @@ pub mod mmcif;
 pub mod mmpld;
 pub mod pdb;
 pub mod ply;
+pub mod profile;
 pub mod psf;
 pub mod random;
 pub mod record;
@@ -31,6 +32,7 @@ pub mod vrml;
 pub mod xtc;
 pub mod xyz_csv;
 
+pub use profile::Profile;
 pub use record::{ColorBy, EllipsoidRecord, IncludeSpec, ParticleRecord, ShColor, ShOrder};
 
 use crate::error::{PgtError, Result};

@@ -596,7 +596,7 @@ struct Options {
 }
 
 fn options(spec: &IncludeSpec) -> Result<Options> {
-    let gaussian = spec.density == Some(crate::optics::Profile::Gaussian);
+    let gaussian = spec.density == Some(crate::formats::Profile::Gaussian);
     if gaussian && spec.extent.is_some() {
         return Err(PgtError::in_file(
             &spec.path,
@@ -1158,7 +1158,7 @@ mod tests {
     #[test]
     fn gaussian_density_takes_the_standard_deviations_and_refuses_extent() {
         let mut s = spec();
-        s.density = Some(crate::optics::Profile::Gaussian);
+        s.density = Some(crate::formats::Profile::Gaussian);
         let l = read(&s, &file("binary_little_endian", &[v()])).expect("ok");
         let axes = DVec3::new((-1.0f64).exp(), 1.0, 0.5f64.exp());
         assert_eq!(l.records[0].ellipsoid.expect("e").semi_axes, axes);

@@ -147,7 +147,7 @@ pub struct IncludeSpec {
     /// The density profile of the file's particles (docs/design.md §9); `[defaults]`' by
     /// default.
     #[serde(default)]
-    pub density: Option<crate::optics::Profile>,
+    pub density: Option<crate::formats::Profile>,
     /// 3DGS PLY: the DC colour (default) or the view-dependent one.
     pub sh: Option<ShColor>,
     /// 3DGS PLY: the order of `f_rest_*` (channel-major by default).

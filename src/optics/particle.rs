@@ -2,6 +2,7 @@
 //! extinction σ already resolved from Θmax or κ (`extinction`), its density profile (constant or
 //! Gaussian) and its colours.
 
+pub use crate::formats::Profile;
 use crate::geometry::{Ellipsoid, Shape};
 use glam::DVec3;
 
@@ -30,29 +31,6 @@ pub struct Particle {
     pub ellipsoid: Option<Ellipsoid>,
     /// How the density varies inside the particle (docs/design.md §9).
     pub profile: Profile,
-}
-
-/// The density profile of a particle (docs/design.md §9 "Gaussian density").
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
-#[serde(rename_all = "kebab-case")]
-pub enum Profile {
-    /// σ inside the sphere or ellipsoid, 0 outside (the thesis).
-    #[default]
-    Constant,
-    /// σ·exp(−½·m(x)²), m the Mahalanobis distance whose axes are the radius or the semi-axes
-    /// taken as standard deviations; `sigma` is the peak density at the centre. The support is
-    /// unbounded: the shape is the 1-σ ellipsoid, not an edge.
-    Gaussian,
-}
-
-impl Profile {
-    /// The name in scene files (`density = "gaussian"`).
-    pub fn name(self) -> &'static str {
-        match self {
-            Profile::Constant => "constant",
-            Profile::Gaussian => "gaussian",
-        }
-    }
 }
 
 impl Particle {

@@ -51,7 +51,7 @@ const SQRT_TAU: f64 = 2.506_628_274_631_000_5;
 
 /// The shortest piece of a ray, in mean standard deviations along the ray of its Gaussians:
 /// shorter pieces cost each Gaussian more evaluations (every piece its window meets starts with
-/// seven nodes), longer ones more splits (docs/performance.md, "Gaussian particles").
+/// seven nodes), longer ones more splits (docs/performance.md, "Gaussian particles in the reference").
 const PIECE_WIDTH: f64 = 4.0;
 
 /// The smallest cut-off k chosen automatically: the reference 3DGS rasteriser's footprint.
@@ -129,6 +129,8 @@ struct Scratch {
     members: Vec<Member>,
     deviations: Vec<Deviation>,
     pieces: Vec<Piece>,
+    /// The transmittance after the last piece of the sweep.
+    end_t: f64,
 }
 
 thread_local! {
@@ -247,8 +249,28 @@ impl GaussianRenderer {
         // Budgets of optical depth left out: tol/4 of radiance in all (M·Δ ≤ tol/4), half for
         // the small Gaussians left out whole and half for the tails outside the windows.
         let budget = self.tol / (4.0 * m_max);
-        let mut delta = self.far_depth;
+        let delta = self.far_depth + self.gather(ray, s, budget);
+        cut_pieces(s);
+        let (mut radiance, mut error, stopped) = self.sweep(s, m_max);
+        if !stopped {
+            radiance += self.background_seen(s);
+        }
+        let converged = self.deviations(s, &mut radiance, &mut error);
 
+        error += self.bound * -(-delta).exp_m1();
+        Sample {
+            radiance,
+            error,
+            shadow_rays: 0,
+            unconverged: !converged,
+        }
+    }
+
+    /// Fills `s.windows` with the Gaussians the ray keeps (sorted by window start) and
+    /// returns the optical depth left out of them: the faint ones left out whole, within half
+    /// of `budget`, and the tails outside the windows.
+    fn gather(&self, ray: &Ray, s: &mut Scratch, budget: f64) -> f64 {
+        let mut delta = 0.0;
         self.bvh.all_hits(ray, 0.0, f64::INFINITY, &mut s.hits);
         s.candidates.clear();
         for h in &s.hits {
@@ -308,40 +330,14 @@ impl GaussianRenderer {
         s.windows
             .sort_unstable_by(|a, b| a.lo.total_cmp(&b.lo).then(a.index.cmp(&b.index)));
 
-        // The pieces: the windows' ends and centres, thinned so that neighbouring cuts are at
-        // least PIECE_WIDTH mean standard deviations apart (the quadrature splits where a
-        // piece needs it; evaluations cost the windows that hold the node, not the piece's).
-        s.points.clear();
-        let mut mean_s = 0.0;
-        for w in &s.windows {
-            s.points.push(w.lo);
-            s.points.push(w.hi);
-            if w.profile.t_star > w.lo && w.profile.t_star < w.hi {
-                s.points.push(w.profile.t_star);
-            }
-            mean_s += w.profile.s;
-        }
-        s.points.sort_unstable_by(f64::total_cmp);
-        s.points.dedup();
-        if let Some(&end) = s.points.last() {
-            let gap = PIECE_WIDTH * mean_s / s.windows.len() as f64;
-            let mut kept = 1;
-            for k in 1..s.points.len() {
-                if s.points[k] - s.points[kept - 1] >= gap {
-                    s.points[kept] = s.points[k];
-                    kept += 1;
-                }
-            }
-            s.points.truncate(kept);
-            if s.points[kept - 1] < end {
-                if kept > 1 {
-                    s.points[kept - 1] = end;
-                } else {
-                    s.points.push(end);
-                }
-            }
-        }
+        delta
+    }
 
+    /// The closed-form part of every piece, front to back: T(a)·C_ref·(1 − e^{−τ(a,b)}) and
+    /// the pieces whose colours differ queued for quadrature (`s.pieces`). Returns the
+    /// radiance, its error so far and whether the ray stopped at T·max M ≤ tol/8; `s.end_t`
+    /// is the transmittance after the last piece.
+    fn sweep(&self, s: &mut Scratch, m_max: f64) -> (DVec3, DVec3, bool) {
         let mut radiance = DVec3::ZERO;
         let mut error = DVec3::ZERO;
         let mut transmittance = 1.0;
@@ -415,10 +411,18 @@ impl GaussianRenderer {
             }
             transmittance *= (-tau).exp();
         }
-        if !stopped {
-            radiance += transmittance * self.background;
-        }
+        s.end_t = transmittance;
+        (radiance, error, stopped)
+    }
 
+    /// L_bg·T(0,∞).
+    fn background_seen(&self, s: &Scratch) -> DVec3 {
+        s.end_t * self.background
+    }
+
+    /// The colour deviations of the queued pieces by adaptive Gauss–Kronrod with tol/2, added
+    /// to `radiance` and their estimate to `error`; whether the quadrature converged.
+    fn deviations(&self, s: &Scratch, radiance: &mut DVec3, error: &mut DVec3) -> bool {
         let mut converged = true;
         if !s.pieces.is_empty() {
             let (windows, members, deviations) = (&s.windows, &s.members, &s.deviations);
@@ -448,17 +452,11 @@ impl GaussianRenderer {
                 |_, _, _| None,
                 |_, _, _| true,
             );
-            radiance += result.value;
-            error += result.error;
+            *radiance += result.value;
+            *error += result.error;
             converged = result.converged;
         }
-        error += self.bound * -(-delta).exp_m1();
-        Sample {
-            radiance,
-            error,
-            shadow_rays: 0,
-            unconverged: !converged,
-        }
+        converged
     }
 
     #[inline]
@@ -474,6 +472,42 @@ impl RadianceEstimator for GaussianRenderer {
 
     fn estimates_error(&self) -> bool {
         true
+    }
+}
+
+/// Cuts the ray into `s.points`: the windows' ends and centres, thinned so that neighbouring
+/// cuts are at least [`PIECE_WIDTH`] mean standard deviations apart (the quadrature splits where
+/// a piece needs it; an evaluation costs the windows that hold the node, not the piece's).
+fn cut_pieces(s: &mut Scratch) {
+    s.points.clear();
+    let mut mean_s = 0.0;
+    for w in &s.windows {
+        s.points.push(w.lo);
+        s.points.push(w.hi);
+        if w.profile.t_star > w.lo && w.profile.t_star < w.hi {
+            s.points.push(w.profile.t_star);
+        }
+        mean_s += w.profile.s;
+    }
+    s.points.sort_unstable_by(f64::total_cmp);
+    s.points.dedup();
+    if let Some(&end) = s.points.last() {
+        let gap = PIECE_WIDTH * mean_s / s.windows.len() as f64;
+        let mut kept = 1;
+        for k in 1..s.points.len() {
+            if s.points[k] - s.points[kept - 1] >= gap {
+                s.points[kept] = s.points[k];
+                kept += 1;
+            }
+        }
+        s.points.truncate(kept);
+        if s.points[kept - 1] < end {
+            if kept > 1 {
+                s.points[kept - 1] = end;
+            } else {
+                s.points.push(end);
+            }
+        }
     }
 }
 
