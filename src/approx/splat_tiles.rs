@@ -214,3 +214,79 @@ pub fn build(buffers: &mut SceneBuffers, frame: &GpuFrame) {
         .collect();
     buffers.tile_entries = entries;
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Profile, Scene, SceneLoadOptions};
+
+    /// A grid of Gaussians, some in front of the near cull, seen by a 100×70 camera.
+    fn buffers() -> (SceneBuffers, GpuFrame) {
+        let mut text = String::from(
+            "[camera]\nposition = [0.0, 0.0, -8.0]\nlook_at = [0.0, 0.0, 0.0]\nwidth = 100\nheight = 70\n",
+        );
+        for i in 0..60 {
+            let (x, y, z) = (
+                (i % 6) as f64 - 2.5,
+                (i / 6 % 5) as f64 - 2.0,
+                (i % 7) as f64,
+            );
+            text += &format!(
+                "[[particles]]\ncenter = [{x}, {y}, {}]\nradius = {}\n",
+                z - 8.0 + 0.1 * (i % 3) as f64,
+                0.1 + 0.05 * (i % 4) as f64
+            );
+        }
+        let mut scene = Scene::from_toml_str(
+            &text,
+            std::path::Path::new("s.toml"),
+            &SceneLoadOptions::default(),
+        )
+        .unwrap();
+        for p in &mut scene.particles {
+            p.profile = Profile::Gaussian;
+        }
+        let frame = GpuFrame::new(&scene, &[]);
+        (SceneBuffers::new(&scene, &scene.build_bvh()), frame)
+    }
+
+    /// Every tile lists exactly the splats whose rectangle covers it, front to back.
+    #[test]
+    fn each_tile_lists_the_splats_that_touch_it_in_depth_order() {
+        let (mut b, frame) = buffers();
+        build(&mut b, &frame);
+        let (cols, rows) = tile_grid(frame.width, frame.height);
+        let culled = (0..b.particles.len())
+            .filter(|&i| project(&b, &frame, i).is_none())
+            .count();
+        assert!(culled > 0, "some Gaussians are culled");
+        assert_eq!(b.splats.len() + culled, b.particles.len());
+        for w in b.splats.windows(2) {
+            assert!(
+                w[0].depth < w[1].depth
+                    || (w[0].depth == w[1].depth && w[0].particle < w[1].particle)
+            );
+        }
+        let mut at = 2 * cols * rows;
+        for y in 0..rows {
+            for x in 0..cols {
+                let k = (y * cols + x) as usize;
+                let (begin, end) = (b.tile_entries[2 * k], b.tile_entries[2 * k + 1]);
+                assert_eq!(begin, at, "tile lists are contiguous");
+                at = end;
+                let listed: Vec<u32> = b.tile_entries[begin as usize..end as usize].to_vec();
+                assert!(listed.windows(2).all(|w| w[0] < w[1]), "front to back");
+                let want: Vec<u32> = (0..b.splats.len() as u32)
+                    .filter(|&s| {
+                        let p =
+                            project(&b, &frame, b.splats[s as usize].particle as usize).unwrap();
+                        (p.tiles_x.0..p.tiles_x.1).contains(&x)
+                            && (p.tiles_y.0..p.tiles_y.1).contains(&y)
+                    })
+                    .collect();
+                assert_eq!(listed, want, "tile ({x}, {y})");
+            }
+        }
+        assert_eq!(at as usize, b.tile_entries.len());
+    }
+}
