@@ -9,11 +9,11 @@
 
 // The constants (MAX_HITS, STACK_SIZE, T_FAR, SIGMA_INFINITE, NO_PARTICLE, NO_ELLIPSOID, PI, the
 // light and falloff codes, LOOP_LIMIT, LOOP_LIMIT_REPORT, WORKGROUP_SIDE, PARAM_SLOTS, the profile
-// codes, TILE_SIDE and the splatting constants SPLAT_*, GAUSSIAN_TRACE_SIGMAS), the structs
-// Particle, Ellipsoid, BvhNode, Light, Frame, Stats, Splat and the bindings frame, particles,
-// nodes, leaf_indices, lights, output, stats, ellipsoids, splats, tile_entries are generated from
-// src/approx/contract.rs and src/approx/layout.rs and prepended to this file: their values and
-// docs live there.
+// codes, TILE_SIDE and the Gaussian methods' SPLAT_*, GAUSSIAN_TRACE_SIGMAS, GAUSS_RAY_BATCH),
+// the structs Particle, Ellipsoid, BvhNode, Light, Frame, Stats, Splat and the bindings frame,
+// particles, nodes, leaf_indices, lights, output, stats, ellipsoids, splats, tile_entries are
+// generated from src/approx/contract.rs and src/approx/layout.rs and prepended to this file:
+// their values and docs live there.
 
 // A method's parameter by slot; the slots are named by generated constants PARAM_<NAME>
 // (e.g. method_param(PARAM_SAMPLES)).

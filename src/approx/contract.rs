@@ -79,6 +79,10 @@ pub const SPLAT_T_MIN: f32 = 1.0e-4;
 /// ellipsoids (3DGRT's bounding primitives; 3DGS's footprint radius is also 3σ).
 pub const GAUSSIAN_TRACE_SIGMAS: f32 = 3.0;
 
+/// Hits per BVH traversal of `gauss-ray`: each traversal keeps the nearest this many by t*
+/// beyond the last one blended (EVER's 16 hits per trace, as `ever`'s default batch).
+pub const GAUSS_RAY_BATCH: u32 = 16;
+
 /// Side of the square image tiles of the splatting methods' lists, in pixels (3D Gaussian
 /// splatting's `BLOCK_X` = `BLOCK_Y` = 16, `cuda_rasterizer/config.h`).
 pub const TILE_SIDE: u32 = 16;

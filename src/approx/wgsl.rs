@@ -43,6 +43,7 @@ pub fn constants() -> Vec<WgslConst> {
         F32("SPLAT_ALPHA_MIN", SPLAT_ALPHA_MIN),
         F32("SPLAT_T_MIN", SPLAT_T_MIN),
         F32("GAUSSIAN_TRACE_SIGMAS", GAUSSIAN_TRACE_SIGMAS),
+        U32("GAUSS_RAY_BATCH", GAUSS_RAY_BATCH),
     ]
 }
 

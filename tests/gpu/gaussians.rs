@@ -377,3 +377,78 @@ fn pgt_approx_refuses_a_constant_density_scene_with_the_gaussian_methods_with_ex
         );
     }
 }
+
+#[test]
+fn gauss_ray_blends_many_hits_in_order_of_their_peaks_across_batches() {
+    if gpu().is_none() {
+        return;
+    }
+    // 40 overlapping Gaussians in a row along the view axis, more than one batch (16) per ray.
+    let ps: Vec<Particle> = (0..40)
+        .map(|i| {
+            let f = i as f64;
+            let shape = Ellipsoid::new(
+                DVec3::new(0.6 + 0.01 * f, 0.4, 0.3),
+                DQuat::from_rotation_z(0.3 * f),
+            );
+            let color = [(f * 0.37).fract(), (f * 0.61).fract(), (f * 0.13).fract()];
+            gaussian(
+                [0.05 * (f % 3.0), -0.04 * (f % 5.0), -4.0 + 0.2 * f],
+                Ok(shape),
+                color,
+                0.15,
+            )
+        })
+        .collect();
+    let s = gaussian_scene(ps.clone(), 32);
+    let image = render("gauss-ray", &s);
+    let bg = s.render.background;
+    let mut many = 0;
+    for py in 0..32 {
+        for px in 0..32 {
+            let ray = s.camera.pixel_ray(px, py);
+            let mut hits: Vec<(f64, usize, f64)> = Vec::new();
+            let mut near_cut = false;
+            for (i, p) in ps.iter().enumerate() {
+                let (t, m) = peak(p, &ray);
+                near_cut |= (m - 3.0).abs() < 1e-4;
+                if m < 3.0 {
+                    hits.push((t, i, (p_opacity(p) * (-0.5 * m * m).exp()).min(0.99)));
+                }
+            }
+            if near_cut {
+                continue;
+            }
+            hits.sort_by(|a, b| a.0.total_cmp(&b.0).then(a.1.cmp(&b.1)));
+            many += (hits.len() > 16) as usize;
+            let (mut l, mut t) = (DVec3::ZERO, 1.0);
+            for &(_, i, alpha) in &hits {
+                if t * (1.0 - alpha) < 1e-4 {
+                    break;
+                }
+                l += ps[i].color * alpha * t;
+                t *= 1.0 - alpha;
+            }
+            let want = l + t * bg;
+            let got = image.pixels[(py * 32 + px) as usize];
+            for k in 0..3 {
+                assert!(
+                    (got[k] as f64 - want[k]).abs() < 1e-4,
+                    "pixel ({px}, {py}) channel {k}: {} vs {} ({} hits)",
+                    got[k],
+                    want[k],
+                    hits.len()
+                );
+            }
+        }
+    }
+    assert!(many > 50, "{many} pixels with more than one batch of hits");
+}
+
+/// The splatting opacity o back from σ (docs/design.md §9): o = 1 − exp(−σ·s_min·√(2π)).
+fn p_opacity(p: &Particle) -> f64 {
+    let shortest = p
+        .ellipsoid
+        .map_or(p.radius, |e| e.semi_axes().min_element());
+    1.0 - (-p.sigma * shortest * SQRT_TAU).exp()
+}

@@ -8,10 +8,11 @@
 //! Mahalanobis distance at t*, t* clamped to t ≥ 0), o its splatting opacity
 //! 1 − exp(−σ·s_min·√(2π)) (docs/design.md §9). The hits are blended front to back in order
 //! of t*; the ray stops at the first hit that would take the transmittance below 1e-4 (not
-//! added; 3DGS's rule and constant, as `splat`). A ray keeps the `MAX_HITS` nearest hits by
-//! entry (an overflow is reported) and sorts them by t*, as `sorted-blend` sorts by centre
-//! depth (`shaders/gauss_ray.wgsl`). No α < 1/255 skip: every traced hit counts. Volume mode,
-//! emission model, Gaussian particles only; spheres and ellipsoids.
+//! added; 3DGS's rule and constant, as `splat`). They are taken a batch at a time, as `ever`
+//! takes its events: each batch is one BVH traversal that keeps the `GAUSS_RAY_BATCH` = 16
+//! nearest hits by (t*, particle index) beyond the last one blended (3DGRT's k nearest hits per
+//! trace), so no hit list overflows (`shaders/gauss_ray.wgsl`). No α < 1/255 skip: every traced
+//! hit counts. Volume mode, emission model, Gaussian particles only; spheres and ellipsoids.
 //!
 //! Parameters: none.
 //!
