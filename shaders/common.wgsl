@@ -8,10 +8,12 @@
 // their layout with naga.
 
 // The constants (MAX_HITS, STACK_SIZE, T_FAR, SIGMA_INFINITE, NO_PARTICLE, NO_ELLIPSOID, PI, the
-// light and falloff codes, LOOP_LIMIT, LOOP_LIMIT_REPORT, WORKGROUP_SIDE, PARAM_SLOTS), the
-// structs Particle, Ellipsoid, BvhNode, Light, Frame, Stats and the bindings frame, particles,
-// nodes, leaf_indices, lights, output, stats, ellipsoids are generated from src/approx/contract.rs and
-// src/approx/layout.rs and prepended to this file: their values and docs live there.
+// light and falloff codes, LOOP_LIMIT, LOOP_LIMIT_REPORT, WORKGROUP_SIDE, PARAM_SLOTS, the profile
+// codes, TILE_SIDE and the Gaussian methods' SPLAT_*, GAUSSIAN_TRACE_SIGMAS, GAUSS_RAY_BATCH),
+// the structs Particle, Ellipsoid, BvhNode, Light, Frame, Stats, Splat and the bindings frame,
+// particles, nodes, leaf_indices, lights, output, stats, ellipsoids, splats, tile_entries are
+// generated from src/approx/contract.rs and src/approx/layout.rs and prepended to this file:
+// their values and docs live there.
 
 // A method's parameter by slot; the slots are named by generated constants PARAM_<NAME>
 // (e.g. method_param(PARAM_SAMPLES)).
@@ -422,4 +424,52 @@ fn lit_opaque_surface(ray: Ray, index: u32, t0: f32, entering: bool) -> vec3<f32
         q = q + (rest * mu_l + p.color * mu_v) / (mu_l + mu_v);
     }
     return frame.light_weight * q;
+}
+
+// Gaussian particles (docs/design.md §9, §4 "splat", "gauss-ray"). The splatting methods read
+// `splats` and `tile_entries`, made on the CPU by src/approx/splat_tiles.rs: tile k's splats,
+// front to back by the centres' view depth, are tile_entries[tile_entries[2k] ..
+// tile_entries[2k + 1]].
+
+// The tile (row-major, TILE_SIDE pixels square) that holds a pixel.
+fn pixel_tile(pixel: vec2<u32>) -> u32 {
+    let columns = (frame.width + TILE_SIDE - 1u) / TILE_SIDE;
+    return (pixel.y / TILE_SIDE) * columns + pixel.x / TILE_SIDE;
+}
+
+// 3D Gaussian splatting's opacity of a splat at a pixel centre (its forward.cu renderCUDA):
+// α = min(SPLAT_ALPHA_MAX, o·exp(−½ dᵀΣ₂D⁻¹d)), d the offset from the projected centre; 0
+// where the quadratic form is negative (rounding), as 3DGS skips it.
+fn splat_alpha(s: Splat, pixel: vec2<u32>) -> f32 {
+    let d = vec2<f32>(s.mean_x, s.mean_y) - (vec2<f32>(pixel) + vec2<f32>(0.5));
+    let power = -0.5 * (s.conic_a * d.x * d.x + s.conic_c * d.y * d.y) - s.conic_b * d.x * d.y;
+    if (power > 0.0) {
+        return 0.0;
+    }
+    return min(SPLAT_ALPHA_MAX, s.opacity * exp(power));
+}
+
+// A Gaussian's maximum response along a ray, for a shape widened to `widened` standard
+// deviations (gauss-ray traces its 3-σ ellipsoids): t* the closest approach in the Mahalanobis
+// metric, clamped to the ray (t ≥ 0), and m the Mahalanobis distance there, in standard
+// deviations. The mapped ray is u(t) = M(o − c) + t·Md (docs/design.md §9).
+struct GaussianPeak {
+    t_star: f32,
+    m: f32,
+}
+
+fn gaussian_peak(ray: Ray, p: Particle, widened: f32) -> GaussianPeak {
+    var u0 = (ray.origin - p.center) / p.radius;
+    var v = ray.direction / p.radius;
+    if (HAS_ELLIPSOIDS && p.ellipsoid != NO_ELLIPSOID) {
+        let e = ellipsoids[p.ellipsoid];
+        u0 = ellipsoid_to_unit(e, ray.origin - p.center);
+        v = ellipsoid_to_unit(e, ray.direction);
+    }
+    let vv = dot(v, v);
+    var t_star = 0.0;
+    if (vv > 0.0) {
+        t_star = max(-dot(u0, v) / vv, 0.0);
+    }
+    return GaussianPeak(t_star, widened * length(u0 + t_star * v));
 }

@@ -61,6 +61,32 @@ pub const EVER_MAX_BATCH: u32 = 64;
 /// `Particle.ellipsoid` of a sphere: no entry in `ellipsoids`.
 pub const NO_ELLIPSOID: u32 = u32::MAX;
 
+/// `Particle.profile` (docs/design.md §9): constant density σ inside the shape.
+pub const PROFILE_CONSTANT: u32 = 0;
+/// `Particle.profile`: Gaussian density σ·exp(−½m²), the shape's axes its standard deviations.
+pub const PROFILE_GAUSSIAN: u32 = 1;
+
+/// The most opacity one splat gives a pixel (3D Gaussian splatting, `forward.cu` `renderCUDA`:
+/// `min(0.99f, con_o.w * exp(power))`; also `gauss-ray`'s, as 3DGRT keeps it).
+pub const SPLAT_ALPHA_MAX: f32 = 0.99;
+/// A splat whose opacity at a pixel is below this is skipped (3DGS `renderCUDA`:
+/// `alpha < 1.0f / 255.0f`).
+pub const SPLAT_ALPHA_MIN: f32 = 1.0 / 255.0;
+/// A pixel stops at the first splat that would take its transmittance below this; that splat
+/// is not added (3DGS `renderCUDA`: `test_T < 0.0001f`, tested before the colour is added).
+pub const SPLAT_T_MIN: f32 = 1.0e-4;
+/// The standard deviations at which `gauss-ray` cuts each Gaussian: it traces the 3-σ
+/// ellipsoids (3DGRT's bounding primitives; 3DGS's footprint radius is also 3σ).
+pub const GAUSSIAN_TRACE_SIGMAS: f32 = 3.0;
+
+/// Hits per BVH traversal of `gauss-ray`: each traversal keeps the nearest this many by t*
+/// beyond the last one blended (EVER's 16 hits per trace, as `ever`'s default batch).
+pub const GAUSS_RAY_BATCH: u32 = 16;
+
+/// Side of the square image tiles of the splatting methods' lists, in pixels (3D Gaussian
+/// splatting's `BLOCK_X` = `BLOCK_Y` = 16, `cuda_rasterizer/config.h`).
+pub const TILE_SIDE: u32 = 16;
+
 /// The pipeline-overridable constant (WGSL `override`, default true) that says whether the scene
 /// has ellipsoids. pgt compiles each method twice as needed: with false for a scene of spheres,
 /// so that the shape test folds away and sphere scenes run the sphere code alone (a branch that
@@ -105,8 +131,15 @@ pub const BINDING_STATS: u32 = 6;
 /// `Particle.ellipsoid`.
 pub const BINDING_ELLIPSOIDS: u32 = 7;
 
+/// `splats` ([`GpuSplat`](super::layout::GpuSplat)): the splatting methods' projected
+/// Gaussians in order of view depth (one zeroed element for the other methods).
+pub const BINDING_SPLATS: u32 = 8;
+/// `tile_entries` (u32): per tile its range in this array, then the tiles' lists of splats
+/// (`approx::splat_tiles::build`).
+pub const BINDING_TILE_ENTRIES: u32 = 9;
+
 /// Every binding of group 0, in index order (the pipeline layout and the WGSL come from this).
-pub const BINDINGS: [Binding; 8] = [
+pub const BINDINGS: [Binding; 10] = [
     Binding {
         index: BINDING_FRAME,
         name: "frame",
@@ -154,6 +187,18 @@ pub const BINDINGS: [Binding; 8] = [
         name: "ellipsoids",
         kind: BindingKind::StorageRead,
         wgsl_type: "array<Ellipsoid>",
+    },
+    Binding {
+        index: BINDING_SPLATS,
+        name: "splats",
+        kind: BindingKind::StorageRead,
+        wgsl_type: "array<Splat>",
+    },
+    Binding {
+        index: BINDING_TILE_ENTRIES,
+        name: "tile_entries",
+        kind: BindingKind::StorageRead,
+        wgsl_type: "array<u32>",
     },
 ];
 

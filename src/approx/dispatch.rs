@@ -9,7 +9,7 @@ use super::contract::{
     BindingKind, BINDINGS, LOOP_BUDGET, OVERRIDE_HAS_ELLIPSOIDS, WORKGROUP_SIDE,
 };
 use super::layout::{
-    GpuBvhNode, GpuEllipsoid, GpuFrame, GpuLight, GpuParticle, GpuStats, SceneBuffers,
+    GpuBvhNode, GpuEllipsoid, GpuFrame, GpuLight, GpuParticle, GpuSplat, GpuStats, SceneBuffers,
 };
 use super::shader::{ShaderProgram, ENTRY_POINT};
 use crate::error::{PgtError, Result};
@@ -310,6 +310,8 @@ struct SceneOnGpu {
     indices: wgpu::Buffer,
     lights: wgpu::Buffer,
     stats: wgpu::Buffer,
+    splats: wgpu::Buffer,
+    tile_entries: wgpu::Buffer,
 }
 
 /// One band of rows of the image: its frame uniform, its part of the output, the bind group
@@ -349,7 +351,7 @@ impl Band {
             U::STORAGE | U::COPY_SRC | U::COPY_DST,
         );
         // In BINDINGS order: frame, particles, nodes, leaf_indices, lights, output, stats,
-        // ellipsoids.
+        // ellipsoids, splats, tile_entries.
         let resources = [
             &frame_buf,
             &scene.particles,
@@ -359,6 +361,8 @@ impl Band {
             &output,
             &scene.stats,
             &scene.ellipsoids,
+            &scene.splats,
+            &scene.tile_entries,
         ];
         let entries: Vec<wgpu::BindGroupEntry> = BINDINGS
             .iter()
@@ -435,6 +439,8 @@ impl Upload {
                 ("BVH node", bytes::<GpuBvhNode>(scene.nodes.len())),
                 ("BVH index", bytes::<u32>(scene.leaf_indices.len())),
                 ("light", bytes::<GpuLight>(scene.lights.len())),
+                ("splat", bytes::<GpuSplat>(scene.splats.len())),
+                ("tile list", bytes::<u32>(scene.tile_entries.len())),
             ],
         )?;
         let rows = bands(frame.width, frame.height, limit)?;
@@ -457,6 +463,8 @@ impl Upload {
                 nodes: storage(ctx, "pgt bvh nodes", &scene.nodes),
                 indices: storage(ctx, "pgt bvh indices", &scene.leaf_indices),
                 lights: storage(ctx, "pgt lights", &scene.lights),
+                splats: storage(ctx, "pgt splats", &scene.splats),
+                tile_entries: storage(ctx, "pgt tile entries", &scene.tile_entries),
                 stats: buffer(
                     ctx,
                     "pgt stats",

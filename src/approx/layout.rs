@@ -12,10 +12,10 @@
 
 use super::contract::{
     FALLOFF_INVERSE_SQUARE, FALLOFF_NONE, LIGHT_DIRECTIONAL, LIGHT_POINT, NO_ELLIPSOID,
-    PARAM_SLOTS, SIGMA_INFINITE,
+    PARAM_SLOTS, PROFILE_CONSTANT, PROFILE_GAUSSIAN, SIGMA_INFINITE,
 };
 use crate::geometry::{Bvh, Ellipsoid};
-use crate::scene::{Falloff, Light, Scene};
+use crate::scene::{Falloff, Light, Particle, Profile, Scene};
 use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
 
@@ -92,8 +92,14 @@ gpu_struct! {
         /// The shape (docs/design.md §9): [`NO_ELLIPSOID`] for a sphere of `radius`, else the
         /// index of its [`GpuEllipsoid`] in `ellipsoids` (`radius` is then the bounding radius).
         pub ellipsoid: u32,
-        pub _pad1: f32,
-        pub _pad2: f32,
+        /// The density profile (docs/design.md §9): [`PROFILE_CONSTANT`] or
+        /// [`PROFILE_GAUSSIAN`] (`radius` or the ellipsoid's semi-axes are then standard
+        /// deviations and `sigma` the peak density).
+        pub profile: u32,
+        /// A Gaussian's splatting opacity o = 1 − exp(−σ·s_min·√(2π)), s_min its shortest
+        /// standard deviation (docs/design.md §9, "The opacity of a Gaussian"; computed in
+        /// f64): what a splatting method blends. 0 for constant density.
+        pub opacity: f32,
     }
 }
 
@@ -206,6 +212,26 @@ gpu_struct! {
 const _: () = assert!(std::mem::size_of::<[[u32; 4]; 2]>() / 4 == PARAM_SLOTS);
 
 gpu_struct! {
+    /// WGSL `struct Splat`, 32 bytes: one Gaussian projected to the image by the splatting
+    /// methods' preprocessing ([`super::splat_tiles`], docs/design.md §4 `splat`).
+    plain "Splat" pub struct GpuSplat {
+        /// Centre on the image, pixels (pixel centres at +0.5, y down).
+        pub mean_x: f32,
+        pub mean_y: f32,
+        /// The conic Σ₂D⁻¹ = [[a, b], [b, c]] of the dilated 2D covariance, 1/px².
+        pub conic_a: f32,
+        pub conic_b: f32,
+        pub conic_c: f32,
+        /// The particle's splatting opacity o (`Particle.opacity`).
+        pub opacity: f32,
+        /// View depth of the centre.
+        pub depth: f32,
+        /// Index of the particle in `particles`.
+        pub particle: u32,
+    }
+}
+
+gpu_struct! {
     /// WGSL `struct Stats`: counters the shaders raise (atomics).
     atomic "Stats" pub struct GpuStats {
         /// Hit lists that were full: the farthest hits were dropped (see `MAX_HITS`).
@@ -231,6 +257,11 @@ pub struct SceneBuffers {
     pub lights: Vec<GpuLight>,
     /// Depth of the BVH (root = 1), checked against the shader's traversal stack.
     pub bvh_depth: u32,
+    /// The splatting methods' projected Gaussians ([`super::splat_tiles::build`]); empty for
+    /// the other methods.
+    pub splats: Vec<GpuSplat>,
+    /// The splatting methods' tile lists ([`super::splat_tiles::build`]); empty otherwise.
+    pub tile_entries: Vec<u32>,
 }
 
 fn rel(v: DVec3, origin: DVec3) -> [f32; 3] {
@@ -281,7 +312,14 @@ impl SceneBuffers {
                 albedo: p.albedo.as_vec3().to_array(),
                 ks: p.ks as f32,
                 shininess: p.shininess as f32,
-                ..GpuParticle::default()
+                profile: match p.profile {
+                    Profile::Constant => PROFILE_CONSTANT,
+                    Profile::Gaussian => PROFILE_GAUSSIAN,
+                },
+                opacity: match p.profile {
+                    Profile::Constant => 0.0,
+                    Profile::Gaussian => gaussian_opacity(p) as f32,
+                },
             })
             .collect();
         let nodes = bvh
@@ -337,8 +375,59 @@ impl SceneBuffers {
             leaf_indices: bvh.indices.clone(),
             lights,
             bvh_depth: bvh_depth(bvh),
+            splats: Vec::new(),
+            tile_entries: Vec::new(),
         }
     }
+
+    /// Widens every Gaussian particle's shape to `k` standard deviations (radius·k, the
+    /// ellipsoid's map M/k and semi-axes·k): what `gauss-ray` traces (its BVH is built over the
+    /// same widened shapes, [`widened_gaussians`]).
+    pub fn widen_gaussians(&mut self, k: f64) {
+        let k32 = k as f32;
+        for p in &mut self.particles {
+            if p.profile != PROFILE_GAUSSIAN {
+                continue;
+            }
+            p.radius *= k32;
+            if let Some(e) = self.ellipsoids.get_mut(p.ellipsoid as usize) {
+                for (row, semi) in [
+                    (&mut e.row_x, &mut e.semi_x),
+                    (&mut e.row_y, &mut e.semi_y),
+                    (&mut e.row_z, &mut e.semi_z),
+                ] {
+                    *row = row.map(|v| v / k32);
+                    *semi *= k32;
+                }
+            }
+        }
+    }
+}
+
+/// A Gaussian particle's splatting opacity o = 1 − exp(−σ·s_min·√(2π)) (docs/design.md §9,
+/// the inverse of [`crate::optics::gaussian::sigma_from_peak_opacity`]); σ = +∞ gives 1.
+pub fn gaussian_opacity(p: &Particle) -> f64 {
+    let shortest = p
+        .ellipsoid
+        .as_ref()
+        .map_or(p.radius, |e| e.shortest_semi_axis());
+    -(-p.sigma * shortest * (2.0 * std::f64::consts::PI).sqrt()).exp_m1()
+}
+
+/// The scene with every Gaussian particle's shape widened to `k` standard deviations (radius
+/// and semi-axes times k), for the BVH of a method that traces the Gaussians' k-σ ellipsoids.
+pub fn widened_gaussians(scene: &Scene, k: f64) -> Scene {
+    let mut out = scene.clone();
+    for p in &mut out.particles {
+        if p.profile != Profile::Gaussian {
+            continue;
+        }
+        p.radius *= k;
+        if let Some(e) = &p.ellipsoid {
+            p.ellipsoid = Some(Ellipsoid::new(e.semi_axes() * k, e.rotation()));
+        }
+    }
+    out
 }
 
 /// Depth of the tree (a lone root is 1), by an explicit stack: no recursion on deep trees.

@@ -11,6 +11,8 @@
 //! * [`params`]: parameter specs, the chosen method and its parameter values.
 //! * [`user_shader`]: users' own methods (docs/user-shaders.md).
 //! * [`dispatch`]: pipeline, upload, pass schedule, read-back, timing.
+//! * [`splat_tiles`]: the splatting methods' projection and tile lists (CPU, before the
+//!   dispatch).
 //!
 //! [`render_approx`] is the library entry point that `pgt approx` and `pgt sweep` share;
 //! [`ApproxPipeline`] keeps a compiled method for many renders.
@@ -23,6 +25,7 @@ pub mod methods;
 pub mod param_spec;
 pub mod params;
 pub mod shader;
+pub mod splat_tiles;
 pub mod user_shader;
 pub mod wgsl;
 
@@ -194,8 +197,15 @@ impl ApproxPipeline {
                 self.names
             )));
         }
-        let bvh = scene.build_bvh();
-        let buffers = layout::SceneBuffers::new(scene, &bvh);
+        let prep = self.method.preparation();
+        let bvh = match prep.traced_sigmas {
+            Some(k) => layout::widened_gaussians(scene, k).build_bvh(),
+            None => scene.build_bvh(),
+        };
+        let mut buffers = layout::SceneBuffers::new(scene, &bvh);
+        if let Some(k) = prep.traced_sigmas {
+            buffers.widen_gaussians(k);
+        }
         if buffers.bvh_depth > STACK_DEPTH {
             return Err(PgtError::Gpu(format!(
                 "the BVH is {} levels deep, the shaders' traversal stack holds {STACK_DEPTH}",
@@ -204,12 +214,21 @@ impl ApproxPipeline {
         }
         let slots: Vec<u32> = values.iter().map(|(_, v)| *v).collect();
         let frame = layout::GpuFrame::new(scene, &slots);
+        // The splatting methods' projection and tile lists, on the CPU: their time counts in
+        // the method's (it is 3DGS's preprocessing and sorting pass).
+        let prepare_seconds = if prep.splat_tiles {
+            let t = std::time::Instant::now();
+            splat_tiles::build(&mut buffers, &frame);
+            t.elapsed().as_secs_f64()
+        } else {
+            0.0
+        };
         let limit = dispatch::storage_limit(ctx);
         let out =
             dispatch::run_with_progress(ctx, &self.pipeline, &buffers, &frame, limit, progress)?;
         Ok(ApproxOutput {
             image: out.image,
-            gpu_seconds: out.gpu_seconds,
+            gpu_seconds: out.gpu_seconds + prepare_seconds,
             timing: out.timing,
             adapter_name: ctx.adapter.name.clone(),
             method: self.method.clone(),

@@ -87,9 +87,17 @@ impl Method {
     pub fn check_scene(&self, scene: &Scene) -> Result<()> {
         match self {
             Method::Builtin(m) => m.check_scene(scene),
-            // A user shader sees no density profile in its buffers, so it is given only
-            // constant-density scenes.
+            // A user shader is given only constant-density scenes (docs/user-shaders.md does
+            // not describe `Particle.profile`).
             Method::User(_) => super::methods::check_profile("user-shader", false, scene),
+        }
+    }
+
+    /// What it needs made on the CPU before the dispatch (a user shader: nothing).
+    pub fn preparation(&self) -> super::methods::Preparation {
+        match self {
+            Method::Builtin(m) => m.preparation(),
+            Method::User(_) => super::methods::Preparation::default(),
         }
     }
 

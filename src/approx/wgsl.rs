@@ -5,7 +5,7 @@
 
 use super::contract::*;
 use super::layout::{
-    GpuBvhNode, GpuEllipsoid, GpuFrame, GpuLight, GpuParticle, GpuStats, WgslStruct,
+    GpuBvhNode, GpuEllipsoid, GpuFrame, GpuLight, GpuParticle, GpuSplat, GpuStats, WgslStruct,
 };
 use std::fmt::Write as _;
 
@@ -36,6 +36,14 @@ pub fn constants() -> Vec<WgslConst> {
         U32("WORKGROUP_SIDE", WORKGROUP_SIDE),
         U32("PARAM_SLOTS", PARAM_SLOTS as u32),
         U32("EVER_MAX_BATCH", EVER_MAX_BATCH),
+        U32("PROFILE_CONSTANT", PROFILE_CONSTANT),
+        U32("PROFILE_GAUSSIAN", PROFILE_GAUSSIAN),
+        U32("TILE_SIDE", TILE_SIDE),
+        F32("SPLAT_ALPHA_MAX", SPLAT_ALPHA_MAX),
+        F32("SPLAT_ALPHA_MIN", SPLAT_ALPHA_MIN),
+        F32("SPLAT_T_MIN", SPLAT_T_MIN),
+        F32("GAUSSIAN_TRACE_SIGMAS", GAUSSIAN_TRACE_SIGMAS),
+        U32("GAUSS_RAY_BATCH", GAUSS_RAY_BATCH),
     ]
 }
 
@@ -83,6 +91,7 @@ pub fn wgsl_declarations() -> String {
     struct_declaration::<GpuLight>(&mut out);
     struct_declaration::<GpuFrame>(&mut out);
     struct_declaration::<GpuStats>(&mut out);
+    struct_declaration::<GpuSplat>(&mut out);
     for b in BINDINGS {
         let space = match b.kind {
             BindingKind::Uniform => "uniform",

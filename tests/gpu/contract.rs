@@ -73,6 +73,7 @@ fn repetitions(text: &str) -> Vec<String> {
         "Light",
         "Frame",
         "Stats",
+        "Splat",
     ] {
         if code.contains(&format!("struct {name} ")) || code.contains(&format!("struct {name}{{")) {
             found.push(format!("declares struct {name}"));

@@ -4,7 +4,9 @@
 //! Rust's. naga computes the WGSL layout; this compares every named member's offset and every
 //! struct's size with `offset_of!` and `size_of`. No GPU needed.
 
-use pgt::approx::layout::{GpuBvhNode, GpuEllipsoid, GpuFrame, GpuLight, GpuParticle, GpuStats};
+use pgt::approx::layout::{
+    GpuBvhNode, GpuEllipsoid, GpuFrame, GpuLight, GpuParticle, GpuSplat, GpuStats,
+};
 use pgt::approx::shader::prelude_source;
 use std::mem::{offset_of, size_of};
 
@@ -60,6 +62,8 @@ fn particle_members() -> Vec<(&'static str, usize)> {
         ("ks", offset_of!(GpuParticle, ks)),
         ("shininess", offset_of!(GpuParticle, shininess)),
         ("ellipsoid", offset_of!(GpuParticle, ellipsoid)),
+        ("profile", offset_of!(GpuParticle, profile)),
+        ("opacity", offset_of!(GpuParticle, opacity)),
     ]
 }
 
@@ -134,6 +138,21 @@ fn rust_and_wgsl_struct_layouts_agree() {
     );
     check(
         &module,
+        "Splat",
+        size_of::<GpuSplat>(),
+        &[
+            ("mean_x", offset_of!(GpuSplat, mean_x)),
+            ("mean_y", offset_of!(GpuSplat, mean_y)),
+            ("conic_a", offset_of!(GpuSplat, conic_a)),
+            ("conic_b", offset_of!(GpuSplat, conic_b)),
+            ("conic_c", offset_of!(GpuSplat, conic_c)),
+            ("opacity", offset_of!(GpuSplat, opacity)),
+            ("depth", offset_of!(GpuSplat, depth)),
+            ("particle", offset_of!(GpuSplat, particle)),
+        ],
+    );
+    check(
+        &module,
         "Stats",
         size_of::<GpuStats>(),
         &[
@@ -150,12 +169,12 @@ fn rust_and_wgsl_struct_layouts_agree() {
 
 #[test]
 fn the_check_catches_a_shifted_member() {
-    // The subtle mismatch: padding moved in front of `ellipsoid`. Same size, same member order,
-    // only one offset differs (56 instead of 52); the check must still fail.
+    // The subtle mismatch: `profile` moved in front of `ellipsoid`. Same size, same types, two
+    // u32 members swapped (52 and 56); the check must still fail.
     let prelude = prelude_source();
     let wrong = prelude.replace(
-        "    ellipsoid: u32,\n    _pad1: f32,",
-        "    _pad1: f32,\n    ellipsoid: u32,",
+        "    ellipsoid: u32,\n    profile: u32,",
+        "    profile: u32,\n    ellipsoid: u32,",
     );
     assert_ne!(wrong, prelude, "the replacement must apply");
     let module = naga::front::wgsl::parse_str(&wrong).expect("still valid WGSL");

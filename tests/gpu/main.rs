@@ -11,6 +11,7 @@ mod bands;
 mod cli;
 mod contract;
 mod ellipsoids;
+mod gaussians;
 mod layout;
 mod methods;
 mod raster;

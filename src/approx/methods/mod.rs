@@ -40,6 +40,17 @@ impl Computes {
     }
 }
 
+/// What a method needs made on the CPU before its dispatch (the default: nothing).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct Preparation {
+    /// The Gaussian particles' shapes widened to this many standard deviations, both in the
+    /// BVH and in the shapes the shader intersects (`gauss-ray`: its 3-σ ellipsoids).
+    pub traced_sigmas: Option<f64>,
+    /// The splat lists (`approx::splat_tiles`): each Gaussian projected to the image and
+    /// binned into tiles, in `splats` and `tile_entries`.
+    pub splat_tiles: bool,
+}
+
 /// An approximation method: a WGSL `shade` function and what it needs.
 pub trait ApproxMethod: Sync {
     /// The name on the command line and in sweeps (`--method NAME`).
@@ -60,6 +71,10 @@ pub trait ApproxMethod: Sync {
     /// not is given only constant-density scenes.
     fn draws_gaussians(&self) -> bool {
         false
+    }
+    /// What it needs made on the CPU before the dispatch ([`Preparation`]).
+    fn preparation(&self) -> Preparation {
+        Preparation::default()
     }
     /// Refuses scenes the method does not compute ([`check_computes`], [`check_profile`]) or has
     /// no meaning for, with a message that says what to do.
@@ -87,6 +102,35 @@ pub fn check_profile(name: &str, draws_gaussians: bool, scene: &Scene) -> Result
     };
     Err(PgtError::Usage(format!(
         "the {name} method draws particles of constant density; this scene has Gaussian particles (density = \"gaussian\", docs/design.md §9): {instead}"
+    )))
+}
+
+/// The refusal of constant-density particles by a method that draws Gaussians only (the
+/// splatting and Gaussian ray-tracing methods: a constant-density particle has no splat),
+/// naming the methods that draw them.
+pub fn check_gaussians_only(name: &str, scene: &Scene) -> Result<()> {
+    let constant = scene
+        .particles
+        .iter()
+        .filter(|p| p.profile == crate::scene::Profile::Constant)
+        .count();
+    if constant == 0 {
+        return Ok(());
+    }
+    let others: Vec<&str> = METHODS
+        .iter()
+        .filter(|m| {
+            !m.draws_gaussians() && m.computes().covers(scene.render.mode, scene.render.model)
+        })
+        .map(|m| m.name())
+        .collect();
+    Err(PgtError::Usage(format!(
+        "the {name} method draws particles of Gaussian density only (docs/design.md §9); this scene has {constant} particles of constant density: use a method that draws constant density{}",
+        if others.is_empty() {
+            String::new()
+        } else {
+            format!(" ({})", others.join(", "))
+        }
     )))
 }
 
@@ -158,6 +202,9 @@ registry! {
     thesis::Thesis,
     sorted_blend::SortedBlend,
     ever::Ever,
+    splat::Splat,
+    splat_pixel_sort::SplatPixelSort,
+    gauss_ray::GaussRay,
 }
 
 /// The registered method called `name`.
@@ -244,8 +291,16 @@ mod tests {
                 };
                 let scene =
                     Scene::from_toml_str(text, std::path::Path::new("s.toml"), &options).unwrap();
+                // The methods that draw Gaussians get the same particle of Gaussian density.
+                let mut gaussian = scene.clone();
+                gaussian.particles[0].profile = crate::scene::Profile::Gaussian;
                 for m in METHODS {
-                    let r = m.check_scene(&scene);
+                    let scene = if m.draws_gaussians() {
+                        &gaussian
+                    } else {
+                        &scene
+                    };
+                    let r = m.check_scene(scene);
                     if m.computes().covers(mode, model) {
                         assert!(
                             r.is_ok(),

@@ -1,0 +1,292 @@
+//! The splatting methods' preprocessing (docs/design.md §4, `splat`): each Gaussian projected to
+//! a 2D Gaussian on the image (EWA), its footprint binned into 16×16-pixel tiles, and one list
+//! per tile in order of the centres' view depth. This is the forward model of the reference 3D
+//! Gaussian splatting rasteriser (graphdeco-inria `diff-gaussian-rasterization`,
+//! `cuda_rasterizer/forward.cu` `preprocessCUDA` and `computeCov2D`, `auxiliary.h` `getRect`,
+//! `rasterizer_impl.cu` `duplicateWithKeys`, `identifyTileRanges`), computed here **on the CPU
+//! in f32** before the dispatch, because pgt's dispatch runs one per-pixel pass and has no
+//! place for a preprocessing pass; its time is counted in the method's time
+//! ([`crate::approx::ApproxOutput::gpu_seconds`]). The per-pixel blending is the shader's
+//! (`shaders/splat.wgsl`).
+//!
+//! Every constant is 3DGS's:
+//!
+//! | constant | value | where in 3DGS |
+//! |---|---|---|
+//! | [`NEAR_CULL`] | 0.2 | `auxiliary.h` `in_frustum`: `p_view.z <= 0.2f` culls |
+//! | [`JACOBIAN_CLAMP`] | 1.3 | `forward.cu` `computeCov2D`: `limx = 1.3f * tan_fovx` |
+//! | [`DILATION`] | 0.3 px² | `forward.cu` `computeCov2D`: `cov[0][0] += 0.3f` (low-pass filter) |
+//! | [`EIGEN_FLOOR`] | 0.1 | `forward.cu` `preprocessCUDA`: `sqrt(max(0.1f, mid * mid - det))` |
+//! | [`FOOTPRINT_SIGMAS`] | 3 | `forward.cu` `preprocessCUDA`: `ceil(3.f * sqrt(max(lambda1, lambda2)))` |
+//! | `TILE_SIDE` | 16 | `config.h` `BLOCK_X`, `BLOCK_Y` |
+//!
+//! Pixel coordinates: pgt's (docs/design.md §1), pixel (px, py) has its centre at
+//! (px + 0.5, py + 0.5), y down. 3DGS's `ndc2Pix` puts pixel centres at integers; its `getRect`
+//! is applied here to the same point in its coordinates (x − 0.5), so a splat touches the same
+//! tiles as in 3DGS.
+
+use super::contract::{PROFILE_GAUSSIAN, TILE_SIDE};
+use super::layout::{GpuFrame, GpuSplat, SceneBuffers};
+use glam::{Mat3, Vec3};
+
+/// Centres at view depth ≤ this (scene units) are culled (3DGS `in_frustum`).
+pub const NEAR_CULL: f32 = 0.2;
+/// The centre's x/z and y/z are clamped to this many times the tangent of the half field of
+/// view before the Jacobian is taken (3DGS `computeCov2D`).
+pub const JACOBIAN_CLAMP: f32 = 1.3;
+/// Added to the diagonal of the 2D covariance, px² (3DGS `computeCov2D`'s low-pass filter).
+pub const DILATION: f32 = 0.3;
+/// Floor of the discriminant in the 2D covariance's eigenvalues (3DGS `preprocessCUDA`).
+pub const EIGEN_FLOOR: f32 = 0.1;
+/// The footprint's radius in standard deviations of the 2D covariance's major axis.
+pub const FOOTPRINT_SIGMAS: f32 = 3.0;
+
+/// A Gaussian projected to the image: its 2D mean (pgt pixel coordinates), the inverse of its
+/// dilated 2D covariance (the conic), its view depth and the tiles its footprint touches.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Projected {
+    /// Centre on the image, pixel centres at +0.5.
+    pub mean: [f32; 2],
+    /// (a, b, c) of the conic Σ₂D⁻¹ = [[a, b], [b, c]].
+    pub conic: [f32; 3],
+    /// The dilated 2D covariance (xx, xy, yy), px².
+    pub cov: [f32; 3],
+    /// View depth of the centre, dot(centre − eye, forward).
+    pub depth: f32,
+    /// Footprint radius, px: ⌈3·√λ_max⌉.
+    pub radius: f32,
+    /// Tiles [min, max) in x and y.
+    pub tiles_x: (u32, u32),
+    pub tiles_y: (u32, u32),
+}
+
+/// The image's tile grid: columns and rows of `TILE_SIDE`-pixel tiles.
+pub fn tile_grid(width: u32, height: u32) -> (u32, u32) {
+    (width.div_ceil(TILE_SIDE), height.div_ceil(TILE_SIDE))
+}
+
+/// The 3D covariance Σ = R·S²·Rᵀ of particle `i` (f32, camera axes as the scene's): a sphere's
+/// r²·I, an ellipsoid's Σⱼ sⱼ²·aⱼaⱼᵀ with aⱼ = sⱼ·rowⱼ its unit axis (rowⱼ = row j of M).
+fn covariance(buffers: &SceneBuffers, i: usize) -> Mat3 {
+    let p = &buffers.particles[i];
+    match buffers.ellipsoids.get(p.ellipsoid as usize) {
+        None => Mat3::from_diagonal(Vec3::splat(p.radius * p.radius)),
+        Some(e) => {
+            let mut sigma = Mat3::ZERO;
+            for (row, s) in [
+                (e.row_x, e.semi_x),
+                (e.row_y, e.semi_y),
+                (e.row_z, e.semi_z),
+            ] {
+                let axis = Vec3::from(row) * s;
+                let s2 = s * s;
+                sigma += Mat3::from_cols(axis * axis.x, axis * axis.y, axis * axis.z) * s2;
+            }
+            sigma
+        }
+    }
+}
+
+/// Projects particle `i` as 3DGS's `preprocessCUDA` does; `None` where 3DGS drops it (near
+/// culling, a singular covariance, a footprint that touches no tile).
+pub fn project(buffers: &SceneBuffers, frame: &GpuFrame, i: usize) -> Option<Projected> {
+    let p = &buffers.particles[i];
+    let c = Vec3::from(p.center);
+    // View axes as 3DGS's (x right, y down, z forward): W has the rows r, −u, f.
+    let (right, down, forward) = (
+        Vec3::from(frame.right),
+        -Vec3::from(frame.up),
+        Vec3::from(frame.forward),
+    );
+    let t = Vec3::new(c.dot(right), c.dot(down), c.dot(forward));
+    if t.z <= NEAR_CULL {
+        return None;
+    }
+    let (w, h) = (frame.width as f32, frame.height as f32);
+    let tan_fovy = frame.tan_half_fov;
+    let tan_fovx = tan_fovy * w / h;
+    // 3DGS `fov2focal`: focal = pixels / (2·tan(fov/2)); fx = fy for square pixels.
+    let focal_x = w / (2.0 * tan_fovx);
+    let focal_y = h / (2.0 * tan_fovy);
+    // The Jacobian of the perspective projection at the (clamped) centre.
+    let lim_x = JACOBIAN_CLAMP * tan_fovx;
+    let lim_y = JACOBIAN_CLAMP * tan_fovy;
+    let tx = (t.x / t.z).clamp(-lim_x, lim_x) * t.z;
+    let ty = (t.y / t.z).clamp(-lim_y, lim_y) * t.z;
+    let j0 = Vec3::new(focal_x / t.z, 0.0, -(focal_x * tx) / (t.z * t.z));
+    let j1 = Vec3::new(0.0, focal_y / t.z, -(focal_y * ty) / (t.z * t.z));
+    // Rows of T = J·W in scene axes (Wᵀ·j: W's rows are r, −u, f); Σ₂D = T·Σ·Tᵀ.
+    let t0 = right * j0.x + down * j0.y + forward * j0.z;
+    let t1 = right * j1.x + down * j1.y + forward * j1.z;
+    let sigma = covariance(buffers, i);
+    let (s_t0, s_t1) = (sigma * t0, sigma * t1);
+    let a = t0.dot(s_t0) + DILATION;
+    let b = t0.dot(s_t1);
+    let cc = t1.dot(s_t1) + DILATION;
+    let det = a * cc - b * b;
+    if det == 0.0 {
+        return None;
+    }
+    let det_inv = 1.0 / det;
+    let conic = [cc * det_inv, -b * det_inv, a * det_inv];
+    let mid = 0.5 * (a + cc);
+    let root = (mid * mid - det).max(EIGEN_FLOOR).sqrt();
+    let radius = (FOOTPRINT_SIGMAS * (mid + root).max(mid - root).sqrt()).ceil();
+    // The mean, pixel centres at +0.5 (docs/design.md §1).
+    let mean = [focal_x * t.x / t.z + 0.5 * w, focal_y * t.y / t.z + 0.5 * h];
+    // 3DGS `getRect` on its pixel coordinates (centres at integers: x − 0.5), truncating.
+    let (cols, rows) = tile_grid(frame.width, frame.height);
+    let side = TILE_SIDE as f32;
+    let rect = |centre: f32, grid: u32| {
+        let lo = (((centre - radius) / side) as i64).clamp(0, grid as i64) as u32;
+        let hi = (((centre + radius + side - 1.0) / side) as i64).clamp(0, grid as i64) as u32;
+        (lo, hi)
+    };
+    let tiles_x = rect(mean[0] - 0.5, cols);
+    let tiles_y = rect(mean[1] - 0.5, rows);
+    if (tiles_x.1 - tiles_x.0) * (tiles_y.1 - tiles_y.0) == 0 {
+        return None;
+    }
+    Some(Projected {
+        mean,
+        conic,
+        cov: [a, b, cc],
+        depth: t.z,
+        radius,
+        tiles_x,
+        tiles_y,
+    })
+}
+
+/// The splat lists of a scene: [`SceneBuffers::splats`], the projected Gaussians in order of
+/// view depth (ties: particle index; 3DGS sorts the keys (tile, depth) with a stable radix sort
+/// of the Gaussians in index order), and [`SceneBuffers::tile_entries`]: for tile k (row-major)
+/// the range `[tile_entries[2k], tile_entries[2k + 1])` of `tile_entries` that lists its splats
+/// front to back. Particles of constant density are left out (the methods refuse them).
+pub fn build(buffers: &mut SceneBuffers, frame: &GpuFrame) {
+    let mut projected: Vec<(u32, Projected)> = (0..buffers.particles.len())
+        .filter(|&i| buffers.particles[i].profile == PROFILE_GAUSSIAN)
+        .filter_map(|i| project(buffers, frame, i).map(|p| (i as u32, p)))
+        .collect();
+    projected.sort_by(|a, b| a.1.depth.total_cmp(&b.1.depth).then(a.0.cmp(&b.0)));
+    let (cols, rows) = tile_grid(frame.width, frame.height);
+    let tiles = (cols * rows) as usize;
+    // Counting sort into tiles, each tile's list in the global depth order.
+    let mut count = vec![0u32; tiles];
+    for (_, p) in &projected {
+        for y in p.tiles_y.0..p.tiles_y.1 {
+            for x in p.tiles_x.0..p.tiles_x.1 {
+                count[(y * cols + x) as usize] += 1;
+            }
+        }
+    }
+    let mut entries = vec![0u32; 2 * tiles];
+    let mut next = Vec::with_capacity(tiles);
+    let mut at = 2 * tiles as u32;
+    for (k, n) in count.iter().enumerate() {
+        entries[2 * k] = at;
+        entries[2 * k + 1] = at + n;
+        next.push(at);
+        at += n;
+    }
+    entries.resize(at as usize, 0);
+    for (s, (_, p)) in projected.iter().enumerate() {
+        for y in p.tiles_y.0..p.tiles_y.1 {
+            for x in p.tiles_x.0..p.tiles_x.1 {
+                let k = (y * cols + x) as usize;
+                entries[next[k] as usize] = s as u32;
+                next[k] += 1;
+            }
+        }
+    }
+    buffers.splats = projected
+        .iter()
+        .map(|&(i, p)| GpuSplat {
+            mean_x: p.mean[0],
+            mean_y: p.mean[1],
+            conic_a: p.conic[0],
+            conic_b: p.conic[1],
+            conic_c: p.conic[2],
+            opacity: buffers.particles[i as usize].opacity,
+            depth: p.depth,
+            particle: i,
+        })
+        .collect();
+    buffers.tile_entries = entries;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scene::{Profile, Scene, SceneLoadOptions};
+
+    /// A grid of Gaussians, some in front of the near cull, seen by a 100×70 camera.
+    fn buffers() -> (SceneBuffers, GpuFrame) {
+        let mut text = String::from(
+            "[camera]\nposition = [0.0, 0.0, -8.0]\nlook_at = [0.0, 0.0, 0.0]\nwidth = 100\nheight = 70\n",
+        );
+        for i in 0..60 {
+            let (x, y, z) = (
+                (i % 6) as f64 - 2.5,
+                (i / 6 % 5) as f64 - 2.0,
+                (i % 7) as f64,
+            );
+            text += &format!(
+                "[[particles]]\ncenter = [{x}, {y}, {}]\nradius = {}\n",
+                z - 8.0 + 0.1 * (i % 3) as f64,
+                0.1 + 0.05 * (i % 4) as f64
+            );
+        }
+        let mut scene = Scene::from_toml_str(
+            &text,
+            std::path::Path::new("s.toml"),
+            &SceneLoadOptions::default(),
+        )
+        .unwrap();
+        for p in &mut scene.particles {
+            p.profile = Profile::Gaussian;
+        }
+        let frame = GpuFrame::new(&scene, &[]);
+        (SceneBuffers::new(&scene, &scene.build_bvh()), frame)
+    }
+
+    /// Every tile lists exactly the splats whose rectangle covers it, front to back.
+    #[test]
+    fn each_tile_lists_the_splats_that_touch_it_in_depth_order() {
+        let (mut b, frame) = buffers();
+        build(&mut b, &frame);
+        let (cols, rows) = tile_grid(frame.width, frame.height);
+        let culled = (0..b.particles.len())
+            .filter(|&i| project(&b, &frame, i).is_none())
+            .count();
+        assert!(culled > 0, "some Gaussians are culled");
+        assert_eq!(b.splats.len() + culled, b.particles.len());
+        for w in b.splats.windows(2) {
+            assert!(
+                w[0].depth < w[1].depth
+                    || (w[0].depth == w[1].depth && w[0].particle < w[1].particle)
+            );
+        }
+        let mut at = 2 * cols * rows;
+        for y in 0..rows {
+            for x in 0..cols {
+                let k = (y * cols + x) as usize;
+                let (begin, end) = (b.tile_entries[2 * k], b.tile_entries[2 * k + 1]);
+                assert_eq!(begin, at, "tile lists are contiguous");
+                at = end;
+                let listed: Vec<u32> = b.tile_entries[begin as usize..end as usize].to_vec();
+                assert!(listed.windows(2).all(|w| w[0] < w[1]), "front to back");
+                let want: Vec<u32> = (0..b.splats.len() as u32)
+                    .filter(|&s| {
+                        let p =
+                            project(&b, &frame, b.splats[s as usize].particle as usize).unwrap();
+                        (p.tiles_x.0..p.tiles_x.1).contains(&x)
+                            && (p.tiles_y.0..p.tiles_y.1).contains(&y)
+                    })
+                    .collect();
+                assert_eq!(listed, want, "tile ({x}, {y})");
+            }
+        }
+        assert_eq!(at as usize, b.tile_entries.len());
+    }
+}
