@@ -20,11 +20,9 @@
 //! pgt approx gaussians.toml --method gauss-ray -o gauss_ray.exr
 //! ```
 
-use super::{check_computes, check_gaussians_only, ApproxMethod, Computes, Preparation};
+use super::{ApproxMethod, Computes, Preparation};
 use crate::approx::contract::GAUSSIAN_TRACE_SIGMAS;
-use crate::error::Result;
 use crate::optics::models;
-use crate::scene::Scene;
 
 /// The `gauss-ray` method (see the module docs).
 pub struct GaussRay;
@@ -53,9 +51,5 @@ impl ApproxMethod for GaussRay {
             traced_sigmas: Some(GAUSSIAN_TRACE_SIGMAS as f64),
             ..Preparation::default()
         }
-    }
-    fn check_scene(&self, scene: &Scene) -> Result<()> {
-        check_computes(self.name(), self.computes(), scene)?;
-        check_gaussians_only(self.name(), scene)
     }
 }

@@ -67,8 +67,8 @@ pub trait ApproxMethod: Sync {
     }
     /// The render mode and optical models it computes (see [`Computes`] for the rule).
     fn computes(&self) -> Computes;
-    /// Whether it draws particles of Gaussian density (docs/design.md §9); a method that does
-    /// not is given only constant-density scenes.
+    /// Whether it draws particles of Gaussian density (docs/design.md §9): such a method is
+    /// given only Gaussian scenes, the others only constant-density ones.
     fn draws_gaussians(&self) -> bool {
         false
     }
@@ -80,7 +80,11 @@ pub trait ApproxMethod: Sync {
     /// no meaning for, with a message that says what to do.
     fn check_scene(&self, scene: &Scene) -> Result<()> {
         check_computes(self.name(), self.computes(), scene)?;
-        check_profile(self.name(), self.draws_gaussians(), scene)
+        if self.draws_gaussians() {
+            check_gaussians_only(self.name(), scene)
+        } else {
+            check_profile(self.name(), false, scene)
+        }
     }
 }
 

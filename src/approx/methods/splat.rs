@@ -33,10 +33,8 @@
 //! pgt approx gaussians.toml --method splat -o splat.exr
 //! ```
 
-use super::{check_computes, check_gaussians_only, ApproxMethod, Computes, Preparation};
-use crate::error::Result;
+use super::{ApproxMethod, Computes, Preparation};
 use crate::optics::models;
-use crate::scene::Scene;
 
 /// The `splat` method (see the module docs).
 pub struct Splat;
@@ -65,9 +63,5 @@ impl ApproxMethod for Splat {
             splat_tiles: true,
             ..Preparation::default()
         }
-    }
-    fn check_scene(&self, scene: &Scene) -> Result<()> {
-        check_computes(self.name(), self.computes(), scene)?;
-        check_gaussians_only(self.name(), scene)
     }
 }

@@ -16,10 +16,8 @@
 //! pgt approx gaussians.toml --method splat-pixel-sort -o sorted.exr
 //! ```
 
-use super::{check_computes, check_gaussians_only, ApproxMethod, Computes, Preparation};
-use crate::error::Result;
+use super::{ApproxMethod, Computes, Preparation};
 use crate::optics::models;
-use crate::scene::Scene;
 
 /// The `splat-pixel-sort` method (see the module docs).
 pub struct SplatPixelSort;
@@ -48,9 +46,5 @@ impl ApproxMethod for SplatPixelSort {
             splat_tiles: true,
             ..Preparation::default()
         }
-    }
-    fn check_scene(&self, scene: &Scene) -> Result<()> {
-        check_computes(self.name(), self.computes(), scene)?;
-        check_gaussians_only(self.name(), scene)
     }
 }
