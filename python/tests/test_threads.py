@@ -55,9 +55,8 @@ def interrupted_render(scene, send_interrupt, after: float = 0.5):
 
 # The interrupt cases run in a Python process of their own: in the suite's process, lavapipe and
 # Mesa's shader-cache threads that the GPU tests left behind come and go on their own schedule,
-# so the thread count before and after the render moved (4 against 5 with a cold shader cache),
-# and a first run after a fresh install once saw no KeyboardInterrupt at all. A clean process
-# sees pgt's threads alone.
+# so the thread count before and after the render moved (4 against 5 with a cold shader cache).
+# A clean process sees pgt's threads alone.
 SENDERS = {
     "interrupt_main": _thread.interrupt_main,
     "SIGINT": lambda: signal.raise_signal(signal.SIGINT),
@@ -81,6 +80,11 @@ def ctrl_c_case(how: str):
     """A long render interrupted by `how` (run in a clean process by the test above): the
     KeyboardInterrupt comes within a second, no thread is left behind, the next render starts
     at once."""
+    # Python installs its KeyboardInterrupt handler only where SIGINT was not ignored when it
+    # started, and a process started in the background by a non-interactive shell inherits
+    # SIGINT ignored (then every sender here does nothing). The test is about pgt under
+    # Python's own handler, so it installs it.
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     send = SENDERS[how]
     scene = long_scene()
     pgt.render(pgt.Scene.from_arrays(*random_particles(5), size=(8, 8)))  # start rayon's pool
