@@ -96,15 +96,24 @@ pub fn columns(particles: &[Particle]) -> &'static [&'static str] {
 }
 
 /// Θmax = 1 − e^{−2rσ}, the opacity along a diameter (docs/design.md §1), the shortest one of an
-/// ellipsoid (§9); 1 for σ = ∞. `expm1` keeps small opacities exact.
+/// ellipsoid (§9); for a Gaussian 1 − e^{−√(2π)·s_min·σ}, the opacity through its centre along
+/// its shortest axis (§9, "The opacity of a Gaussian"); 1 for σ = ∞. `expm1` keeps small
+/// opacities exact.
 pub fn opacity_of(p: &Particle) -> f64 {
     let r = p.ellipsoid.map_or(p.radius, |e| e.shortest_semi_axis());
+    let depth = match p.profile {
+        crate::optics::Profile::Constant => 2.0 * r * p.sigma,
+        crate::optics::Profile::Gaussian => SQRT_TAU * r * p.sigma,
+    };
     if p.sigma == f64::INFINITY {
         1.0
     } else {
-        -(-2.0 * r * p.sigma).exp_m1()
+        -(-depth).exp_m1()
     }
 }
+
+/// √(2π).
+const SQRT_TAU: f64 = 2.506_628_274_631_000_5;
 
 /// A particle's row, in [`COLUMNS`] order.
 pub fn row(p: &Particle) -> [f64; 9] {
@@ -205,6 +214,13 @@ pub fn run(args: ExportArgs) -> anyhow::Result<Outcome> {
     let scene = super::frames::scene_at_frame(&args.scene, &options, args.frame)?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
+    }
+    if scene.has_gaussians() {
+        // The columns hold a Gaussian's standard deviations and peak density; the profile
+        // itself has no column (docs/design.md §7).
+        eprintln!(
+            "warning: the scene's Gaussian particles are written with their standard deviations and peak σ, but the file does not say they are Gaussians: include it with density = \"gaussian\" to read them back as they are"
+        );
     }
     write_atomically(&args.output, |w| match format {
         ExportFormat::Csv => write_csv(w, &scene.particles),

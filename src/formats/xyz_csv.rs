@@ -457,11 +457,27 @@ fn sigma(path: &Path, line: usize, s: &str) -> Result<f64> {
 }
 
 /// A row's `opacity` and `sigma` must say the same (see the module docs).
-fn check_agreement(path: &Path, line: usize, radius: f64, opacity: f64, sigma: f64) -> Result<()> {
+/// For a Gaussian (`density = "gaussian"` on the include) the opacity is that through the centre
+/// along the shortest axis, 1 − e^(−√(2π)·s·sigma) (docs/design.md §9).
+fn check_agreement(
+    path: &Path,
+    line: usize,
+    radius: f64,
+    (opacity, sigma): (f64, f64),
+    gaussian: bool,
+) -> Result<()> {
+    let (depth, rule) = if gaussian {
+        (
+            2.506_628_274_631_000_5 * radius * sigma,
+            "1 − e^(−√(2π)·s·sigma) (a Gaussian)",
+        )
+    } else {
+        (2.0 * radius * sigma, "1 − e^(−2·r·sigma)")
+    };
     let from_sigma = if sigma == f64::INFINITY {
         1.0
     } else {
-        -(-2.0 * radius * sigma).exp_m1()
+        -(-depth).exp_m1()
     };
     if (from_sigma - opacity).abs() <= SIGMA_OPACITY_AGREEMENT {
         return Ok(());
@@ -470,7 +486,7 @@ fn check_agreement(path: &Path, line: usize, radius: f64, opacity: f64, sigma: f
         path,
         line,
         format!(
-            "opacity {opacity} and sigma {sigma} disagree: with radius {radius}, sigma gives opacity 1 − e^(−2·r·sigma) = {from_sigma}; give one of them, or both consistent (sigma is used where both are given)"
+            "opacity {opacity} and sigma {sigma} disagree: with radius {radius}, sigma gives opacity {rule} = {from_sigma}; give one of them, or both consistent (sigma is used where both are given)"
         ),
     ))
 }
@@ -534,7 +550,8 @@ pub fn read_csv(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
         if let (Some(o), Some(s)) = (opacity, sigma) {
             // Θmax is the opacity along the shortest diameter (docs/design.md §9).
             let r = ellipsoid.map_or(radius, |e| e.semi_axes.min_element());
-            check_agreement(path, line, r, o, s)?;
+            let gaussian = spec.density == Some(super::Profile::Gaussian);
+            check_agreement(path, line, r, (o, s), gaussian)?;
         }
         records.push(ParticleRecord {
             ellipsoid,

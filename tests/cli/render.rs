@@ -338,6 +338,50 @@ fn gaussian_particles_render_exactly_and_what_cannot_draw_them_exits_2() {
         .iter()
         .flatten()
         .all(|&e| e > 0.0 && e <= 1e-5));
+    // Exported, the Gaussians carry their standard deviations and peak σ but not their
+    // profile: export says so, and the CSV included with density = "gaussian" renders the
+    // same image within the two errs.
+    let csv = dir.path().join("gaussians.csv");
+    let out = pgt(&["export", &scene, "-o", s(&csv)]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(out.status.success(), "{err}");
+    assert!(err.contains("density = \"gaussian\""), "{err}");
+    let text = std::fs::read_to_string(&scene).expect("the example");
+    let settings = &text[..text.find("[defaults]").expect("a [defaults] table")];
+    let again = dir.path().join("again.toml");
+    std::fs::write(
+        &again,
+        format!("{settings}\n[[include]]\npath = \"gaussians.csv\"\ndensity = \"gaussian\"\n"),
+    )
+    .expect("write the scene");
+    let exr2 = dir.path().join("again.exr");
+    let out = pgt(&["render", s(&again), "-o", s(&exr2), "--size", "24x24"]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let (a, b) = (
+        pgt::image_io::read_exr_layer(&exr, "").expect("first"),
+        pgt::image_io::read_exr_layer(&exr2, "").expect("again"),
+    );
+    let err2 = pgt::image_io::read_exr_layer(&exr2, "err").expect("the err layer");
+    let mut lit = 0;
+    for i in 0..a.pixels.len() {
+        for c in 0..3 {
+            let bound = err_layer.pixels[i][c] + err2.pixels[i][c];
+            assert!(
+                (a.pixels[i][c] - b.pixels[i][c]).abs() <= bound,
+                "pixel {i} channel {c}: {} against {}",
+                a.pixels[i][c],
+                b.pixels[i][c]
+            );
+            if a.pixels[i][c] > 0.2 {
+                lit += 1;
+            }
+        }
+    }
+    assert!(lit > 20, "the Gaussians hardly show");
     for (args, words) in [
         (vec!["render", &scene, "--model", "lit"], "lit model"),
         (vec!["render", &scene, "--mode", "opaque"], "no surface"),
