@@ -101,19 +101,13 @@ pub fn columns(particles: &[Particle]) -> &'static [&'static str] {
 /// opacities exact.
 pub fn opacity_of(p: &Particle) -> f64 {
     let r = p.ellipsoid.map_or(p.radius, |e| e.shortest_semi_axis());
-    let depth = match p.profile {
-        crate::optics::Profile::Constant => 2.0 * r * p.sigma,
-        crate::optics::Profile::Gaussian => SQRT_TAU * r * p.sigma,
-    };
+    let depth = p.profile.centre_depth(r, p.sigma);
     if p.sigma == f64::INFINITY {
         1.0
     } else {
         -(-depth).exp_m1()
     }
 }
-
-/// √(2π).
-const SQRT_TAU: f64 = 2.506_628_274_631_000_5;
 
 /// A particle's row, in [`COLUMNS`] order.
 pub fn row(p: &Particle) -> [f64; 9] {

@@ -24,3 +24,19 @@ impl Profile {
         }
     }
 }
+
+impl Profile {
+    /// The optical depth through the centre of a particle along its shortest axis, of extent
+    /// `shortest` (the radius, the shortest semi-axis or the shortest standard deviation) and
+    /// (peak) density `sigma`: 2·r·σ for constant density (docs/design.md §1), √(2π)·s·σ for a
+    /// Gaussian (§9). The particle's opacity is 1 − e^{−depth}.
+    pub fn centre_depth(self, shortest: f64, sigma: f64) -> f64 {
+        match self {
+            Profile::Constant => 2.0 * shortest * sigma,
+            Profile::Gaussian => SQRT_TAU * shortest * sigma,
+        }
+    }
+}
+
+/// √(2π).
+const SQRT_TAU: f64 = 2.506_628_274_631_000_5;

@@ -466,14 +466,15 @@ fn check_agreement(
     (opacity, sigma): (f64, f64),
     gaussian: bool,
 ) -> Result<()> {
-    let (depth, rule) = if gaussian {
+    let (profile, rule) = if gaussian {
         (
-            2.506_628_274_631_000_5 * radius * sigma,
+            super::Profile::Gaussian,
             "1 − e^(−√(2π)·s·sigma) (a Gaussian)",
         )
     } else {
-        (2.0 * radius * sigma, "1 − e^(−2·r·sigma)")
+        (super::Profile::Constant, "1 − e^(−2·r·sigma)")
     };
+    let depth = profile.centre_depth(radius, sigma);
     let from_sigma = if sigma == f64::INFINITY {
         1.0
     } else {

@@ -46,9 +46,6 @@ use crate::scene::{RenderMode, Scene};
 use glam::{DQuat, DVec3};
 use std::cell::RefCell;
 
-/// √(2π).
-const SQRT_TAU: f64 = 2.506_628_274_631_000_5;
-
 /// The shortest piece of a ray, in mean standard deviations along the ray of its Gaussians:
 /// shorter pieces cost each Gaussian more evaluations (every piece its window meets starts with
 /// seven nodes), longer ones more splits (docs/performance.md, "Gaussian particles in the reference").
@@ -77,7 +74,6 @@ pub struct GaussianRenderer {
     tol: f64,
     /// The bound on the depth of the Gaussians a ray does not meet within k σ.
     far_depth: f64,
-    cutoff: f64,
 }
 
 /// One candidate Gaussian of a ray: its profile and depth in front of the eye.
@@ -129,8 +125,6 @@ struct Scratch {
     members: Vec<Member>,
     deviations: Vec<Deviation>,
     pieces: Vec<Piece>,
-    /// The transmittance after the last piece of the sweep.
-    end_t: f64,
 }
 
 thread_local! {
@@ -194,7 +188,7 @@ impl GaussianRenderer {
         // longest axis, the factor of e^{−k²/2} in the bound on what is missed.
         let line_depth: f64 = gaussians
             .iter()
-            .map(|g| g.sigma * g.shape.semi_axes().max_element() * SQRT_TAU)
+            .map(|g| Profile::Gaussian.centre_depth(g.shape.semi_axes().max_element(), g.sigma))
             .sum();
         let cutoff = scene
             .render
@@ -225,19 +219,7 @@ impl GaussianRenderer {
             bound,
             tol,
             far_depth,
-            cutoff,
         })
-    }
-
-    /// k, the cut-off in standard deviations.
-    pub fn cutoff(&self) -> f64 {
-        self.cutoff
-    }
-
-    /// The bound on the optical depth, along any ray, of the Gaussians it does not meet
-    /// within k σ.
-    pub fn far_depth(&self) -> f64 {
-        self.far_depth
     }
 
     fn radiance_with(&self, ray: &Ray, s: &mut Scratch) -> Sample {
@@ -251,10 +233,7 @@ impl GaussianRenderer {
         let budget = self.tol / (4.0 * m_max);
         let delta = self.far_depth + self.gather(ray, s, budget);
         cut_pieces(s);
-        let (mut radiance, mut error, stopped) = self.sweep(s, m_max);
-        if !stopped {
-            radiance += self.background_seen(s);
-        }
+        let (mut radiance, mut error) = self.sweep(s, m_max);
         let converged = self.deviations(s, &mut radiance, &mut error);
 
         error += self.bound * -(-delta).exp_m1();
@@ -334,10 +313,10 @@ impl GaussianRenderer {
     }
 
     /// The closed-form part of every piece, front to back: T(a)·C_ref·(1 − e^{−τ(a,b)}) and
-    /// the pieces whose colours differ queued for quadrature (`s.pieces`). Returns the
-    /// radiance, its error so far and whether the ray stopped at T·max M ≤ tol/8; `s.end_t`
-    /// is the transmittance after the last piece.
-    fn sweep(&self, s: &mut Scratch, m_max: f64) -> (DVec3, DVec3, bool) {
+    /// the pieces whose colours differ queued for quadrature (`s.pieces`), then L_bg·T(0,∞),
+    /// or the bounded rest of a ray stopped at T·max M ≤ tol/8. Returns the radiance and its
+    /// error so far.
+    fn sweep(&self, s: &mut Scratch, m_max: f64) -> (DVec3, DVec3) {
         let mut radiance = DVec3::ZERO;
         let mut error = DVec3::ZERO;
         let mut transmittance = 1.0;
@@ -411,13 +390,10 @@ impl GaussianRenderer {
             }
             transmittance *= (-tau).exp();
         }
-        s.end_t = transmittance;
-        (radiance, error, stopped)
-    }
-
-    /// L_bg·T(0,∞).
-    fn background_seen(&self, s: &Scratch) -> DVec3 {
-        s.end_t * self.background
+        if !stopped {
+            radiance += transmittance * self.background;
+        }
+        (radiance, error)
     }
 
     /// The colour deviations of the queued pieces by adaptive Gauss–Kronrod with tol/2, added

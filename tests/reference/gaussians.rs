@@ -7,13 +7,13 @@
 //! The oracles evaluate σ(x) = σᵢ·exp(−½(x − c)ᵀΣ⁻¹(x − c)) in 3D with Σ = R·S²·Rᵀ built here
 //! from the quaternion, never through `optics::gaussian`.
 
-use crate::support::volume::Rng;
+use crate::support::{self, volume::Rng};
 use glam::{DMat3, DQuat, DVec3};
 use pgt::geometry::{Camera, Ellipsoid, Ray};
 use pgt::optics::{models, Particle, Profile};
 use pgt::reference::gaussian::GaussianRenderer;
 use pgt::reference::{render, Integrator, RadianceEstimator, RenderOptions};
-use pgt::scene::{RenderMode, RenderSettings, Scene, SceneLoadOptions};
+use pgt::scene::{RenderMode, Scene, SceneLoadOptions};
 use std::path::Path;
 
 const SQRT_TAU: f64 = 2.506_628_274_631_000_5;
@@ -32,29 +32,21 @@ fn gaussian(center: DVec3, std: DVec3, rotation: DQuat, color: DVec3, sigma: f64
     }
 }
 
+/// The volume tests' scene (emission, its background), seen from further away, at `tol` and
+/// the cut-off `cutoff`.
 fn scene(particles: Vec<Particle>, size: u32, tol: f64, cutoff: Option<f64>) -> Scene {
-    Scene {
-        source: "gaussians".into(),
-        camera: Camera::new(
-            DVec3::new(0.0, 0.0, -12.0),
-            DVec3::ZERO,
-            DVec3::Y,
-            30.0,
-            size,
-            size,
-        ),
-        render: RenderSettings {
-            mode: RenderMode::Volume,
-            model: models::EMISSION,
-            background: DVec3::new(0.05, 0.1, 0.2),
-            tol,
-            gaussian_cutoff: cutoff,
-            ..RenderSettings::default()
-        },
-        lights: vec![],
-        particles,
-        warnings: vec![],
-    }
+    let mut s = support::volume::scene(models::EMISSION, particles, vec![], size);
+    s.camera = Camera::new(
+        DVec3::new(0.0, 0.0, -12.0),
+        DVec3::ZERO,
+        DVec3::Y,
+        30.0,
+        size,
+        size,
+    );
+    s.render.tol = tol;
+    s.render.gaussian_cutoff = cutoff;
+    s
 }
 
 /// σ of one Gaussian at x, from its covariance in 3D.
