@@ -121,6 +121,7 @@ struct Scratch {
     hits: Vec<Hit>,
     candidates: Vec<Candidate>,
     windows: Vec<Window>,
+    cuts: Vec<(f64, bool)>,
     points: Vec<f64>,
     members: Vec<Member>,
     deviations: Vec<Deviation>,
@@ -455,35 +456,36 @@ impl RadianceEstimator for GaussianRenderer {
 /// cuts are at least [`PIECE_WIDTH`] mean standard deviations apart (the quadrature splits where
 /// a piece needs it; an evaluation costs the windows that hold the node, not the piece's).
 fn cut_pieces(s: &mut Scratch) {
-    s.points.clear();
+    s.cuts.clear();
     let mut mean_s = 0.0;
     for w in &s.windows {
-        s.points.push(w.lo);
-        s.points.push(w.hi);
-        if w.profile.t_star > w.lo && w.profile.t_star < w.hi {
-            s.points.push(w.profile.t_star);
-        }
         mean_s += w.profile.s;
     }
-    s.points.sort_unstable_by(f64::total_cmp);
-    s.points.dedup();
-    if let Some(&end) = s.points.last() {
-        let gap = PIECE_WIDTH * mean_s / s.windows.len() as f64;
-        let mut kept = 1;
-        for k in 1..s.points.len() {
-            if s.points[k] - s.points[kept - 1] >= gap {
-                s.points[kept] = s.points[k];
-                kept += 1;
-            }
+    let gap = PIECE_WIDTH * mean_s / s.windows.len().max(1) as f64;
+    for w in &s.windows {
+        // A window narrower than the gap keeps its own cuts: thinned away, it would lie inside
+        // a piece whose nodes step over it (a flat splat's window can be 10⁻¹⁰ of the others').
+        let own = w.hi - w.lo < gap;
+        s.cuts.push((w.lo, own));
+        s.cuts.push((w.hi, own));
+        if w.profile.t_star > w.lo && w.profile.t_star < w.hi {
+            s.cuts.push((w.profile.t_star, own));
         }
-        s.points.truncate(kept);
-        if s.points[kept - 1] < end {
-            if kept > 1 {
-                s.points[kept - 1] = end;
-            } else {
-                s.points.push(end);
-            }
+    }
+    s.cuts
+        .sort_unstable_by(|a, b| a.0.total_cmp(&b.0).then(b.1.cmp(&a.1)));
+    s.points.clear();
+    let Some(&(end, _)) = s.cuts.last() else {
+        return;
+    };
+    for &(t, own) in &s.cuts {
+        match s.points.last() {
+            Some(&last) if t == last || (!own && t - last < gap) => {}
+            _ => s.points.push(t),
         }
+    }
+    if s.points.last().is_some_and(|&last| last < end) {
+        s.points.push(end);
     }
 }
 

@@ -441,3 +441,42 @@ fn the_peak_density_of_the_mapping_gives_the_files_opacity() {
     assert!((tau - -(0.65f64).ln()).abs() < 1e-10, "{tau}");
     assert!((p.sigma * 0.25 * SQRT_TAU - -(0.65f64).ln()).abs() < 1e-14);
 }
+
+#[test]
+fn a_flat_gaussian_inside_a_wide_one_is_not_stepped_over() {
+    // A splat 10⁻⁸ thick along the view at the centre of a wide Gaussian of another colour
+    // (real splatting files hold such flat ones): along the axis the flat one is a slab at t_f,
+    // so L = C_w(1 − e^{−τ₁}) + e^{−τ₁}[C_f(1 − e^{−τ_f}) + e^{−τ_f}(C_w(1 − e^{−τ₂}) + e^{−τ₂}L_bg)]
+    // with τ₁ = τ₂ half the wide one's depth; the slab's own width moves L by < 1e-6.
+    let wide = gaussian(
+        DVec3::ZERO,
+        DVec3::splat(0.8),
+        DQuat::IDENTITY,
+        DVec3::new(0.1, 0.2, 1.0),
+        1.5,
+    );
+    let flat = gaussian(
+        DVec3::ZERO,
+        DVec3::new(0.5, 0.4, 1e-8),
+        DQuat::IDENTITY,
+        DVec3::new(1.0, 0.8, 0.1),
+        0.9 / (1e-8 * SQRT_TAU),
+    );
+    let s = scene(vec![wide, flat], 9, 1e-7, None);
+    let got = renderer(&s).radiance(&s.camera.ray_at(4.5, 4.5));
+    let half = 0.5 * wide.sigma * 0.8 * SQRT_TAU;
+    let tau_f: f64 = 0.9;
+    let bg = s.render.background;
+    let behind = wide.color * -(-half).exp_m1() + (-half).exp() * bg;
+    let at_flat = flat.color * -(-tau_f).exp_m1() + (-tau_f).exp() * behind;
+    let want = wide.color * -(-half).exp_m1() + (-half).exp() * at_flat;
+    for c in 0..3 {
+        assert!(
+            (got.radiance[c] - want[c]).abs() <= got.error[c] + 1e-6,
+            "channel {c}: {} against {} (err {})",
+            got.radiance[c],
+            want[c],
+            got.error[c]
+        );
+    }
+}
