@@ -9,7 +9,7 @@ to 1. MSE share: |d_j|^2 / |I0 - R|^2 (from each comparison's per-channel RMSE);
 
 import json
 
-FILES = ["lod3_tile_0", "fruit_drops_minimal", "GSHairLoD_donut_fused"]
+FILES = ["lod3_tile_0", "fruit_drops_minimal"]
 CHAIN = ["splat", "splat-pixel-sort", "gauss-ray"]
 CAUSES = [("sorting", "step_sorting"), ("projection", "step_projection"), ("model", "step_model")]
 
