@@ -1,5 +1,5 @@
 //! The exact renderer of particles of Gaussian density (docs/design.md §9 "Gaussian density"),
-//! emission model.
+//! emission and single-scatter models.
 //!
 //! Along a camera ray each Gaussian's density is a 1D Gaussian in t (`optics::gaussian`), so
 //! the optical depth through any number of them is a sum of closed forms (erf differences) and
@@ -34,6 +34,20 @@
 //! the smallest value ≥ 3 that puts that sum's share below tol/8. A ray whose transmittance has
 //! fallen to T with T·M ≤ tol/8 stops: what lies beyond is in [0, T·M], taken as its midpoint
 //! with half of it in err.
+//!
+//! **Single-scatter.** The source is Q = a·E + α·(1/4π)·Σ_l E_l·T_l (docs/design.md §2), so
+//! σ·Q = a·Σσᵢ(t)Cᵢ + (1/4π)·Σᵢσᵢ(t)αᵢ·Σ_l E_l(x_t)·T_l(x_t): the first term is the emission
+//! model's with colours a·Cᵢ, the second is added to the quadrature's integrand of every piece,
+//! with T_l in closed form: the sum of the erf depths, over [0, d_l], of the Gaussians whose k-σ
+//! ellipsoid the shadow ray meets. The model is asked for its per-light part
+//! (`OpticalModel::light_source`, at the σ-weighted albedo of the point), never by name; a model
+//! that needs the shadow ray's radiance (lit) is refused. A point light's nearest point on the
+//! camera ray is a cut, where its 1/d² peaks. Two more things go into err: M above bounds Q on
+//! this ray, a·max Cᵢ + the model's part at max αᵢ and each light's largest irradiance on the
+//! ray (`Light::max_irradiance_beyond`, +∞ for a ray through a point light, which is then
+//! reported as not converged); and each shadow ray leaves out at most the same missed depth
+//! Δ_far as a camera ray, so the rendered T_l is at most e^{Δ_far} times the true one and the
+//! scattered radiance is high by at most (L + err)·(1 − e^{−Δ_far}).
 
 use super::quadrature::{integrate_adaptive, Piece};
 use super::volume::MAX_SEGMENTS;
@@ -41,7 +55,11 @@ use super::{Integrator, RadianceEstimator, Sample};
 use crate::error::{PgtError, Result};
 use crate::geometry::{Bvh, Ellipsoid, Hit, Ray};
 use crate::optics::gaussian::{DepthFrom, GaussianAlongRay};
-use crate::optics::{models, Profile};
+use crate::optics::intervals::Interval;
+use crate::optics::light::Light;
+use crate::optics::model::{LightNeed, OpticalModel};
+use crate::optics::source::{LightSample, SourceParams};
+use crate::optics::Profile;
 use crate::scene::{RenderMode, Scene};
 use glam::{DQuat, DVec3};
 use std::cell::RefCell;
@@ -60,7 +78,11 @@ struct Gaussian {
     center: DVec3,
     shape: Ellipsoid,
     sigma: f64,
+    /// k·Cᵢ, the colour of the model's constant part k·E (k = 1 in the emission model, a in
+    /// single-scatter).
+    emitted: DVec3,
     color: DVec3,
+    albedo: DVec3,
 }
 
 /// The renderer of a scene whose particles all have Gaussian density.
@@ -69,11 +91,19 @@ pub struct GaussianRenderer {
     /// Over the k-σ ellipsoids of `gaussians` (indices into it).
     bvh: Bvh,
     background: DVec3,
-    /// M per channel: max(maxᵢ Cᵢ, L_bg).
+    /// Per channel, max(maxᵢ k·Cᵢ, L_bg): M where no light scatters.
     bound: DVec3,
     tol: f64,
     /// The bound on the depth of the Gaussians a ray does not meet within k σ.
     far_depth: f64,
+    model: &'static dyn OpticalModel,
+    params: SourceParams,
+    /// The lights whose part of Q is integrated: empty where the model has none.
+    lights: Vec<Light>,
+    /// Per channel, the largest k·Cᵢ, colour and albedo of any Gaussian.
+    max_emitted: DVec3,
+    max_color: DVec3,
+    max_albedo: DVec3,
 }
 
 /// One candidate Gaussian of a ray: its profile and depth in front of the eye.
@@ -126,6 +156,7 @@ struct Scratch {
     members: Vec<Member>,
     deviations: Vec<Deviation>,
     pieces: Vec<Piece>,
+    shadow_hits: Vec<Hit>,
 }
 
 thread_local! {
@@ -134,7 +165,8 @@ thread_local! {
 
 impl GaussianRenderer {
     /// The renderer of `scene`, or the reason it cannot render it (a name for each: a mixed
-    /// scene, a model or mode other than the emission volume, an infinite peak density).
+    /// scene, the opaque mode, a model that needs the shadow rays' radiance (lit), an infinite
+    /// peak density, a negative colour, albedo or light).
     pub fn new(scene: &Scene, integrator: Integrator) -> Result<GaussianRenderer> {
         let refuse = |why: String| Err(PgtError::Usage(why));
         if scene
@@ -151,10 +183,11 @@ impl GaussianRenderer {
                 "Gaussian particles have no surface: the opaque mode does not draw them (use mode = \"volume\")".into(),
             );
         }
-        if scene.render.model != models::EMISSION {
+        let model = scene.render.model.model();
+        if model.light_need() == LightNeed::Radiance {
             return refuse(format!(
-                "the reference renders Gaussian particles in the emission model; the {} model is not implemented for them (docs/design.md §9): pass --model emission",
-                scene.render.model.name()
+                "the {} model's shadow rays composite coloured emission, which the reference does not integrate through Gaussian particles (docs/design.md §9): pass --model emission or --model single-scatter",
+                model.name()
             ));
         }
         if let Integrator::Riemann { .. } = integrator {
@@ -169,6 +202,11 @@ impl GaussianRenderer {
                     "particle {i} is a Gaussian of infinite peak density (opacity 1); a Gaussian's opacity must be < 1"
                 ));
             }
+            if !(p.color.cmpge(DVec3::ZERO).all() && p.albedo.cmpge(DVec3::ZERO).all()) {
+                return refuse(format!(
+                    "particle {i} has a negative colour or albedo; the reference's bound on what it leaves out of a Gaussian scene needs them ≥ 0"
+                ));
+            }
             if p.sigma == 0.0 {
                 continue;
             }
@@ -179,11 +217,38 @@ impl GaussianRenderer {
                 center: p.center,
                 shape,
                 sigma: p.sigma,
+                emitted: DVec3::ZERO,
                 color: p.color,
+                albedo: p.albedo,
             });
         }
+        let params = SourceParams::new(
+            scene.render.light_weight,
+            scene.lights.len(),
+            scene.render.emission_weight,
+        );
+        let k = model.emission_factor(&params);
+        for g in &mut gaussians {
+            g.emitted = k * g.color;
+        }
+        let lights = if model.light_need() == LightNeed::None {
+            Vec::new()
+        } else {
+            scene.lights.clone()
+        };
+        if lights.iter().any(|l| match *l {
+            Light::Directional { irradiance, .. } => !irradiance.cmpge(DVec3::ZERO).all(),
+            Light::Point { intensity, .. } => !intensity.cmpge(DVec3::ZERO).all(),
+        }) {
+            return refuse(
+                "a light has a negative irradiance or intensity; the reference's bound on what it leaves out of a Gaussian scene needs them ≥ 0".into(),
+            );
+        }
         let background = scene.render.background;
-        let bound = gaussians.iter().fold(background, |m, g| m.max(g.color));
+        let bound = gaussians.iter().fold(background, |m, g| m.max(g.emitted));
+        let max_emitted = gaussians.iter().fold(DVec3::ZERO, |m, g| m.max(g.emitted));
+        let max_color = gaussians.iter().fold(DVec3::ZERO, |m, g| m.max(g.color));
+        let max_albedo = gaussians.iter().fold(DVec3::ZERO, |m, g| m.max(g.albedo));
         let tol = scene.render.tol;
         // Σᵢ σᵢ·s_max,i·√(2π): the line depth of every Gaussian through its centre along its
         // longest axis, the factor of e^{−k²/2} in the bound on what is missed.
@@ -191,12 +256,26 @@ impl GaussianRenderer {
             .iter()
             .map(|g| Profile::Gaussian.centre_depth(g.shape.semi_axes().max_element(), g.sigma))
             .sum();
-        let cutoff = scene
-            .render
-            .gaussian_cutoff
-            .unwrap_or_else(|| auto_cutoff(line_depth, bound.max_element(), tol));
-        let far_depth = line_depth * (-0.5 * cutoff * cutoff).exp();
-        let bvh = Bvh::build_shapes(
+        let mut renderer = GaussianRenderer {
+            gaussians,
+            bvh: Bvh::build_shapes(Vec::new(), Vec::new(), Vec::new(), |_| true),
+            background,
+            bound,
+            tol,
+            far_depth: 0.0,
+            model,
+            params,
+            lights,
+            max_emitted,
+            max_color,
+            max_albedo,
+        };
+        let cutoff = scene.render.gaussian_cutoff.unwrap_or_else(|| {
+            auto_cutoff(line_depth, renderer.typical_bound().max_element(), tol)
+        });
+        let gaussians = &renderer.gaussians;
+        renderer.far_depth = line_depth * (-0.5 * cutoff * cutoff).exp();
+        renderer.bvh = Bvh::build_shapes(
             gaussians.iter().map(|g| g.center).collect(),
             gaussians
                 .iter()
@@ -213,36 +292,95 @@ impl GaussianRenderer {
                 .collect(),
             |_| true,
         );
-        Ok(GaussianRenderer {
-            gaussians,
-            bvh,
-            background,
-            bound,
-            tol,
-            far_depth,
-        })
+        Ok(renderer)
+    }
+
+    /// M of this ray per channel: a bound of Q at every point of the ray, and of L_bg.
+    fn source_bound(&self, ray: &Ray) -> DVec3 {
+        let mut q = self.bound;
+        let mut scattered = DVec3::ZERO;
+        for light in &self.lights {
+            scattered +=
+                self.light_part_bound(light.max_irradiance_beyond(ray.origin, ray.direction, 0.0));
+        }
+        if scattered != DVec3::ZERO {
+            q = q.max(self.max_emitted + scattered);
+        }
+        q
+    }
+
+    /// M for choosing the cut-off: as [`GaussianRenderer::source_bound`], with each point
+    /// light's irradiance at the distance of the nearest Gaussian's centre (no ray's bound: a
+    /// ray may pass through the light).
+    fn typical_bound(&self) -> DVec3 {
+        let mut scattered = DVec3::ZERO;
+        for light in &self.lights {
+            let nearest = self
+                .gaussians
+                .iter()
+                .filter_map(|g| light.incident_at(g.center))
+                .fold(DVec3::ZERO, |m, inc| m.max(inc.irradiance));
+            scattered += self.light_part_bound(nearest);
+        }
+        let q = self.bound.max(self.max_emitted + scattered);
+        if q.is_finite() {
+            q
+        } else {
+            self.bound
+        }
+    }
+
+    /// The model's part of Q for one light at the largest colour and albedo and `irradiance`,
+    /// unshadowed: a bound of that part wherever the irradiance is at most `irradiance`
+    /// (`OpticalModel::light_source` is non-decreasing in each).
+    fn light_part_bound(&self, irradiance: DVec3) -> DVec3 {
+        let bounds = Interval {
+            t0: 0.0,
+            t1: 0.0,
+            sigma: 1.0,
+            emission: self.max_color,
+            albedo: self.max_albedo,
+        };
+        let sample = LightSample {
+            radiance: DVec3::ZERO,
+            irradiance,
+            transmittance: 1.0,
+        };
+        self.model.light_source(&self.params, &bounds, &sample)
     }
 
     fn radiance_with(&self, ray: &Ray, s: &mut Scratch) -> Sample {
-        let m_max = self.bound.max_element();
+        let bound = self.source_bound(ray);
+        let m_max = bound.max_element();
         if m_max == 0.0 {
-            // Every colour and the background are black: L = 0 whatever the densities.
+            // Every colour, light and the background are black: L = 0 whatever the densities.
             return Sample::default();
         }
         // Budgets of optical depth left out: tol/4 of radiance in all (M·Δ ≤ tol/4), half for
-        // the small Gaussians left out whole and half for the tails outside the windows.
-        let budget = self.tol / (4.0 * m_max);
+        // the small Gaussians left out whole and half for the tails outside the windows. A ray
+        // through a point light has no finite M; its windows are those of the scene's M.
+        let m_budget = if m_max.is_finite() {
+            m_max
+        } else {
+            self.typical_bound().max_element().max(f64::MIN_POSITIVE)
+        };
+        let budget = self.tol / (4.0 * m_budget);
         let delta = self.far_depth + self.gather(ray, s, budget);
-        cut_pieces(s);
-        let (mut radiance, mut error) = self.sweep(s, m_max);
-        let converged = self.deviations(s, &mut radiance, &mut error);
+        cut_pieces(s, &self.lights, ray);
+        let (mut radiance, mut error) = self.sweep(s, bound);
+        let (converged, shadow_rays) = self.deviations(ray, s, &mut radiance, &mut error);
 
-        error += self.bound * -(-delta).exp_m1();
+        if !self.lights.is_empty() {
+            // The scattered part is at most the whole radiance; the shadow rays' missed depth
+            // makes it high by at most that part's 1 − e^{−Δ_far}.
+            error += (radiance + error) * -(-self.far_depth).exp_m1();
+        }
+        error += bound * -(-delta).exp_m1();
         Sample {
             radiance,
             error,
-            shadow_rays: 0,
-            unconverged: !converged,
+            shadow_rays,
+            unconverged: !converged || !error.is_finite(),
         }
     }
 
@@ -314,10 +452,11 @@ impl GaussianRenderer {
     }
 
     /// The closed-form part of every piece, front to back: T(a)·C_ref·(1 − e^{−τ(a,b)}) and
-    /// the pieces whose colours differ queued for quadrature (`s.pieces`), then L_bg·T(0,∞),
-    /// or the bounded rest of a ray stopped at T·max M ≤ tol/8. Returns the radiance and its
-    /// error so far.
-    fn sweep(&self, s: &mut Scratch, m_max: f64) -> (DVec3, DVec3) {
+    /// the pieces whose colours differ, or every piece where lights scatter, queued for
+    /// quadrature (`s.pieces`), then L_bg·T(0,∞), or the bounded rest of a ray stopped at
+    /// T·max M ≤ tol/8 (`bound` is M). Returns the radiance and its error so far.
+    fn sweep(&self, s: &mut Scratch, bound: DVec3) -> (DVec3, DVec3) {
+        let m_max = bound.max_element();
         let mut radiance = DVec3::ZERO;
         let mut error = DVec3::ZERO;
         let mut transmittance = 1.0;
@@ -357,7 +496,7 @@ impl GaussianRenderer {
                 continue;
             }
             if transmittance * m_max <= self.tol / 8.0 {
-                let rest = 0.5 * transmittance * self.bound;
+                let rest = 0.5 * transmittance * bound;
                 radiance += rest;
                 error += rest;
                 stopped = true;
@@ -371,9 +510,10 @@ impl GaussianRenderer {
                 .fold(&members[0], |h, m| if m.depth > h.depth { m } else { h });
             let reference = self.color_of(&s.windows[heaviest.window]);
             radiance += transmittance * reference * -(-tau).exp_m1();
-            if members
-                .iter()
-                .any(|m| self.color_of(&s.windows[m.window]) != reference)
+            if !self.lights.is_empty()
+                || members
+                    .iter()
+                    .any(|m| self.color_of(&s.windows[m.window]) != reference)
             {
                 s.pieces.push(Piece {
                     lo: a,
@@ -397,16 +537,26 @@ impl GaussianRenderer {
         (radiance, error)
     }
 
-    /// The colour deviations of the queued pieces by adaptive Gauss–Kronrod with tol/2, added
-    /// to `radiance` and their estimate to `error`; whether the quadrature converged.
-    fn deviations(&self, s: &Scratch, radiance: &mut DVec3, error: &mut DVec3) -> bool {
+    /// The colour deviations of the queued pieces, and the lights' part where they scatter, by
+    /// adaptive Gauss–Kronrod with tol/2, added to `radiance` and their estimate to `error`;
+    /// whether the quadrature converged, and the number of shadow rays traced.
+    fn deviations(
+        &self,
+        ray: &Ray,
+        s: &mut Scratch,
+        radiance: &mut DVec3,
+        error: &mut DVec3,
+    ) -> (bool, u64) {
         let mut converged = true;
+        let mut shadow_rays = 0;
         if !s.pieces.is_empty() {
             let (windows, members, deviations) = (&s.windows, &s.members, &s.deviations);
+            let hits = &mut s.shadow_hits;
             let integrand = |tag: usize, t: f64| {
                 let d = &deviations[tag];
                 let mut tau = 0.0;
                 let mut sum = DVec3::ZERO;
+                let (mut sigma, mut color, mut albedo) = (0.0, DVec3::ZERO, DVec3::ZERO);
                 for m in &members[d.first..d.first + d.count] {
                     if t <= m.x0 {
                         continue;
@@ -417,7 +567,39 @@ impl GaussianRenderer {
                     }
                     let w = &windows[m.window];
                     tau += m.from.to(t);
-                    sum += w.profile.density(t) * (self.color_of(w) - d.reference);
+                    let density = w.profile.density(t);
+                    let g = &self.gaussians[w.index as usize];
+                    sum += density * (g.emitted - d.reference);
+                    sigma += density;
+                    color += density * g.color;
+                    albedo += density * g.albedo;
+                }
+                if sigma > 0.0 && !self.lights.is_empty() {
+                    let x = ray.at(t);
+                    let here = Interval {
+                        t0: t,
+                        t1: t,
+                        sigma,
+                        emission: color / sigma,
+                        albedo: albedo / sigma,
+                    };
+                    for light in &self.lights {
+                        let Some(incident) = light.incident_at(x) else {
+                            continue;
+                        };
+                        shadow_rays += 1;
+                        let sample = LightSample {
+                            radiance: DVec3::ZERO,
+                            irradiance: incident.irradiance,
+                            transmittance: self.transmittance(
+                                x,
+                                incident.toward,
+                                incident.distance,
+                                hits,
+                            ),
+                        };
+                        sum += sigma * self.model.light_source(&self.params, &here, &sample);
+                    }
                 }
                 (-tau).exp() * sum
             };
@@ -433,12 +615,30 @@ impl GaussianRenderer {
             *error += result.error;
             converged = result.converged;
         }
-        converged
+        (converged, shadow_rays)
     }
 
+    /// T_l: the transmittance from `x` over `distance` along `toward` (unit) through the
+    /// Gaussians whose k-σ ellipsoid that stretch meets, in closed form.
+    fn transmittance(&self, x: DVec3, toward: DVec3, distance: f64, hits: &mut Vec<Hit>) -> f64 {
+        let shadow = Ray {
+            origin: x,
+            direction: toward,
+        };
+        self.bvh.all_hits(&shadow, 0.0, distance, hits);
+        let mut depth = 0.0;
+        for h in hits.iter() {
+            let g = &self.gaussians[h.index as usize];
+            depth += GaussianAlongRay::new(&shadow, g.center, &g.shape, g.sigma)
+                .optical_depth(0.0, distance);
+        }
+        (-depth).exp()
+    }
+
+    /// The colour of a window's Gaussian in the model's constant part, k·Cᵢ.
     #[inline]
     fn color_of(&self, w: &Window) -> DVec3 {
-        self.gaussians[w.index as usize].color
+        self.gaussians[w.index as usize].emitted
     }
 }
 
@@ -454,8 +654,9 @@ impl RadianceEstimator for GaussianRenderer {
 
 /// Cuts the ray into `s.points`: the windows' ends and centres, thinned so that neighbouring
 /// cuts are at least [`PIECE_WIDTH`] mean standard deviations apart (the quadrature splits where
-/// a piece needs it; an evaluation costs the windows that hold the node, not the piece's).
-fn cut_pieces(s: &mut Scratch) {
+/// a piece needs it; an evaluation costs the windows that hold the node, not the piece's), and
+/// the point of the ray nearest to each point light, where its irradiance peaks.
+fn cut_pieces(s: &mut Scratch, lights: &[Light], ray: &Ray) {
     s.cuts.clear();
     let mut mean_s = 0.0;
     for w in &s.windows {
@@ -470,6 +671,19 @@ fn cut_pieces(s: &mut Scratch) {
         s.cuts.push((w.hi, own));
         if w.profile.t_star > w.lo && w.profile.t_star < w.hi {
             s.cuts.push((w.profile.t_star, own));
+        }
+    }
+    if let (Some(first), Some(last)) = (
+        s.windows.iter().map(|w| w.lo).reduce(f64::min),
+        s.windows.iter().map(|w| w.hi).reduce(f64::max),
+    ) {
+        for light in lights {
+            if let Light::Point { position, .. } = *light {
+                let nearest = (position - ray.origin).dot(ray.direction);
+                if nearest > first && nearest < last {
+                    s.cuts.push((nearest, true));
+                }
+            }
         }
     }
     s.cuts

@@ -382,6 +382,53 @@ fn gaussian_particles_render_exactly_and_what_cannot_draw_them_exits_2() {
         }
     }
     assert!(lit > 20, "the Gaussians hardly show");
+    // Single-scatter with a = 1 and a sun: Q = E + α·E_l·T_l/4π ≥ E at every point, so every
+    // pixel is at least the emission image's (within the two errs), and brighter where lit.
+    let sunny = dir.path().join("sunny.toml");
+    std::fs::write(
+        &sunny,
+        format!("{text}\n[[lights]]\ntype = \"directional\"\ndirection = [0.3, -1.0, 0.4]\nirradiance = [6.0, 6.0, 6.0]\n"),
+    )
+    .expect("write the scene");
+    let scattered = dir.path().join("scattered.exr");
+    let out = pgt(&[
+        "render",
+        s(&sunny),
+        "--model",
+        "single-scatter",
+        "-o",
+        s(&scattered),
+        "--size",
+        "24x24",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let c = pgt::image_io::read_exr_layer(&scattered, "").expect("single-scatter");
+    let c_err = pgt::image_io::read_exr_layer(&scattered, "err").expect("its err layer");
+    let mut brighter = 0;
+    for i in 0..a.pixels.len() {
+        for ch in 0..3 {
+            assert!(
+                c_err.pixels[i][ch] <= 1e-5,
+                "pixel {i}: err {}",
+                c_err.pixels[i][ch]
+            );
+            let bound = err_layer.pixels[i][ch] + c_err.pixels[i][ch];
+            assert!(
+                c.pixels[i][ch] >= a.pixels[i][ch] - bound,
+                "pixel {i} channel {ch}: {} below the emission image's {}",
+                c.pixels[i][ch],
+                a.pixels[i][ch]
+            );
+            if c.pixels[i][ch] > a.pixels[i][ch] + 0.01 {
+                brighter += 1;
+            }
+        }
+    }
+    assert!(brighter > 20, "the sun hardly shows");
     for (args, words) in [
         (vec!["render", &scene, "--model", "lit"], "lit model"),
         (vec!["render", &scene, "--mode", "opaque"], "no surface"),
