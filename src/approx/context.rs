@@ -136,6 +136,17 @@ impl GpuContext {
                 .unwrap_or(&adapters[0]),
         };
         let info = adapter.get_info();
+        let storage = super::contract::BINDINGS
+            .iter()
+            .filter(|b| b.kind != super::contract::BindingKind::Uniform)
+            .count() as u32;
+        let allowed = adapter.limits().max_storage_buffers_per_shader_stage;
+        if allowed < storage {
+            return Err(PgtError::Gpu(format!(
+                "{} allows {allowed} storage buffers per shader stage; pgt's programs bind {storage} (docs/user-shaders.md)",
+                info.name
+            )));
+        }
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
         let required_features = if timestamps {
             wgpu::Features::TIMESTAMP_QUERY

@@ -552,6 +552,7 @@ impl GaussianRenderer {
         if !s.pieces.is_empty() {
             let (windows, members, deviations) = (&s.windows, &s.members, &s.deviations);
             let hits = &mut s.shadow_hits;
+            let scatters = !self.lights.is_empty();
             let integrand = |tag: usize, t: f64| {
                 let d = &deviations[tag];
                 let mut tau = 0.0;
@@ -570,11 +571,13 @@ impl GaussianRenderer {
                     let density = w.profile.density(t);
                     let g = &self.gaussians[w.index as usize];
                     sum += density * (g.emitted - d.reference);
-                    sigma += density;
-                    color += density * g.color;
-                    albedo += density * g.albedo;
+                    if scatters {
+                        sigma += density;
+                        color += density * g.color;
+                        albedo += density * g.albedo;
+                    }
                 }
-                if sigma > 0.0 && !self.lights.is_empty() {
+                if sigma > 0.0 {
                     let x = ray.at(t);
                     let here = Interval {
                         t0: t,

@@ -6,19 +6,12 @@
 # gauss-ray. Needs pgt on PATH (cargo build --release; export PATH=$PWD/target/release:$PATH)
 # and ../shared/data beside the repository.
 #
-# Attribution (docs/design.md §5 "Sweeps and error attribution"): each step of the chain
-# reference → gauss-ray → splat-pixel-sort → splat changes one thing, and NAME_step_STEP.json
-# compares its two ends:
-#   model       gauss-ray against the reference: α = min(0.99, o·e^{−½m*²}) per Gaussian,
-#               blended in order, against the emission–absorption integral of their sum
-#   projection  splat-pixel-sort against gauss-ray: the EWA footprint (perspective Jacobian at
-#               the centre, +0.3 px², 3σ cut) against the exact maximum along the ray, both
-#               blended in the order of the peak's depth
-#   sorting     splat against splat-pixel-sort: one global order by centre depth against the
-#               per-pixel order
-# NAME_METHOD.json compares each method with the reference, the report NAME_splat/ shows splat
-# against it, and attribution.py turns the JSON into attribution.md (the chain's maps add up to
-# splat − reference exactly).
+# Attribution (docs/design.md §5 "Sweeps and error attribution"): NAME_experiment.toml is a
+# `pgt sweep` experiment with the three methods and the chain splat → splat-pixel-sort →
+# gauss-ray → reference, one change a step (sorting, projection, model; the file says what
+# each changes); its report NAME_sweep/ holds the table, the attribution's shares and the
+# causes' error maps (they add up to splat − reference exactly). NAME_METHOD.json compares each
+# method with the reference, and the report NAME_splat/ shows splat against it.
 set -eu
 cd "$(dirname "$0")"
 for f in lod3_tile_0 fruit_drops_minimal; do
@@ -28,11 +21,9 @@ for f in lod3_tile_0 fruit_drops_minimal; do
         pgt compare "${f}_reference.exr" "${f}_$m.exr" --json "${f}_$m.json"
     done
     pgt compare "${f}_reference.exr" "${f}_splat.exr" --report "${f}_splat" > /dev/null
-    pgt compare "${f}_reference.exr" "${f}_gauss-ray.exr" --json "${f}_step_model.json"
-    pgt compare "${f}_gauss-ray.exr" "${f}_splat-pixel-sort.exr" --json "${f}_step_projection.json"
-    pgt compare "${f}_splat-pixel-sort.exr" "${f}_splat.exr" --json "${f}_step_sorting.json"
+    rm -rf "${f}_sweep"
+    pgt sweep "${f}_experiment.toml" --report "${f}_sweep"
 done
-python3 attribution.py > attribution.md
 
 # An orbit of lod3_tile_0 (lod3_orbit.toml: 12 frames, 6° a frame, 128x128), exactly and with
 # splat and splat-pixel-sort: the sequence reports show where splatting pops (its global order
