@@ -628,7 +628,12 @@ fn design_citations(text: &str) -> Vec<(usize, u32)> {
     for (n, line) in text.lines().enumerate() {
         for (i, _) in line.match_indices('§') {
             let before = &line[..i];
-            let window = &before[before.len().saturating_sub(40)..];
+            // The last 40 bytes, moved forward to a character boundary.
+            let mut start = before.len().saturating_sub(40);
+            while !before.is_char_boundary(start) {
+                start += 1;
+            }
+            let window = &before[start..];
             if window.contains("paper") || window.contains("14772") || window.contains("thesis §")
             {
                 continue;
@@ -793,6 +798,11 @@ fn the_docs_scans_find_what_they_should() {
     // Citations: design sections, not a paper's or a standard's.
     let text = "/// docs/design.md §2, and §8\n/// (paper §3.1) ISO/IEC 14772-1 §5.1\n";
     assert_eq!(design_citations(text), vec![(1, 2), (1, 8)]);
+    // A window of 40 bytes that would start inside a character moves to the next one.
+    assert_eq!(
+        design_citations("//! ··········· (docs/design.md §2)"),
+        vec![(1, 2)]
+    );
     assert_eq!(
         docs_mentions("see docs/performance.md, \"Exponentials\"; docs/cli.md."),
         vec![

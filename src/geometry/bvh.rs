@@ -284,6 +284,18 @@ impl Bvh {
         best
     }
 
+    /// Visits every sphere whose chord overlaps (t_min, t_max), nearer boxes first (not sorted:
+    /// the tree's order, the same on every run), until `visit` returns true.
+    pub fn visit_hits(
+        &self,
+        ray: &Ray,
+        t_min: f64,
+        t_max: f64,
+        mut visit: impl FnMut(u32, Chord) -> bool,
+    ) {
+        self.traverse(ray, t_min, t_max, |index, chord, _| visit(index, chord));
+    }
+
     /// Visits every sphere whose chord overlaps (t_min, limit), nearer boxes first; `visit` may
     /// lower `limit` (nearest-hit search) and returns true to stop.
     fn traverse(

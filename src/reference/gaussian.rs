@@ -47,7 +47,10 @@
 //! ray (`Light::max_irradiance_beyond`, +∞ for a ray through a point light, which is then
 //! reported as not converged); and each shadow ray leaves out at most the same missed depth
 //! Δ_far as a camera ray, so the rendered T_l is at most e^{Δ_far} times the true one and the
-//! scattered radiance is high by at most (L + err)·(1 − e^{−Δ_far}).
+//! scattered radiance is high by at most (L + err)·(1 − e^{−Δ_far}). A shadow ray stops once
+//! its depth reaches D with e^{−D}·Σ_l q̂_l ≤ tol/16 (q̂_l the bound of light l's part on this
+//! ray): its T_l is then high by at most e^{−D}, the pixel by at most e^{−D}·Σ_l q̂_l, which goes
+//! into err where a shadow ray stopped; that tol/16 comes out of the quadrature's tol/2.
 
 use super::quadrature::{integrate_adaptive, Piece};
 use super::volume::MAX_SEGMENTS;
@@ -156,7 +159,6 @@ struct Scratch {
     members: Vec<Member>,
     deviations: Vec<Deviation>,
     pieces: Vec<Piece>,
-    shadow_hits: Vec<Hit>,
 }
 
 thread_local! {
@@ -168,33 +170,9 @@ impl GaussianRenderer {
     /// scene, the opaque mode, a model that needs the shadow rays' radiance (lit), an infinite
     /// peak density, a negative colour, albedo or light).
     pub fn new(scene: &Scene, integrator: Integrator) -> Result<GaussianRenderer> {
+        check(scene, integrator)?;
         let refuse = |why: String| Err(PgtError::Usage(why));
-        if scene
-            .particles
-            .iter()
-            .any(|p| p.profile != Profile::Gaussian)
-        {
-            return refuse(
-                "this scene mixes particles of constant and Gaussian density; the reference renders a scene of one kind (docs/design.md §9)".into(),
-            );
-        }
-        if scene.render.mode != RenderMode::Volume {
-            return refuse(
-                "Gaussian particles have no surface: the opaque mode does not draw them (use mode = \"volume\")".into(),
-            );
-        }
         let model = scene.render.model.model();
-        if model.light_need() == LightNeed::Radiance {
-            return refuse(format!(
-                "the {} model's shadow rays composite coloured emission, which the reference does not integrate through Gaussian particles (docs/design.md §9): pass --model emission or --model single-scatter",
-                model.name()
-            ));
-        }
-        if let Integrator::Riemann { .. } = integrator {
-            return refuse(
-                "the Riemann sums apply to particles of constant density; Gaussian particles are integrated adaptively".into(),
-            );
-        }
         let mut gaussians = Vec::with_capacity(scene.particles.len());
         for (i, p) in scene.particles.iter().enumerate() {
             if !p.sigma.is_finite() {
@@ -236,14 +214,6 @@ impl GaussianRenderer {
         } else {
             scene.lights.clone()
         };
-        if lights.iter().any(|l| match *l {
-            Light::Directional { irradiance, .. } => !irradiance.cmpge(DVec3::ZERO).all(),
-            Light::Point { intensity, .. } => !intensity.cmpge(DVec3::ZERO).all(),
-        }) {
-            return refuse(
-                "a light has a negative irradiance or intensity; the reference's bound on what it leaves out of a Gaussian scene needs them ≥ 0".into(),
-            );
-        }
         let background = scene.render.background;
         let bound = gaussians.iter().fold(background, |m, g| m.max(g.emitted));
         let max_emitted = gaussians.iter().fold(DVec3::ZERO, |m, g| m.max(g.emitted));
@@ -295,8 +265,9 @@ impl GaussianRenderer {
         Ok(renderer)
     }
 
-    /// M of this ray per channel: a bound of Q at every point of the ray, and of L_bg.
-    fn source_bound(&self, ray: &Ray) -> DVec3 {
+    /// M of this ray per channel: a bound of Q at every point of the ray, and of L_bg; and
+    /// Σ_l q̂_l, the bound of the lights' part of Q alone.
+    fn source_bound(&self, ray: &Ray) -> (DVec3, DVec3) {
         let mut q = self.bound;
         let mut scattered = DVec3::ZERO;
         for light in &self.lights {
@@ -306,7 +277,7 @@ impl GaussianRenderer {
         if scattered != DVec3::ZERO {
             q = q.max(self.max_emitted + scattered);
         }
-        q
+        (q, scattered)
     }
 
     /// M for choosing the cut-off: as [`GaussianRenderer::source_bound`], with each point
@@ -350,7 +321,7 @@ impl GaussianRenderer {
     }
 
     fn radiance_with(&self, ray: &Ray, s: &mut Scratch) -> Sample {
-        let bound = self.source_bound(ray);
+        let (bound, scattered) = self.source_bound(ray);
         let m_max = bound.max_element();
         if m_max == 0.0 {
             // Every colour, light and the background are black: L = 0 whatever the densities.
@@ -368,7 +339,17 @@ impl GaussianRenderer {
         let delta = self.far_depth + self.gather(ray, s, budget);
         cut_pieces(s, &self.lights, ray);
         let (mut radiance, mut error) = self.sweep(s, bound);
-        let (converged, shadow_rays) = self.deviations(ray, s, &mut radiance, &mut error);
+        let q = scattered.max_element();
+        let stop_depth = if q > 0.0 && q.is_finite() {
+            (16.0 * q / self.tol).ln().max(0.0)
+        } else {
+            f64::INFINITY
+        };
+        let (converged, shadow_rays, stopped) =
+            self.deviations(ray, s, stop_depth, &mut radiance, &mut error);
+        if stopped {
+            error += scattered * (-stop_depth).exp();
+        }
 
         if !self.lights.is_empty() {
             // The scattered part is at most the whole radiance; the shadow rays' missed depth
@@ -538,20 +519,22 @@ impl GaussianRenderer {
     }
 
     /// The colour deviations of the queued pieces, and the lights' part where they scatter, by
-    /// adaptive Gauss–Kronrod with tol/2, added to `radiance` and their estimate to `error`;
-    /// whether the quadrature converged, and the number of shadow rays traced.
+    /// adaptive Gauss–Kronrod with tol/2 (7·tol/16 where a shadow ray may stop), added to
+    /// `radiance` and their estimate to `error`; whether the quadrature converged, the number of
+    /// shadow rays traced and whether one stopped at `stop_depth`.
     fn deviations(
         &self,
         ray: &Ray,
         s: &mut Scratch,
+        stop_depth: f64,
         radiance: &mut DVec3,
         error: &mut DVec3,
-    ) -> (bool, u64) {
+    ) -> (bool, u64, bool) {
         let mut converged = true;
         let mut shadow_rays = 0;
+        let mut stopped = false;
         if !s.pieces.is_empty() {
             let (windows, members, deviations) = (&s.windows, &s.members, &s.deviations);
-            let hits = &mut s.shadow_hits;
             let scatters = !self.lights.is_empty();
             let integrand = |tag: usize, t: f64| {
                 let d = &deviations[tag];
@@ -591,24 +574,28 @@ impl GaussianRenderer {
                             continue;
                         };
                         shadow_rays += 1;
+                        let (transmittance, cut) =
+                            self.transmittance(x, incident.toward, incident.distance, stop_depth);
+                        stopped |= cut;
                         let sample = LightSample {
                             radiance: DVec3::ZERO,
                             irradiance: incident.irradiance,
-                            transmittance: self.transmittance(
-                                x,
-                                incident.toward,
-                                incident.distance,
-                                hits,
-                            ),
+                            transmittance,
                         };
                         sum += sigma * self.model.light_source(&self.params, &here, &sample);
                     }
                 }
                 (-tau).exp() * sum
             };
+            // A shadow ray that may stop takes its tol/16 from the quadrature's half.
+            let quadrature_tol = if stop_depth.is_finite() {
+                7.0 / 16.0 * self.tol
+            } else {
+                0.5 * self.tol
+            };
             let result = integrate_adaptive(
                 &s.pieces,
-                0.5 * self.tol,
+                quadrature_tol,
                 MAX_SEGMENTS,
                 integrand,
                 |_, _, _| None,
@@ -618,24 +605,33 @@ impl GaussianRenderer {
             *error += result.error;
             converged = result.converged;
         }
-        (converged, shadow_rays)
+        (converged, shadow_rays, stopped)
     }
 
     /// T_l: the transmittance from `x` over `distance` along `toward` (unit) through the
-    /// Gaussians whose k-σ ellipsoid that stretch meets, in closed form.
-    fn transmittance(&self, x: DVec3, toward: DVec3, distance: f64, hits: &mut Vec<Hit>) -> f64 {
+    /// Gaussians whose k-σ ellipsoid that stretch meets, in closed form, in the BVH's order;
+    /// stopped once the depth reaches `stop_depth` (then true).
+    fn transmittance(
+        &self,
+        x: DVec3,
+        toward: DVec3,
+        distance: f64,
+        stop_depth: f64,
+    ) -> (f64, bool) {
         let shadow = Ray {
             origin: x,
             direction: toward,
         };
-        self.bvh.all_hits(&shadow, 0.0, distance, hits);
         let mut depth = 0.0;
-        for h in hits.iter() {
-            let g = &self.gaussians[h.index as usize];
+        let mut stopped = false;
+        self.bvh.visit_hits(&shadow, 0.0, distance, |index, _| {
+            let g = &self.gaussians[index as usize];
             depth += GaussianAlongRay::new(&shadow, g.center, &g.shape, g.sigma)
                 .optical_depth(0.0, distance);
-        }
-        (-depth).exp()
+            stopped = depth >= stop_depth;
+            stopped
+        });
+        ((-depth).exp(), stopped)
     }
 
     /// The colour of a window's Gaussian in the model's constant part, k·Cᵢ.
@@ -653,6 +649,50 @@ impl RadianceEstimator for GaussianRenderer {
     fn estimates_error(&self) -> bool {
         true
     }
+}
+
+/// The scene-wide reasons the renderer refuses `scene` (each by name): a mixed scene, the
+/// opaque mode, a model that needs the shadow rays' radiance (lit), the Riemann sums, a
+/// negative light.
+fn check(scene: &Scene, integrator: Integrator) -> Result<()> {
+    let refuse = |why: String| Err(PgtError::Usage(why));
+    if scene
+        .particles
+        .iter()
+        .any(|p| p.profile != Profile::Gaussian)
+    {
+        return refuse(
+            "this scene mixes particles of constant and Gaussian density; the reference renders a scene of one kind (docs/design.md §9)".into(),
+        );
+    }
+    if scene.render.mode != RenderMode::Volume {
+        return refuse(
+            "Gaussian particles have no surface: the opaque mode does not draw them (use mode = \"volume\")".into(),
+        );
+    }
+    let model = scene.render.model.model();
+    if model.light_need() == LightNeed::Radiance {
+        return refuse(format!(
+            "the {} model's shadow rays composite coloured emission, which the reference does not integrate through Gaussian particles (docs/design.md §9): pass --model emission or --model single-scatter",
+            model.name()
+        ));
+    }
+    if let Integrator::Riemann { .. } = integrator {
+        return refuse(
+            "the Riemann sums apply to particles of constant density; Gaussian particles are integrated adaptively".into(),
+        );
+    }
+    if model.light_need() != LightNeed::None
+        && scene.lights.iter().any(|l| match *l {
+            Light::Directional { irradiance, .. } => !irradiance.cmpge(DVec3::ZERO).all(),
+            Light::Point { intensity, .. } => !intensity.cmpge(DVec3::ZERO).all(),
+        })
+    {
+        return refuse(
+            "a light has a negative irradiance or intensity; the reference's bound on what it leaves out of a Gaussian scene needs them ≥ 0".into(),
+        );
+    }
+    Ok(())
 }
 
 /// Cuts the ray into `s.points`: the windows' ends and centres, thinned so that neighbouring
