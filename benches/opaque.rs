@@ -44,6 +44,7 @@ fn random_scene(n: usize, size: u32) -> Scene {
         lights: thesis_lights(),
         particles,
         warnings: vec![],
+        provenance: Default::default(),
     }
 }
 

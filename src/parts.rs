@@ -154,8 +154,9 @@ pub fn render_hash(scene: &Scene, options: &RenderOptions) -> String {
 /// every particle's bits.
 pub fn hash_with(scene: &Scene, what: &str) -> String {
     let mut h = Fnv128(0x6c62_272e_07bb_0142_62b8_2175_6295_c58d);
-    // Every field but the file name and the warnings (the pattern names every field, so a new
-    // one does not compile until it is placed here); the particles follow as bits.
+    // Every field but the file name, the warnings and the provenance (where settings were
+    // chosen changes messages, not pixels; the pattern names every field, so a new one does not
+    // compile until it is placed here); the particles follow as bits.
     let Scene {
         source: _,
         camera,
@@ -163,6 +164,7 @@ pub fn hash_with(scene: &Scene, what: &str) -> String {
         lights,
         particles,
         warnings: _,
+        provenance: _,
     } = scene;
     // Writing into the hasher cannot fail.
     let _ = write!(

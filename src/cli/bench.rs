@@ -405,6 +405,7 @@ fn bare_scene(particles: Vec<Particle>, size: u32) -> Scene {
         lights: thesis_lights(),
         particles,
         warnings: Vec::new(),
+        provenance: Default::default(),
     }
 }
 

@@ -31,7 +31,7 @@ pub struct ParticleRecord {
 
 /// An ellipsoid as a file gives it (docs/design.md §9), checked by
 /// [`check_records`](super::check_records) and resolved (the quaternion normalised) when the
-/// scene is built (`scene::validate`).
+/// scene is built (`scene::load`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct EllipsoidRecord {
     /// Semi-axes along the body's x, y, z, in the file's length unit.

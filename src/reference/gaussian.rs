@@ -63,7 +63,7 @@ use crate::optics::light::Light;
 use crate::optics::model::{LightNeed, OpticalModel};
 use crate::optics::source::{LightSample, SourceParams};
 use crate::optics::Profile;
-use crate::scene::{RenderMode, Scene};
+use crate::scene::{RenderMode, Scene, Setting};
 use glam::{DQuat, DVec3};
 use std::cell::RefCell;
 
@@ -661,26 +661,28 @@ fn check(scene: &Scene, integrator: Integrator) -> Result<()> {
         .iter()
         .any(|p| p.profile != Profile::Gaussian)
     {
-        return refuse(
-            "this scene mixes particles of constant and Gaussian density; the reference renders a scene of one kind (docs/design.md §9)".into(),
-        );
+        return Err(scene.mixed_density_refused(
+            "the reference renders a scene of one kind (docs/design.md §9)",
+        ));
     }
     if scene.render.mode != RenderMode::Volume {
-        return refuse(
-            "Gaussian particles have no surface: the opaque mode does not draw them (use mode = \"volume\")".into(),
-        );
+        return Err(scene.gaussians_refused(
+            Setting::Mode,
+            "Gaussian particles have no surface: the opaque mode does not draw them (render them in the volume mode)",
+        ));
     }
     let model = scene.render.model.model();
     if model.light_need() == LightNeed::Radiance {
-        return refuse(format!(
-            "the {} model's shadow rays composite coloured emission, which the reference does not integrate through Gaussian particles (docs/design.md §9): pass --model emission or --model single-scatter",
+        return Err(scene.gaussians_refused(Setting::Model, &format!(
+            "the {} model's shadow rays composite coloured emission, which the reference does not integrate through Gaussian particles (docs/design.md §9): choose model = \"emission\" or \"single-scatter\" ([render], or --model)",
             model.name()
-        ));
+        )));
     }
     if let Integrator::Riemann { .. } = integrator {
-        return refuse(
-            "the Riemann sums apply to particles of constant density; Gaussian particles are integrated adaptively".into(),
-        );
+        return Err(scene.gaussians_refused(
+            Setting::Flag("--integrator riemann"),
+            "the Riemann sums apply to particles of constant density; Gaussian particles are integrated adaptively",
+        ));
     }
     if model.light_need() != LightNeed::None
         && scene.lights.iter().any(|l| match *l {

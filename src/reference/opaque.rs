@@ -167,6 +167,7 @@ mod tests {
             lights,
             particles,
             warnings: vec![],
+            provenance: Default::default(),
         }
     }
 

@@ -13,7 +13,7 @@
 //! include on demand (nothing holds more than the frame being built) and is `&self`, so workers
 //! may build different frames at once.
 
-use super::validate::{load_bare, load_toml, IncludeGroup, Loaded, ParticleMaker};
+use super::load::{load_bare, load_toml, IncludeGroup, Loaded, ParticleMaker};
 use super::{Scene, SceneLoadOptions};
 use crate::error::{PgtError, Result};
 use crate::formats::frames::{open_frames, uses_frames, FrameInfo, FrameSelection, FrameSource};
@@ -186,6 +186,7 @@ impl SceneFrames {
             lights: self.first.lights.clone(),
             particles,
             warnings,
+            provenance: self.first.provenance.clone(),
         })
     }
 }

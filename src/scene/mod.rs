@@ -1,16 +1,20 @@
 //! The scene model of docs/design.md §1: particles, lights, camera and render settings, already
 //! validated and resolved (σ computed, defaults applied). `file` holds the TOML format and
-//! `validate` turns it into a [`Scene`], with errors that name the file, line and field.
+//! `load` turns it into a [`Scene`], step by step, with errors that name the file, line and
+//! field; `provenance` keeps where the settings were chosen, for the errors of renderers that
+//! refuse a combination of them.
 
 mod file;
 mod frames;
 mod framing;
-mod validate;
+mod load;
+mod provenance;
 
 pub use crate::formats::{ColorBy, IncludeSpec, ParticleRecord};
 pub use frames::SceneFrames;
 pub use framing::{bounding_sphere, default_camera, thesis_lights};
-pub use validate::checked_tol_override;
+pub use load::checked_tol_override;
+pub use provenance::{Origin, ParticleOrigin, ParticleSource, Provenance, Setting};
 // The light physics, the resolved particle and the optical models live in `optics` (the scene
 // builds on optics, never the reverse); re-exported so that `scene::Light` etc. keep working.
 pub use crate::optics::light::{Falloff, Incident, Light, LightWeight};
@@ -83,6 +87,10 @@ pub struct Scene {
     pub particles: Vec<Particle>,
     /// Non-fatal remarks for the user (an empty scene, skipped shapes, …).
     pub warnings: Vec<String>,
+    /// Where the mode, the model and the particles' densities were chosen, for the messages of
+    /// renderers that refuse a combination of them ([`Scene::gaussians_refused`]); the default
+    /// (nothing chosen anywhere) for a scene a program builds.
+    pub provenance: Provenance,
 }
 
 /// Command-line overrides of the scene (docs/design.md §1: flags override the scene).
@@ -158,13 +166,13 @@ impl Scene {
             let text = std::fs::read_to_string(path).map_err(|e| PgtError::io(path, e))?;
             Scene::from_toml_str(&text, path, options)
         } else {
-            validate::bare_particle_file(path, options)
+            load::bare_particle_file(path, options)
         }
     }
 
     /// Parses and validates scene TOML text; `path` names it in messages and anchors includes.
     pub fn from_toml_str(text: &str, path: &Path, options: &SceneLoadOptions) -> Result<Scene> {
-        validate::scene_from_toml(text, path, options)
+        load::scene_from_toml(text, path, options)
     }
 
     /// A scene from settings and particles given by a program (the Python package's
@@ -179,7 +187,7 @@ impl Scene {
         particles: impl IntoIterator<Item = ParticleInput>,
         default_lights: bool,
     ) -> Result<Scene> {
-        validate::scene_from_toml_and_particles(
+        load::scene_from_toml_and_particles(
             settings,
             name,
             options,

@@ -488,7 +488,11 @@ fn an_unreadable_include_says_which_folder_its_path_is_relative_to() {
     let o = pgt(&["info", s(&scene)]);
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(err.contains(&format!("{}:1", scene.display())), "{err}");
+    // Named at the line of the `path` key that names the file.
+    assert!(
+        err.contains(&format!("{}:2: include.path: cannot read", scene.display())),
+        "{err}"
+    );
     assert!(
         err.contains("`data/missing.pdb` is taken relative to")
             && err.contains(&format!("{}, the scene file's folder", scenes.display())),

@@ -81,6 +81,7 @@ pub fn scene(
         lights,
         particles,
         warnings: vec![],
+        provenance: Default::default(),
     }
 }
 

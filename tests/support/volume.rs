@@ -78,6 +78,7 @@ pub fn scene(model: Model, particles: Vec<Particle>, lights: Vec<Light>, size: u
         lights,
         particles,
         warnings: vec![],
+        provenance: Default::default(),
     }
 }
 

@@ -63,6 +63,7 @@ fn roof_scene(model: Model, tol: f64) -> Scene {
         }],
         particles,
         warnings: vec![],
+        provenance: Default::default(),
     }
 }
 
