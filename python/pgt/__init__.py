@@ -90,8 +90,9 @@ def load_scene(
     format: Optional[str] = None,
 ) -> Scene:
     """Load a scene: a scene file (.toml) or a bare particle file (PDB, mmCIF, VRML, MMPLD,
-    XYZ, CSV), which gets the default scene (camera framing the particles from -z, the
-    thesis's two lights, black background).
+    XYZ, CSV, GRO, PLY), which gets the default scene (camera framing the particles from -z,
+    the thesis's two lights, black background). A scene moves when its includes play frames
+    (trajectories, models, sequences): see ``load_frames``.
 
     Arguments (the overrides of ``pgt render SCENE``):
       path   scene file (.toml) or a bare particle file.

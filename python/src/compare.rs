@@ -94,7 +94,8 @@ impl From<&LibGateCheck> for GateCheck {
 }
 
 /// A gate evaluated on a comparison, as `pgt compare --gate` evaluates it. True in a boolean
-/// context when every threshold passed: `assert result, result.verdict` in a test.
+/// context when every threshold passed: `assert (g := cmp.gate(...)), g.verdict` in a test
+/// (the verdict names the thresholds that failed).
 #[pyclass(frozen, module = "pgt")]
 pub struct GateResult {
     /// True when every threshold passed, False when one failed, None for an empty gate.
@@ -122,6 +123,11 @@ impl GateResult {
 
     fn __repr__(&self) -> String {
         format!("<pgt.GateResult {}>", self.verdict)
+    }
+
+    /// The verdict, so that an assertion on the result shows which threshold failed.
+    fn __str__(&self) -> String {
+        self.verdict.clone()
     }
 }
 

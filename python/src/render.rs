@@ -215,6 +215,13 @@ pub fn render(
     if let Some(w) = pgt::cli::render::unconverged_warning(&s, scene.render.tol) {
         warn(py, &w, 2)?;
     }
+    let above_tol = out
+        .error
+        .as_ref()
+        .and_then(|err| pgt::reference::err_above_tol_warning(err, scene.render.tol, scene));
+    if let Some(w) = above_tol {
+        warn(py, &w, 2)?;
+    }
     Ok(RenderResult {
         image: image_to_array(py, out.image).unbind(),
         err: out.error.map(|e| image_to_array(py, e).unbind()),

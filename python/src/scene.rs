@@ -431,7 +431,7 @@ impl Scene {
         )?;
         out.set_item("convention", &projection.convention)?;
         out.set_item("eye", vec3(cam.eye))?;
-        out.set_item("look_at", vec3(cam.look_at))?;
+        out.set_item("eye_plus_forward", vec3(cam.eye_plus_forward))?;
         out.set_item("forward", vec3(cam.forward))?;
         out.set_item("right", vec3(cam.right))?;
         out.set_item("up", vec3(cam.up))?;

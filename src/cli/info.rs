@@ -4,7 +4,7 @@
 
 use super::Outcome;
 use crate::formats::frames::{open_frames, FrameInfo};
-use crate::formats::topology::{trajectory_format_of, trajectory_summary};
+use crate::formats::topology::{trajectory_format_of, trajectory_summary, TRAJECTORY_FORMATS};
 use crate::formats::{format_of, load_bytes, read_input, Format, IncludeSpec, FORMATS};
 use crate::scene::{SceneFrames, SceneLoadOptions};
 use clap::Args;
@@ -15,7 +15,7 @@ use std::path::PathBuf;
 /// Options of `pgt info`.
 #[derive(Debug, Args)]
 pub struct InfoArgs {
-    /// A particle file or a scene file (.toml).
+    /// A particle file, an MD trajectory or a scene file (.toml).
     #[arg(long_help = file_help())]
     pub file: PathBuf,
     /// Print JSON on stdout instead of text.
@@ -30,8 +30,8 @@ pub struct InfoArgs {
 /// `pgt info --help` for FILE, from the table of formats.
 fn file_help() -> String {
     let mut help = String::from(
-        "A particle file or a scene file (.toml). Particle formats (the name for `--format` and \
-         for `format` in an [[include]], the extensions, the format):",
+        "A particle file, an MD trajectory or a scene file (.toml). Particle formats (the name for \
+         `--format` and for `format` in an [[include]], the extensions, the format):",
     );
     for f in FORMATS {
         let ext: Vec<String> = f.extensions.iter().map(|e| format!(".{e}")).collect();
@@ -42,6 +42,25 @@ fn file_help() -> String {
             f.description
         ));
     }
+    help.push_str(
+        "\nMD trajectories (alone, or in a scene as `trajectory = \"…\"` beside a topology: PDB, \
+         mmCIF, GRO or PSF):",
+    );
+    for f in TRAJECTORY_FORMATS {
+        let ext: Vec<String> = f.extensions.iter().map(|e| format!(".{e}")).collect();
+        help.push_str(&format!(
+            "\n  {:<6} {:<13} {}",
+            f.name,
+            ext.join(" "),
+            f.description
+        ));
+    }
+    help.push_str(
+        "\nA file or scene with frames (PDB models, MMPLD frames, XYZ frames, a trajectory, a \
+         sequence) also reports its frame count, the atoms per frame and the time step in ps \
+         where the file has one; a trajectory alone is summarised as its atoms at frame 0, as \
+         points.",
+    );
     help
 }
 
@@ -285,7 +304,7 @@ fn text_of(info: &Info) -> String {
         let step = f.time_step_ps.map_or("no time step".to_string(), |dt| {
             format!("time step {dt} ps")
         });
-        println!("frames:    {} ({atoms}, {step})", f.count);
+        let _ = writeln!(t, "frames:    {} ({atoms}, {step})", f.count);
     }
     for w in &info.warnings {
         let _ = writeln!(t, "warning:   {w}");

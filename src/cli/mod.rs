@@ -65,7 +65,8 @@ pub enum Command {
     Compare(compare::CompareArgs),
     /// Render the reference once and an approximation per parameter set; report with plots.
     Sweep(sweep::SweepArgs),
-    /// Particle count, bounds, radius range and colours of a particle or scene file.
+    /// Particle count, bounds, radius range and colours of a particle, trajectory or scene file,
+    /// and its frames (count, atoms per frame, time step) where it has them.
     Info(info::InfoArgs),
     /// Generate synthetic data sets (`pgt gen random`).
     Gen(gen::GenArgs),

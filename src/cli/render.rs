@@ -135,7 +135,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
     let rays = s.primary_rays + s.shadow_rays;
     let particles = particles_text(&scene);
     let mut line = format!(
-        "rendered {} ({}x{}, {particles}, {} lights) in {:.2} s: {} primary + {} shadow rays, {:.3} Mrays/s",
+        "rendered {} ({}x{}, {particles}, {} lights) in {:.2} s: {} primary + {} shadow rays, {}",
         args.output.display(),
         scene.camera.width,
         scene.camera.height,
@@ -143,13 +143,20 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
         s.seconds,
         s.primary_rays,
         s.shadow_rays,
-        rays as f64 / s.seconds.max(1e-9) / 1e6
+        ray_rate_text(rays, s.seconds)
     );
     if let (Some(max), Some(mean)) = (s.max_error, s.mean_error) {
         line += &format!(", error estimate max {max:.3e} mean {mean:.3e}");
     }
     eprintln!("{line}");
     if let Some(warning) = unconverged_warning(s, scene.render.tol) {
+        eprintln!("warning: {warning}");
+    }
+    let above_tol = out
+        .error
+        .as_ref()
+        .and_then(|err| reference::err_above_tol_warning(err, scene.render.tol, &scene));
+    if let Some(warning) = above_tol {
         eprintln!("warning: {warning}");
     }
     Ok(Outcome::Success)
@@ -244,6 +251,17 @@ fn render_frames(
 
 /// "11032 spheres", "4 particles, 3 of them ellipsoids" or "1971 Gaussians": the particles of a
 /// summary line.
+/// Rays per second in words: `R Mrays/s` with three decimals, or `R rays/s` where that would
+/// read 0.000 (a slow render of a small image).
+pub(crate) fn ray_rate_text(rays: u64, seconds: f64) -> String {
+    let rate = rays as f64 / seconds.max(1e-9);
+    if rate >= 1e3 {
+        format!("{:.3} Mrays/s", rate / 1e6)
+    } else {
+        format!("{rate:.1} rays/s")
+    }
+}
+
 pub(crate) fn particles_text(scene: &Scene) -> String {
     let n = scene.particles.len();
     if n > 0
@@ -265,5 +283,17 @@ pub(crate) fn particles_text(scene: &Scene) -> String {
             "{} particles, {n} of them ellipsoids",
             scene.particles.len()
         ),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ray_rate_text;
+
+    #[test]
+    fn slow_renders_state_their_rate_in_rays_not_zero_mrays() {
+        assert_eq!(ray_rate_text(4_096, 38.8), "105.6 rays/s");
+        assert_eq!(ray_rate_text(2_500_000, 2.0), "1.250 Mrays/s");
+        assert_eq!(ray_rate_text(1_000, 1.0), "0.001 Mrays/s");
     }
 }

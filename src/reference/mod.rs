@@ -353,6 +353,43 @@ pub fn worse_unconverged(
     }
 }
 
+/// docs/design.md §3 and §9: a pixel whose err exceeds `tol` although its quadrature converged
+/// is reported too (err also bounds what the reference leaves out: with Gaussians, the depth
+/// beyond the cut-off of k σ, so a small `gaussian_cutoff` makes err large everywhere). The
+/// count and the pixel with the largest err, or `None` when every err is within `tol`.
+pub fn err_above_tol_warning(err: &RgbImage, tol: f64, scene: &Scene) -> Option<String> {
+    let mut count = 0u64;
+    let mut worst: Option<(u32, u32, f64)> = None;
+    for (i, e) in err.pixels.iter().enumerate() {
+        let e = f64::from(e[0].max(e[1]).max(e[2]));
+        if e > tol {
+            count += 1;
+            let (px, py) = (
+                (i % err.width as usize) as u32,
+                (i / err.width as usize) as u32,
+            );
+            worst = worse_unconverged(worst, (px, py, e));
+        }
+    }
+    let (x, y, e) = worst?;
+    let gaussians = scene
+        .particles
+        .iter()
+        .any(|p| p.profile == crate::optics::Profile::Gaussian);
+    let why = match (gaussians, scene.render.gaussian_cutoff) {
+        (true, Some(k)) => format!(
+            ": it bounds the depth of the Gaussians the rays pass beyond the cut-off gaussian_cutoff = {k} σ; a larger cut-off (or none, to choose it from tol) makes it smaller"
+        ),
+        (true, None) => {
+            ": it bounds what the rays leave out (Gaussian tails, and with scattering lights the shadow rays' missed depth)".to_string()
+        }
+        (false, _) => String::new(),
+    };
+    Some(format!(
+        "{count} pixel(s) have err above tol {tol:e}; the largest is {e:.3e} at ({x}, {y}){why}"
+    ))
+}
+
 /// Runs `work` on a pool of `threads` workers (`--threads`), or on rayon's global pool.
 pub(crate) fn with_threads<T: Send>(
     threads: Option<usize>,
