@@ -212,7 +212,7 @@ pub fn render(
     })?
     .map_err(|e| to_py(py, e))?;
     let s = out.stats;
-    if let Some(w) = pgt::cli::render::unconverged_warning(&s, scene.render.tol) {
+    if let Some(w) = pgt::reference::unconverged_warning(&s, scene.render.tol) {
         warn(py, &w, 2)?;
     }
     let above_tol = out

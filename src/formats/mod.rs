@@ -16,6 +16,7 @@
 pub mod atoms;
 pub mod dcd;
 pub mod elements;
+pub mod export;
 pub mod frame_source;
 pub mod frames;
 pub mod gro;
@@ -27,6 +28,7 @@ pub mod profile;
 pub mod psf;
 pub mod random;
 pub mod record;
+pub mod summary;
 pub mod topology;
 pub mod vrml;
 pub mod xtc;

@@ -90,6 +90,16 @@ pub struct RenderStats {
     pub worst_unconverged: Option<(u32, u32, f64)>,
 }
 
+/// docs/design.md §3: a pixel that does not converge is reported, not hidden. The count and the pixel
+/// with the largest error estimate, or `None` when every pixel reached `tol`.
+pub fn unconverged_warning(stats: &RenderStats, tol: f64) -> Option<String> {
+    let (x, y, e) = stats.worst_unconverged?;
+    Some(format!(
+        "{} pixel(s) did not reach tol {tol:e}; the worst is ({x}, {y}) with error estimate {e:.3e} (its err value says how far off it may be)",
+        stats.unconverged
+    ))
+}
+
 /// A finished reference render.
 #[derive(Debug, Clone)]
 pub struct RenderOutput {
@@ -113,6 +123,32 @@ pub fn render_controlled(
 ) -> Result<RenderOutput> {
     let estimator = estimator_for(scene, options)?;
     render_with_control(&scene.camera, estimator.as_ref(), options, control)
+}
+
+/// A scene file rendered by the exact reference with its default options, as `pgt compare`
+/// renders a scene given in place of an image (docs/design.md §5): its warnings, the time taken
+/// and any pixel that did not reach `tol` are printed on stderr, a progress bar where stderr is
+/// a terminal.
+pub fn render_scene_file(path: &std::path::Path) -> anyhow::Result<RgbImage> {
+    use std::io::IsTerminal;
+    let scene = Scene::load(path, &crate::scene::SceneLoadOptions::default())?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    let options = RenderOptions {
+        progress: std::io::stderr().is_terminal(),
+        ..Default::default()
+    };
+    let out = render(&scene, &options)?;
+    eprintln!(
+        "rendered the reference of {} in {:.2} s",
+        path.display(),
+        out.stats.seconds
+    );
+    if let Some(w) = unconverged_warning(&out.stats, scene.render.tol) {
+        eprintln!("warning: {w}");
+    }
+    Ok(out.image)
 }
 
 /// Shared between a running render and the thread that waits for it: how many blocks of how
