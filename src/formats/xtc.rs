@@ -409,6 +409,23 @@ fn bits_of(size: u64) -> u32 {
     (64 - size.leading_zeros()).min(32)
 }
 
+/// The number of values each integer coordinate takes, max − min + 1, refused where the range
+/// is negative or exceeds what 32 bits hold.
+fn coordinate_sizes(minint: [i32; 3], maxint: [i32; 3]) -> std::result::Result<[u64; 3], Corrupt> {
+    let mut sizes = [0u64; 3];
+    for c in 0..3 {
+        let size = i64::from(maxint[c]) - i64::from(minint[c]) + 1;
+        if !(1..=i64::from(u32::MAX)).contains(&size) {
+            return Err((
+                0,
+                "the coordinate range (maximum − minimum) is negative or too large".to_string(),
+            ));
+        }
+        sizes[c] = size as u64;
+    }
+    Ok(sizes)
+}
+
 /// The integer positions of `atoms` atoms from a compressed block (the module doc's algorithm,
 /// libxdrfile's `xdrfile_decompress_coord_float` after the prelude). Errors carry the byte
 /// offset in the block.
@@ -420,17 +437,7 @@ fn decompress(
     smallidx: i32,
 ) -> std::result::Result<Vec<[i32; 3]>, Corrupt> {
     let corrupt = |at: usize, m: &str| -> Corrupt { (at as u64, m.to_string()) };
-    let mut sizes = [0u64; 3];
-    for c in 0..3 {
-        let size = i64::from(maxint[c]) - i64::from(minint[c]) + 1;
-        if !(1..=i64::from(u32::MAX)).contains(&size) {
-            return Err(corrupt(
-                0,
-                "the coordinate range (maximum − minimum) is negative or too large",
-            ));
-        }
-        sizes[c] = size as u64;
-    }
+    let sizes = coordinate_sizes(minint, maxint)?;
     let large = sizes.iter().any(|&s| s > 0xff_ffff);
     let field_bits = sizes.map(bits_of);
     let product_bits = 128
