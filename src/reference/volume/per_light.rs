@@ -281,15 +281,9 @@ impl VolumeRenderer<'_> {
         buffers: &mut ShadowBuffers,
     ) -> (DVec3, DVec3, bool) {
         let render = &self.scene.render;
-        let mut value = DVec3::ZERO;
+        let mut value = self.constant_part(intervals, pieces);
         let mut error = DVec3::ZERO;
         let mut unconverged = false;
-        let k = self.model.emission_factor(&self.params);
-        if k != 0.0 {
-            for p in pieces {
-                value += (p.weight * (p.hi - p.lo) * k) * intervals[p.tag].emission;
-            }
-        }
         let Some(first) = intervals.first() else {
             return (value, error, unconverged);
         };
@@ -310,18 +304,13 @@ impl VolumeRenderer<'_> {
             let Some(last) = intervals[..kept].last() else {
                 continue;
             };
-            buffers.wide.gather(
-                &self.bvh,
+            self.light_breakpoints(
                 ray,
-                (WHOLE_RAY_TAG, l),
-                light,
                 (first.t0, last.t1),
+                (l, light),
+                buffers,
+                (&mut marks, &mut kinks, &mut sides),
             );
-            self.breakpoints(ray, (first.t0, last.t1), light, &buffers.wide, &mut marks);
-            kinks.clear();
-            sides.clear();
-            kinks.extend(marks.iter().map(|&(t, _)| t));
-            sides.extend(marks.iter().map(|&(_, side)| side));
             split_at_kinks(pieces, intervals, &kinks, &mut split);
             let kink_in = |k: usize, lo: f64, hi: f64| {
                 let (a, b) = (t_of(k, lo), t_of(k, hi));
@@ -351,12 +340,7 @@ impl VolumeRenderer<'_> {
             buffers.shadow_cut = cut.map(|(epsilon, bound, _)| (epsilon, bound));
             buffers.was_cut = false;
             let tol = quadrature_tol(share);
-            // The largest channel of q_l's bound over each interval (∞ where none is known).
-            bounds.clear();
-            bounds.extend(intervals[..kept].iter().map(|iv| {
-                let q = self.source_bound(ray, iv.t0, light);
-                q.map_or(f64::INFINITY, |q| q.max_element())
-            }));
+            self.interval_bounds(ray, &intervals[..kept], light, &mut bounds);
             let singular_ends = |k: usize, lo: f64, hi: f64, hair: f64| {
                 let near = (t_of(k, lo - hair), t_of(k, hi + hair));
                 singular_ends(&kinks, &sides, &intervals[k], near, (lo, hi, hair))
@@ -392,6 +376,56 @@ impl VolumeRenderer<'_> {
             buffers.shadow_cut = None;
         }
         (value, error, unconverged)
+    }
+
+    /// The part of Q that does not depend on the lights (k·E, single-scatter's a·E), exact on
+    /// every piece: the weight times the piece's u-range times k·E.
+    fn constant_part(&self, intervals: &[Interval], pieces: &[Piece]) -> DVec3 {
+        let mut value = DVec3::ZERO;
+        let k = self.model.emission_factor(&self.params);
+        if k != 0.0 {
+            for p in pieces {
+                value += (p.weight * (p.hi - p.lo) * k) * intervals[p.tag].emission;
+            }
+        }
+        value
+    }
+
+    /// Light `l`'s breakpoints on `ray` in `span` ([`Self::breakpoints`], among the occluders
+    /// gathered towards it for the whole span into `buffers.wide`): the marks with their sides,
+    /// and the same as two lists of parameters and sides.
+    fn light_breakpoints(
+        &self,
+        ray: &Ray,
+        span: (f64, f64),
+        (l, light): (usize, &Light),
+        buffers: &mut ShadowBuffers,
+        (marks, kinks, sides): (&mut Vec<(f64, u8)>, &mut Vec<f64>, &mut Vec<u8>),
+    ) {
+        buffers
+            .wide
+            .gather(&self.bvh, ray, (WHOLE_RAY_TAG, l), light, span);
+        self.breakpoints(ray, span, light, &buffers.wide, marks);
+        kinks.clear();
+        sides.clear();
+        kinks.extend(marks.iter().map(|&(t, _)| t));
+        sides.extend(marks.iter().map(|&(_, side)| side));
+    }
+
+    /// The largest channel of light `light`'s source bound q_l over each interval, into `out`
+    /// (cleared first; ∞ where none is known).
+    fn interval_bounds(
+        &self,
+        ray: &Ray,
+        intervals: &[Interval],
+        light: &Light,
+        out: &mut Vec<f64>,
+    ) {
+        out.clear();
+        out.extend(intervals.iter().map(|iv| {
+            let q = self.source_bound(ray, iv.t0, light);
+            q.map_or(f64::INFINITY, |q| q.max_element())
+        }));
     }
 
     /// The breakpoints of light `light`'s integral along `ray` in (t_lo, t_hi), sorted, into
