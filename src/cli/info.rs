@@ -26,6 +26,12 @@ pub struct InfoArgs {
     pub format: Option<&'static pgt::formats::Format>,
 }
 
+/// One line of the help's table of formats: the name, the extensions, the description.
+fn format_line(name: &str, extensions: &[&str], description: &str) -> String {
+    let ext: Vec<String> = extensions.iter().map(|e| format!(".{e}")).collect();
+    format!("\n  {name:<6} {:<13} {description}", ext.join(" "))
+}
+
 /// `pgt info --help` for FILE, from the table of formats.
 fn file_help() -> String {
     let mut help = String::from(
@@ -33,26 +39,14 @@ fn file_help() -> String {
          `--format` and for `format` in an [[include]], the extensions, the format):",
     );
     for f in FORMATS {
-        let ext: Vec<String> = f.extensions.iter().map(|e| format!(".{e}")).collect();
-        help.push_str(&format!(
-            "\n  {:<6} {:<13} {}",
-            f.name,
-            ext.join(" "),
-            f.description
-        ));
+        help.push_str(&format_line(f.name, f.extensions, f.description));
     }
     help.push_str(
         "\nMD trajectories (alone, or in a scene as `trajectory = \"…\"` beside a topology: PDB, \
          mmCIF, GRO or PSF):",
     );
     for f in TRAJECTORY_FORMATS {
-        let ext: Vec<String> = f.extensions.iter().map(|e| format!(".{e}")).collect();
-        help.push_str(&format!(
-            "\n  {:<6} {:<13} {}",
-            f.name,
-            ext.join(" "),
-            f.description
-        ));
+        help.push_str(&format_line(f.name, f.extensions, f.description));
     }
     help.push_str(
         "\nA file or scene with frames (PDB models, MMPLD frames, XYZ frames, a trajectory, a \

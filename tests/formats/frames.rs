@@ -73,19 +73,32 @@ fn check_against(source: &dyn FrameSource, key: &str, check_time: bool) {
         let frame = source
             .read_frame(f)
             .unwrap_or_else(|e| panic!("{key} frame {f}: {e}"));
-        assert_eq!(
-            frame.particles.records.len() as u64,
-            v["atoms"].as_u64().expect("atoms"),
-            "{key} frame {f}"
+        let got: Vec<DVec3> = frame.particles.records.iter().map(|r| r.center).collect();
+        assert_sampled_positions(&got, v, f, &format!("{key} frame {f}"));
+    }
+}
+
+/// `got` (every atom of frame `f`) has the vectors' atom count and, at the sampled atoms, their
+/// positions within `TOL`.
+fn assert_sampled_positions(got: &[DVec3], v: &Value, f: usize, what: &str) {
+    assert_eq!(
+        got.len() as u64,
+        v["atoms"].as_u64().expect("atoms"),
+        "{what}"
+    );
+    for (k, a) in v["atom_indices"]
+        .as_array()
+        .expect("atoms")
+        .iter()
+        .enumerate()
+    {
+        let a = a.as_u64().expect("index") as usize;
+        let expected = position(&v["positions"][f.to_string()][k]);
+        assert!(
+            (got[a] - expected).abs().max_element() <= TOL,
+            "{what} atom {a}: {} vs {expected}",
+            got[a]
         );
-        for (k, &a) in atoms.iter().enumerate() {
-            let expected = position(&v["positions"][f.to_string()][k]);
-            let got = frame.particles.records[a].center;
-            assert!(
-                (got - expected).abs().max_element() <= TOL,
-                "{key} frame {f} atom {a}: {got} vs {expected}"
-            );
-        }
     }
 }
 
@@ -260,25 +273,8 @@ fn check_first_frame(source: &dyn FrameSource, key: &str) {
     let v = &all[key];
     assert_eq!(v["frames"].as_u64(), Some(1), "{key}: one frame");
     let frame = source.read_frame(0).expect("frame 0");
-    assert_eq!(
-        frame.particles.records.len() as u64,
-        v["atoms"].as_u64().expect("atoms"),
-        "{key}"
-    );
-    for (k, a) in v["atom_indices"]
-        .as_array()
-        .expect("atoms")
-        .iter()
-        .enumerate()
-    {
-        let a = a.as_u64().expect("index") as usize;
-        let expected = position(&v["positions"]["0"][k]);
-        let got = frame.particles.records[a].center;
-        assert!(
-            (got - expected).abs().max_element() <= TOL,
-            "{key} atom {a}: {got} vs {expected}"
-        );
-    }
+    let got: Vec<DVec3> = frame.particles.records.iter().map(|r| r.center).collect();
+    assert_sampled_positions(&got, v, 0, key);
 }
 
 #[test]
@@ -307,20 +303,7 @@ fn xtc_with_the_small_integer_index_zero_reads_as_mdanalysis_reads_it() {
     let mut p = Vec::new();
     for f in [0usize, 1] {
         t.read_positions(f, &mut p).expect("decodes");
-        for (k, a) in v["atom_indices"]
-            .as_array()
-            .expect("atoms")
-            .iter()
-            .enumerate()
-        {
-            let a = a.as_u64().expect("index") as usize;
-            let expected = position(&v["positions"][f.to_string()][k]);
-            assert!(
-                (p[a] - expected).abs().max_element() <= TOL,
-                "frame {f} atom {a}: {} vs {expected}",
-                p[a]
-            );
-        }
+        assert_sampled_positions(&p, v, f, &format!("frame {f}"));
     }
 }
 
