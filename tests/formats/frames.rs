@@ -62,12 +62,6 @@ fn check_against(source: &dyn FrameSource, key: &str, check_time: bool) {
             "{key}: dt {ours} vs {dt}"
         );
     }
-    let atoms: Vec<usize> = v["atom_indices"]
-        .as_array()
-        .expect("atoms")
-        .iter()
-        .map(|x| x.as_u64().expect("index") as usize)
-        .collect();
     for f in v["frame_indices"].as_array().expect("frames") {
         let f = f.as_u64().expect("frame") as usize;
         let frame = source
