@@ -215,10 +215,9 @@ pub fn render(
     if let Some(w) = pgt::reference::unconverged_warning(&s, scene.render.tol) {
         warn(py, &w, 2)?;
     }
-    let above_tol = out
-        .error
-        .as_ref()
-        .and_then(|err| pgt::reference::err_above_tol_warning(err, scene.render.tol, scene));
+    let above_tol = out.error.as_ref().and_then(|err| {
+        pgt::reference::err_above_tol_warning(&out.image, err, scene.render.tol, scene)
+    });
     if let Some(w) = above_tol {
         warn(py, &w, 2)?;
     }

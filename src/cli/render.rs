@@ -152,10 +152,9 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
     if let Some(warning) = reference::unconverged_warning(s, scene.render.tol) {
         eprintln!("warning: {warning}");
     }
-    let above_tol = out
-        .error
-        .as_ref()
-        .and_then(|err| reference::err_above_tol_warning(err, scene.render.tol, &scene));
+    let above_tol = out.error.as_ref().and_then(|err| {
+        reference::err_above_tol_warning(&out.image, err, scene.render.tol, &scene)
+    });
     if let Some(warning) = above_tol {
         eprintln!("warning: {warning}");
     }

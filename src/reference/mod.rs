@@ -389,22 +389,33 @@ pub fn worse_unconverged(
     }
 }
 
-/// docs/design.md §3 and §9: a pixel whose err exceeds `tol` although its quadrature converged
-/// is reported too (err also bounds what the reference leaves out: with Gaussians, the depth
-/// beyond the cut-off of k σ, so a small `gaussian_cutoff` makes err large everywhere). The
-/// count and the pixel with the largest err, or `None` when every err is within `tol`.
-pub fn err_above_tol_warning(err: &RgbImage, tol: f64, scene: &Scene) -> Option<String> {
+/// docs/design.md §3 and §9: a pixel whose err exceeds `tol` beyond the float32 storage of its
+/// value is reported too (err also bounds what the reference leaves out: with Gaussians, the
+/// depth beyond the cut-off of k σ, so a small `gaussian_cutoff` makes err large everywhere).
+/// The float32 rounding of the stored value (part 5 of err, up to one spacing of float32 at the
+/// value with err's rounding up) is not counted: a tol below it is no news. The count and the
+/// pixel with the largest err, or `None` when every err is within `tol` so far.
+pub fn err_above_tol_warning(
+    image: &RgbImage,
+    err: &RgbImage,
+    tol: f64,
+    scene: &Scene,
+) -> Option<String> {
     let mut count = 0u64;
     let mut worst: Option<(u32, u32, f64)> = None;
-    for (i, e) in err.pixels.iter().enumerate() {
-        let e = f64::from(e[0].max(e[1]).max(e[2]));
-        if e > tol {
+    for (i, (e, v)) in err.pixels.iter().zip(&image.pixels).enumerate() {
+        let above = (0..3).any(|c| {
+            let a = v[c].abs();
+            let storage = f64::from(f32::from_bits(a.to_bits() + 1) - a);
+            f64::from(e[c]) > tol + storage
+        });
+        if above {
             count += 1;
             let (px, py) = (
                 (i % err.width as usize) as u32,
                 (i / err.width as usize) as u32,
             );
-            worst = worse_unconverged(worst, (px, py, e));
+            worst = worse_unconverged(worst, (px, py, f64::from(e[0].max(e[1]).max(e[2]))));
         }
     }
     let (x, y, e) = worst?;
@@ -461,5 +472,40 @@ fn round_up_f32(v: f64) -> f32 {
         f32::from_bits(f.to_bits() + 1)
     } else {
         f
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::err_above_tol_warning;
+    use crate::image_io::RgbImage;
+    use crate::scene::{Scene, SceneLoadOptions};
+    use std::path::Path;
+
+    fn scene(text: &str) -> Scene {
+        Scene::from_toml_str(text, Path::new("s.toml"), &SceneLoadOptions::default()).unwrap()
+    }
+
+    #[test]
+    fn err_above_tol_is_reported_beyond_the_float32_storage_of_the_value() {
+        let spheres = scene("[[particles]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\n");
+        let mut image = RgbImage::new(2, 1);
+        let mut err = RgbImage::new(2, 1);
+        image.pixels = vec![[0.5; 3], [0.5; 3]];
+        // Float32's spacing at 0.5 is 5.96e-8: err 1.2e-7 at tol 1e-7 is the storage alone.
+        err.pixels = vec![[1.2e-7; 3], [1.2e-7; 3]];
+        assert_eq!(err_above_tol_warning(&image, &err, 1e-7, &spheres), None);
+        err.pixels[1] = [0.0, 2.0e-7, 0.0];
+        let w = err_above_tol_warning(&image, &err, 1e-7, &spheres).expect("a warning");
+        assert!(
+            w.starts_with("1 pixel(s) have err above tol 1e-7") && w.contains("at (1, 0)"),
+            "{w}"
+        );
+        assert!(!w.contains("Gaussian"), "{w}");
+        let cut = scene(
+            "[render]\nmodel = \"emission\"\ngaussian_cutoff = 1.0\n[defaults]\ndensity = \"gaussian\"\n[[particles]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\n",
+        );
+        let w = err_above_tol_warning(&image, &err, 1e-7, &cut).expect("a warning");
+        assert!(w.contains("gaussian_cutoff = 1 σ"), "{w}");
     }
 }
