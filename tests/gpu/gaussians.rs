@@ -510,8 +510,11 @@ fn gsplat_fixture_scene(tensors: &safetensors::SafeTensors<'_>) -> Scene {
 }
 
 /// `splat` with the gsplat preset reproduces gsplat 1.5.3's image of the fixture to ≤ 1e-5 per
-/// pixel channel (docs/design.md §4 `splat`, rasteriser presets); the 3dgs preset does not
-/// (its 3σ footprint, α cap 0.99 and near plane differ), so the comparison can fail.
+/// pixel channel (docs/design.md §4 `splat`, rasteriser presets). The 3dgs preset's figure is
+/// printed beside it: on this fixture its constants do not bind (no α reaches 0.99, every
+/// pixel above 1/255 lies in a tile of the 3σ footprint), so the two agree here; the unit test
+/// `approx::splat_tiles::tests::gsplats_box_lists_a_splat_that_3dgs_radius_leaves_out` shows
+/// where they part.
 #[test]
 fn splat_with_the_gsplat_preset_reproduces_gsplats_image_of_the_fixture() {
     let path = crate::support::shared_or_skip!(
@@ -552,9 +555,5 @@ fn splat_with_the_gsplat_preset_reproduces_gsplats_image_of_the_fixture() {
     assert!(
         gsplat <= 1e-5,
         "gsplat preset: max |difference| {gsplat:e} > 1e-5"
-    );
-    assert!(
-        three_dgs > 1e-5,
-        "the 3dgs preset matches gsplat too: {three_dgs:e}"
     );
 }
