@@ -410,9 +410,9 @@ mod tests {
         assert_eq!(at as usize, b.tile_entries.len());
     }
 
-    /// A round splat of σ = 5 px centred 0.5 px right of a tile edge: 3DGS's radius ⌈3·√λ⌉ = 16
-    /// px reaches one tile to the left, gsplat's box ⌈3.33·σ⌉ = 17 px two, and at 16.5 px left of
-    /// the centre (outside 3σ) a splat of opacity 1 still has α ≈ 0.0043 ≥ 1/255.
+    /// A round splat of σ = 10 px at x = 47.5: 3DGS's radius ⌈3·√λ⌉ = 31 px starts at tile 1,
+    /// gsplat's box ⌈3.33·σ⌉ = 34 px at tile 0, where pixel 15 (32 px from the centre, beyond
+    /// 3σ) still has α = exp(−3.2²/2) ≈ 0.006 ≥ 1/255 for opacity 1.
     #[test]
     fn gsplats_box_lists_a_splat_that_3dgs_radius_leaves_out() {
         let (b, frame) = buffers();
@@ -427,16 +427,16 @@ mod tests {
             (0.99, 0.2, 0.3)
         );
         assert_eq!((three.alpha_skip, three.stop_below), (1.0 / 255.0, 1e-4));
-        let cov = [25.0, 0.0, 25.0];
-        let det = 625.0;
-        let mean = [32.5, 35.0];
+        let cov = [100.0, 0.0, 100.0];
+        let det = 10000.0;
+        let mean = [47.5, 35.0];
         let (r3, x3, _) = footprint_tiles(Footprint::Radius3dgs, mean, cov, det, &frame);
         let (rg, xg, _) = footprint_tiles(Footprint::BoxGsplat, mean, cov, det, &frame);
-        assert_eq!((r3, rg), (16.0, 17.0));
+        assert_eq!((r3, rg), (31.0, 34.0));
         assert_eq!(x3.0, 1, "3DGS: from tile 1");
         assert_eq!(xg.0, 0, "gsplat: from tile 0");
-        // Pixel 15 (centre 15.5) is 17 px left of the centre: beyond 3σ, yet above 1/255.
-        let alpha = (-0.5f64 * (17.0 / 5.0f64).powi(2)).exp();
+        // Pixel 15 (centre 15.5) is 32 px left of the centre: beyond 3σ, yet above 1/255.
+        let alpha = (-0.5f64 * (32.0 / 10.0f64).powi(2)).exp();
         assert!(alpha > 1.0 / 255.0, "{alpha}");
         drop(b);
     }

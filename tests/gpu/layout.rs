@@ -136,7 +136,10 @@ fn rust_and_wgsl_struct_layouts_agree() {
             ("splat_alpha_cap", offset_of!(GpuFrame, splat_alpha_cap)),
             ("splat_alpha_skip", offset_of!(GpuFrame, splat_alpha_skip)),
             ("splat_stop_below", offset_of!(GpuFrame, splat_stop_below)),
-            ("splat_stop_inclusive", offset_of!(GpuFrame, splat_stop_inclusive)),
+            (
+                "splat_stop_inclusive",
+                offset_of!(GpuFrame, splat_stop_inclusive),
+            ),
             ("params", offset_of!(GpuFrame, params)),
         ],
     );

@@ -33,7 +33,7 @@
 //! |---|---|---|---|
 //! | `footprint` | 0 | 0..=1 | tiles a splat is listed in: 0, 3DGS's radius ⌈3·√λ_max⌉; 1, gsplat's box ⌈3.33·√Σxx⌉ × ⌈3.33·√Σyy⌉ |
 //! | `alpha_cap` | 990000 | 1..=1000000 | the most opacity one splat gives a pixel, in millionths (3DGS 0.99, gsplat 0.999) |
-//! | `near` | 200000 | 0..=4294967295 | centres at view depth up to this are culled, in millionths of a scene unit (3DGS 0.2, gsplat 0.01) |
+//! | `near` | 200000 | 0..=1000000000 | centres at view depth up to this are culled, in millionths of a scene unit (3DGS 0.2, gsplat 0.01) |
 //! | `jacobian_clamp` | 130 | 1..=100000 | x/z and y/z clamped to this many hundredths of tan(fov/2) for the Jacobian (1.3 in both) |
 //! | `dilation` | 300 | 0..=1000000 | added to the 2D covariance's diagonal, in thousandths of px² (0.3 in both) |
 //! | `skip_denominator` | 255 | 1..=1000000 | splats with α below 1/this at a pixel are skipped (255 in both) |
@@ -79,7 +79,7 @@ pub const PARAMS: &[ParamSpec] = &[
         name: "near",
         default: 200_000,
         min: 0,
-        max: u32::MAX,
+        max: 1_000_000_000,
         doc: "centres at view depth up to this are culled, in millionths of a scene unit (3DGS 0.2, gsplat 0.01)",
     },
     ParamSpec {

@@ -307,9 +307,11 @@ mod tests {
         assert_eq!(old.render.model, models::LIT);
         assert_eq!(old.render.background, glam::DVec3::new(0.1, 0.2, 0.3));
         assert!(old.particles.iter().all(|p| p.profile == Profile::Constant));
+        // The file's values are f32: 0.2 and 0.1 as f32.
+        let dc = glam::DVec3::new(0.5, 0.2f32 as f64, 0.1f32 as f64);
         assert_eq!(
             old.particles[0].color,
-            glam::DVec3::new(0.5, 0.2, 0.1) * crate::formats::ply::SH_C0 + 0.5
+            dc * crate::formats::ply::SH_C0 + 0.5
         );
         assert_eq!(
             old.provenance.particles[0].density,
