@@ -56,7 +56,11 @@ fn main() {
     let mut buffers = SceneBuffers::new(&gaussians, &bvh);
     let frame = GpuFrame::new(&gaussians, &[]);
     let started = std::time::Instant::now();
-    splat_tiles::build(&mut buffers, &frame);
+    splat_tiles::build(
+        &mut buffers,
+        &frame,
+        &splat_tiles::SplatConstants::three_dgs(),
+    );
     eprintln!(
         "bench: splat's CPU projection and tile lists: {:.4} s ({} splats, {} tile entries)",
         started.elapsed().as_secs_f64(),

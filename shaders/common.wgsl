@@ -438,15 +438,24 @@ fn pixel_tile(pixel: vec2<u32>) -> u32 {
 }
 
 // 3D Gaussian splatting's opacity of a splat at a pixel centre (its forward.cu renderCUDA):
-// α = min(SPLAT_ALPHA_MAX, o·exp(−½ dᵀΣ₂D⁻¹d)), d the offset from the projected centre; 0
-// where the quadratic form is negative (rounding), as 3DGS skips it.
+// α = min(cap, o·exp(−½ dᵀΣ₂D⁻¹d)), d the offset from the projected centre, cap the frame's
+// splat_alpha_cap (3DGS 0.99, gsplat 0.999); 0 where the quadratic form is negative
+// (rounding), as 3DGS and gsplat skip it.
+// Whether a pixel whose transmittance would become `next` stops before this splat: below the
+// frame's splat_stop_below (3DGS: test_T < 0.0001), or also equal to it where
+// splat_stop_inclusive is 1 (gsplat: next_T <= 1e-4).
+fn splat_stops(next: f32) -> bool {
+    return next < frame.splat_stop_below
+        || (frame.splat_stop_inclusive != 0u && next == frame.splat_stop_below);
+}
+
 fn splat_alpha(s: Splat, pixel: vec2<u32>) -> f32 {
     let d = vec2<f32>(s.mean_x, s.mean_y) - (vec2<f32>(pixel) + vec2<f32>(0.5));
     let power = -0.5 * (s.conic_a * d.x * d.x + s.conic_c * d.y * d.y) - s.conic_b * d.x * d.y;
     if (power > 0.0) {
         return 0.0;
     }
-    return min(SPLAT_ALPHA_MAX, s.opacity * exp(power));
+    return min(frame.splat_alpha_cap, s.opacity * exp(power));
 }
 
 // A Gaussian's maximum response along a ray, for a shape widened to `widened` standard

@@ -1,10 +1,12 @@
 // Method `splat` (docs/design.md §4): the forward model of the reference 3D Gaussian splatting
 // rasteriser (graphdeco-inria diff-gaussian-rasterization, cuda_rasterizer/forward.cu
-// renderCUDA). The projection, the 3-σ footprints and the tile lists are made on the CPU
-// (src/approx/splat_tiles.rs); here each pixel walks its tile's list front to back (one global
-// order by the centres' view depth), α = min(0.99, o·G₂D) per splat, splats with α < 1/255
-// skipped, and stops at the first splat that would take the transmittance below 1e-4 (that
-// splat not added): L = Σ αᵢTᵢCᵢ + T·L_bg.
+// renderCUDA) or, by its parameters, gsplat's (rasterize_to_pixels). The projection, the
+// footprints and the tile lists are made on the CPU (src/approx/splat_tiles.rs); here each
+// pixel walks its tile's list front to back (one global order by the centres' view depth),
+// α = min(cap, o·G₂D) per splat, splats with α below the skip threshold skipped, and stops at
+// the first splat that would take the transmittance below the stop threshold (that splat not
+// added): L = Σ αᵢTᵢCᵢ + T·L_bg. The thresholds are the frame's splat_* (3DGS: 0.99, 1/255,
+// 1e-4).
 fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {
     let tile = pixel_tile(pixel);
     let end = tile_entries[2u * tile + 1u];
@@ -14,11 +16,11 @@ fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {
         count_iteration();
         let s = splats[tile_entries[k]];
         let alpha = splat_alpha(s, pixel);
-        if (alpha < SPLAT_ALPHA_MIN) {
+        if (alpha < frame.splat_alpha_skip) {
             continue;
         }
         let next = transmittance * (1.0 - alpha);
-        if (next < SPLAT_T_MIN) {
+        if (splat_stops(next)) {
             break;
         }
         radiance = radiance + particles[s.particle].color * (alpha * transmittance);

@@ -19,7 +19,7 @@ fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {
         let index = tile_entries[k];
         let s = splats[index];
         let alpha = splat_alpha(s, pixel);
-        if (alpha < SPLAT_ALPHA_MIN) {
+        if (alpha < frame.splat_alpha_skip) {
             continue;
         }
         let peak = gaussian_peak(ray, particles[s.particle], 1.0);
@@ -31,7 +31,7 @@ fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {
         count_iteration();
         let alpha = pixel_splats.t_exit[k];
         let next = transmittance * (1.0 - alpha);
-        if (next < SPLAT_T_MIN) {
+        if (splat_stops(next)) {
             break;
         }
         let p = particles[splats[pixel_splats.index[k]].particle];

@@ -96,6 +96,7 @@ pub fn scene_load_options(
         model: model.map(|m| parse_model(py, m)).transpose()?,
         tol,
         format: format.map(|f| parse_format(py, f)).transpose()?,
+        ..SceneLoadOptions::default()
     })
 }
 

@@ -162,7 +162,7 @@ gpu_struct! {
 }
 
 gpu_struct! {
-    /// WGSL `struct Frame` (the uniform buffer), 144 bytes: camera, background, render settings
+    /// WGSL `struct Frame` (the uniform buffer), 160 bytes: camera, background, render settings
     /// and the method's parameters.
     plain "Frame" pub struct GpuFrame {
         /// Camera frame f, r, u of docs/design.md §1 (the camera is at the origin).
@@ -202,6 +202,14 @@ gpu_struct! {
         pub row_begin: u32,
         pub row_count: u32,
         pub _pad0: u32,
+        /// The splatting methods' per-pixel constants (docs/design.md §4 `splat`, set from the
+        /// method's parameters by `splat_tiles::SplatConstants::apply_to`; 3DGS's otherwise):
+        /// the α cap, the α below which a splat is skipped, the transmittance below which a
+        /// pixel stops, and 1 when it also stops at a transmittance equal to it.
+        pub splat_alpha_cap: f32,
+        pub splat_alpha_skip: f32,
+        pub splat_stop_below: f32,
+        pub splat_stop_inclusive: u32,
         /// The method's parameters, slot k at `params[k / 4][k % 4]` (the prelude's
         /// `method_param(slot)`; slots are named by generated `PARAM_<NAME>` constants).
         pub params: [[u32; 4]; 2],
@@ -478,6 +486,10 @@ impl GpuFrame {
             row_begin: 0,
             row_count: cam.height,
             params: slots,
+            splat_alpha_cap: super::contract::SPLAT_ALPHA_MAX,
+            splat_alpha_skip: super::contract::SPLAT_ALPHA_MIN,
+            splat_stop_below: super::contract::SPLAT_T_MIN,
+            splat_stop_inclusive: 0,
             ..GpuFrame::default()
         }
     }

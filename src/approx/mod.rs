@@ -213,12 +213,14 @@ impl ApproxPipeline {
             )));
         }
         let slots: Vec<u32> = values.iter().map(|(_, v)| *v).collect();
-        let frame = layout::GpuFrame::new(scene, &slots);
+        let mut frame = layout::GpuFrame::new(scene, &slots);
         // The splatting methods' projection and tile lists, on the CPU: their time counts in
         // the method's (it is 3DGS's preprocessing and sorting pass).
         let prepare_seconds = if prep.splat_tiles {
             let t = std::time::Instant::now();
-            splat_tiles::build(&mut buffers, &frame);
+            let constants = splat_tiles::SplatConstants::from_values(&values);
+            constants.apply_to(&mut frame);
+            splat_tiles::build(&mut buffers, &frame, &constants);
             t.elapsed().as_secs_f64()
         } else {
             0.0

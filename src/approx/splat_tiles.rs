@@ -3,43 +3,120 @@
 //! per tile in order of the centres' view depth. This is the forward model of the reference 3D
 //! Gaussian splatting rasteriser (graphdeco-inria `diff-gaussian-rasterization`,
 //! `cuda_rasterizer/forward.cu` `preprocessCUDA` and `computeCov2D`, `auxiliary.h` `getRect`,
-//! `rasterizer_impl.cu` `duplicateWithKeys`, `identifyTileRanges`), computed here **on the CPU
-//! in f32** before the dispatch, because pgt's dispatch runs one per-pixel pass and has no
-//! place for a preprocessing pass; its time is counted in the method's time
+//! `rasterizer_impl.cu` `duplicateWithKeys`, `identifyTileRanges`) and, with the `gsplat`
+//! preset, of gsplat's (nerfstudio-project `gsplat` 1.5.3, `gsplat/cuda/csrc/`
+//! `ProjectionEWA3DGSFused.cu`, `IntersectTile.cu`), computed here **on the CPU in f32** before
+//! the dispatch, because pgt's dispatch runs one per-pixel pass and has no place for a
+//! preprocessing pass; its time is counted in the method's time
 //! ([`crate::approx::ApproxOutput::gpu_seconds`]). The per-pixel blending is the shader's
 //! (`shaders/splat.wgsl`).
 //!
-//! Every constant is 3DGS's:
+//! The constants are the method's parameters ([`SplatConstants`], `approx::methods::splat`'s
+//! table, a preset per rasteriser); the fixed ones are 3DGS's and gsplat's alike:
 //!
-//! | constant | value | where in 3DGS |
+//! | constant | value | where |
 //! |---|---|---|
-//! | [`NEAR_CULL`] | 0.2 | `auxiliary.h` `in_frustum`: `p_view.z <= 0.2f` culls |
-//! | [`JACOBIAN_CLAMP`] | 1.3 | `forward.cu` `computeCov2D`: `limx = 1.3f * tan_fovx` |
-//! | [`DILATION`] | 0.3 px² | `forward.cu` `computeCov2D`: `cov[0][0] += 0.3f` (low-pass filter) |
-//! | [`EIGEN_FLOOR`] | 0.1 | `forward.cu` `preprocessCUDA`: `sqrt(max(0.1f, mid * mid - det))` |
-//! | [`FOOTPRINT_SIGMAS`] | 3 | `forward.cu` `preprocessCUDA`: `ceil(3.f * sqrt(max(lambda1, lambda2)))` |
-//! | `TILE_SIDE` | 16 | `config.h` `BLOCK_X`, `BLOCK_Y` |
+//! | [`EIGEN_FLOOR`] | 0.1 | 3DGS `forward.cu` `preprocessCUDA`: `sqrt(max(0.1f, mid * mid - det))` (3DGS footprint only) |
+//! | [`FOOTPRINT_SIGMAS`] | 3 | 3DGS `forward.cu` `preprocessCUDA`: `ceil(3.f * sqrt(max(lambda1, lambda2)))` |
+//! | [`BOX_SIGMAS`] | 3.33 | gsplat `ProjectionEWA3DGSFused.cu`: `extend = 3.33f`, `ceilf(extend * sqrtf(covar2d[0][0]))` |
+//! | `TILE_SIDE` | 16 | 3DGS `config.h` `BLOCK_X`, `BLOCK_Y`; gsplat `tile_size` 16 |
 //!
 //! Pixel coordinates: pgt's (docs/design.md §1), pixel (px, py) has its centre at
-//! (px + 0.5, py + 0.5), y down. 3DGS's `ndc2Pix` puts pixel centres at integers; its `getRect`
-//! is applied here to the same point in its coordinates (x − 0.5), so a splat touches the same
-//! tiles as in 3DGS.
+//! (px + 0.5, py + 0.5), y down, as gsplat's (`mean2d = fx·x/z + cx`). 3DGS's `ndc2Pix` puts
+//! pixel centres at integers; its `getRect` is applied here to the same point in its
+//! coordinates (x − 0.5), so a splat touches the same tiles as in 3DGS.
 
 use super::contract::{PROFILE_GAUSSIAN, TILE_SIDE};
 use super::layout::{GpuFrame, GpuSplat, SceneBuffers};
 use glam::{Mat3, Vec3};
 
-/// Centres at view depth ≤ this (scene units) are culled (3DGS `in_frustum`).
-pub const NEAR_CULL: f32 = 0.2;
-/// The centre's x/z and y/z are clamped to this many times the tangent of the half field of
-/// view before the Jacobian is taken (3DGS `computeCov2D`).
-pub const JACOBIAN_CLAMP: f32 = 1.3;
-/// Added to the diagonal of the 2D covariance, px² (3DGS `computeCov2D`'s low-pass filter).
-pub const DILATION: f32 = 0.3;
 /// Floor of the discriminant in the 2D covariance's eigenvalues (3DGS `preprocessCUDA`).
 pub const EIGEN_FLOOR: f32 = 0.1;
-/// The footprint's radius in standard deviations of the 2D covariance's major axis.
+/// The 3DGS footprint's radius in standard deviations of the 2D covariance's major axis.
 pub const FOOTPRINT_SIGMAS: f32 = 3.0;
+/// The gsplat box's half-sides in standard deviations of the 2D covariance along x and y:
+/// exp(−3.33²/2) < 1/255, so the box holds every pixel whose α reaches the skip threshold.
+pub const BOX_SIGMAS: f32 = 3.33;
+
+/// Which tiles a splat is listed in (the method's parameter `footprint`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Footprint {
+    /// 3DGS: the square of radius ⌈3·√λ_max⌉ about the centre, binned by `getRect`.
+    Radius3dgs,
+    /// gsplat: the box ⌈3.33·√Σxx⌉ × ⌈3.33·√Σyy⌉ about the centre, binned by `isect_tiles`
+    /// (tiles ⌊(x − r)/16⌋ to ⌈(x + r)/16⌉).
+    BoxGsplat,
+}
+
+/// The rasteriser's constants: the method's parameters in their units (docs/design.md §4,
+/// `splat`; `approx::methods::splat` lists them with their sources).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SplatConstants {
+    pub footprint: Footprint,
+    /// The most opacity one splat gives a pixel.
+    pub alpha_cap: f32,
+    /// Centres at view depth ≤ this (scene units) are culled.
+    pub near: f32,
+    /// The centre's x/z and y/z are clamped to this many times the tangent of the half field
+    /// of view before the Jacobian is taken.
+    pub jacobian_clamp: f32,
+    /// Added to the diagonal of the 2D covariance, px² (the low-pass filter).
+    pub dilation: f32,
+    /// A splat whose α at a pixel is below this is skipped.
+    pub alpha_skip: f32,
+    /// A pixel stops at the splat that would take its transmittance below this.
+    pub stop_below: f32,
+    /// Whether the stop also takes a transmittance equal to `stop_below`.
+    pub stop_inclusive: bool,
+}
+
+impl SplatConstants {
+    /// The constants of the method's parameter values by name (as `ApproxParams::resolve`
+    /// gives them); a parameter not among them takes its default (3DGS's value).
+    pub fn from_values(values: &[(String, u32)]) -> SplatConstants {
+        let get = |name: &str| {
+            values
+                .iter()
+                .find(|(n, _)| n == name)
+                .map(|(_, v)| *v)
+                .or_else(|| {
+                    super::methods::splat::PARAMS
+                        .iter()
+                        .find(|p| p.name == name)
+                        .map(|p| p.default)
+                })
+                .unwrap_or(0)
+        };
+        // Correctly rounded divisions: the f32 nearest each decimal, as a literal would be.
+        let ratio = |name: &str, unit: f64| (get(name) as f64 / unit) as f32;
+        SplatConstants {
+            footprint: match get("footprint") {
+                0 => Footprint::Radius3dgs,
+                _ => Footprint::BoxGsplat,
+            },
+            alpha_cap: ratio("alpha_cap", 1e6),
+            near: ratio("near", 1e6),
+            jacobian_clamp: ratio("jacobian_clamp", 100.0),
+            dilation: ratio("dilation", 1000.0),
+            alpha_skip: (1.0 / get("skip_denominator").max(1) as f64) as f32,
+            stop_below: ratio("stop_below", 1e6),
+            stop_inclusive: get("stop_inclusive") != 0,
+        }
+    }
+
+    /// 3DGS's constants (the parameters' defaults).
+    pub fn three_dgs() -> SplatConstants {
+        SplatConstants::from_values(&[])
+    }
+
+    /// Writes the per-pixel constants (α cap, skip, stop) into the frame for the shader.
+    pub fn apply_to(&self, frame: &mut GpuFrame) {
+        frame.splat_alpha_cap = self.alpha_cap;
+        frame.splat_alpha_skip = self.alpha_skip;
+        frame.splat_stop_below = self.stop_below;
+        frame.splat_stop_inclusive = self.stop_inclusive as u32;
+    }
+}
 
 /// A Gaussian projected to the image: its 2D mean (pgt pixel coordinates), the inverse of its
 /// dilated 2D covariance (the conic), its view depth and the tiles its footprint touches.
@@ -53,7 +130,7 @@ pub struct Projected {
     pub cov: [f32; 3],
     /// View depth of the centre, dot(centre − eye, forward).
     pub depth: f32,
-    /// Footprint radius, px: ⌈3·√λ_max⌉.
+    /// Footprint radius, px: ⌈3·√λ_max⌉ (3DGS), the box's larger half-side (gsplat).
     pub radius: f32,
     /// Tiles [min, max) in x and y.
     pub tiles_x: (u32, u32),
@@ -87,9 +164,15 @@ fn covariance(buffers: &SceneBuffers, i: usize) -> Mat3 {
     }
 }
 
-/// Projects particle `i` as 3DGS's `preprocessCUDA` does; `None` where 3DGS drops it (near
-/// culling, a singular covariance, a footprint that touches no tile).
-pub fn project(buffers: &SceneBuffers, frame: &GpuFrame, i: usize) -> Option<Projected> {
+/// Projects particle `i` as 3DGS's `preprocessCUDA` (or gsplat's projection) does with the
+/// constants `k`; `None` where the rasteriser drops it (near culling, a singular covariance,
+/// a footprint that touches no tile).
+pub fn project(
+    buffers: &SceneBuffers,
+    frame: &GpuFrame,
+    k: &SplatConstants,
+    i: usize,
+) -> Option<Projected> {
     let p = &buffers.particles[i];
     let c = Vec3::from(p.center);
     // View axes as 3DGS's (x right, y down, z forward): W has the rows r, −u, f.
@@ -99,7 +182,7 @@ pub fn project(buffers: &SceneBuffers, frame: &GpuFrame, i: usize) -> Option<Pro
         Vec3::from(frame.forward),
     );
     let t = Vec3::new(c.dot(right), c.dot(down), c.dot(forward));
-    if t.z <= NEAR_CULL {
+    if t.z <= k.near {
         return None;
     }
     let (w, h) = (frame.width as f32, frame.height as f32);
@@ -109,8 +192,8 @@ pub fn project(buffers: &SceneBuffers, frame: &GpuFrame, i: usize) -> Option<Pro
     let focal_x = w / (2.0 * tan_fovx);
     let focal_y = h / (2.0 * tan_fovy);
     // The Jacobian of the perspective projection at the (clamped) centre.
-    let lim_x = JACOBIAN_CLAMP * tan_fovx;
-    let lim_y = JACOBIAN_CLAMP * tan_fovy;
+    let lim_x = k.jacobian_clamp * tan_fovx;
+    let lim_y = k.jacobian_clamp * tan_fovy;
     let tx = (t.x / t.z).clamp(-lim_x, lim_x) * t.z;
     let ty = (t.y / t.z).clamp(-lim_y, lim_y) * t.z;
     let j0 = Vec3::new(focal_x / t.z, 0.0, -(focal_x * tx) / (t.z * t.z));
@@ -120,30 +203,19 @@ pub fn project(buffers: &SceneBuffers, frame: &GpuFrame, i: usize) -> Option<Pro
     let t1 = right * j1.x + down * j1.y + forward * j1.z;
     let sigma = covariance(buffers, i);
     let (s_t0, s_t1) = (sigma * t0, sigma * t1);
-    let a = t0.dot(s_t0) + DILATION;
+    let a = t0.dot(s_t0) + k.dilation;
     let b = t0.dot(s_t1);
-    let cc = t1.dot(s_t1) + DILATION;
+    let cc = t1.dot(s_t1) + k.dilation;
     let det = a * cc - b * b;
-    if det == 0.0 {
+    // 3DGS drops a singular covariance, gsplat also a negative determinant.
+    if det == 0.0 || (k.footprint == Footprint::BoxGsplat && det < 0.0) {
         return None;
     }
     let det_inv = 1.0 / det;
     let conic = [cc * det_inv, -b * det_inv, a * det_inv];
-    let mid = 0.5 * (a + cc);
-    let root = (mid * mid - det).max(EIGEN_FLOOR).sqrt();
-    let radius = (FOOTPRINT_SIGMAS * (mid + root).max(mid - root).sqrt()).ceil();
     // The mean, pixel centres at +0.5 (docs/design.md §1).
     let mean = [focal_x * t.x / t.z + 0.5 * w, focal_y * t.y / t.z + 0.5 * h];
-    // 3DGS `getRect` on its pixel coordinates (centres at integers: x − 0.5), truncating.
-    let (cols, rows) = tile_grid(frame.width, frame.height);
-    let side = TILE_SIDE as f32;
-    let rect = |centre: f32, grid: u32| {
-        let lo = (((centre - radius) / side) as i64).clamp(0, grid as i64) as u32;
-        let hi = (((centre + radius + side - 1.0) / side) as i64).clamp(0, grid as i64) as u32;
-        (lo, hi)
-    };
-    let tiles_x = rect(mean[0] - 0.5, cols);
-    let tiles_y = rect(mean[1] - 0.5, rows);
+    let (radius, tiles_x, tiles_y) = footprint_tiles(k.footprint, mean, [a, b, cc], det, frame);
     if (tiles_x.1 - tiles_x.0) * (tiles_y.1 - tiles_y.0) == 0 {
         return None;
     }
@@ -158,15 +230,57 @@ pub fn project(buffers: &SceneBuffers, frame: &GpuFrame, i: usize) -> Option<Pro
     })
 }
 
+/// The footprint's radius (px, the larger half-side for gsplat's box) and the tiles
+/// [min, max) in x and y it is listed in, by `rule`, for the dilated 2D covariance `cov`
+/// (xx, xy, yy) of determinant `det` centred at `mean`.
+fn footprint_tiles(
+    rule: Footprint,
+    mean: [f32; 2],
+    cov: [f32; 3],
+    det: f32,
+    frame: &GpuFrame,
+) -> (f32, (u32, u32), (u32, u32)) {
+    let (cols, rows) = tile_grid(frame.width, frame.height);
+    let side = TILE_SIDE as f32;
+    match rule {
+        Footprint::Radius3dgs => {
+            let mid = 0.5 * (cov[0] + cov[2]);
+            let root = (mid * mid - det).max(EIGEN_FLOOR).sqrt();
+            let radius = (FOOTPRINT_SIGMAS * (mid + root).max(mid - root).sqrt()).ceil();
+            // 3DGS `getRect` on its pixel coordinates (centres at integers: x − 0.5),
+            // truncating.
+            let rect = |centre: f32, grid: u32| {
+                let lo = (((centre - radius) / side) as i64).clamp(0, grid as i64) as u32;
+                let hi =
+                    (((centre + radius + side - 1.0) / side) as i64).clamp(0, grid as i64) as u32;
+                (lo, hi)
+            };
+            (radius, rect(mean[0] - 0.5, cols), rect(mean[1] - 0.5, rows))
+        }
+        Footprint::BoxGsplat => {
+            let rx = (BOX_SIGMAS * cov[0].sqrt()).ceil();
+            let ry = (BOX_SIGMAS * cov[2].sqrt()).ceil();
+            // gsplat `isect_tiles`: ⌊(x − r)/16⌋ inclusive to ⌈(x + r)/16⌉ exclusive.
+            let rect = |centre: f32, r: f32, grid: u32| {
+                let (c, tr) = (centre / side, r / side);
+                let lo = ((c - tr).floor() as i64).clamp(0, grid as i64) as u32;
+                let hi = ((c + tr).ceil() as i64).clamp(0, grid as i64) as u32;
+                (lo, hi)
+            };
+            (rx.max(ry), rect(mean[0], rx, cols), rect(mean[1], ry, rows))
+        }
+    }
+}
+
 /// The splat lists of a scene: [`SceneBuffers::splats`], the projected Gaussians in order of
 /// view depth (ties: particle index; 3DGS sorts the keys (tile, depth) with a stable radix sort
 /// of the Gaussians in index order), and [`SceneBuffers::tile_entries`]: for tile k (row-major)
 /// the range `[tile_entries[2k], tile_entries[2k + 1])` of `tile_entries` that lists its splats
 /// front to back. Particles of constant density are left out (the methods refuse them).
-pub fn build(buffers: &mut SceneBuffers, frame: &GpuFrame) {
+pub fn build(buffers: &mut SceneBuffers, frame: &GpuFrame, k: &SplatConstants) {
     let mut projected: Vec<(u32, Projected)> = (0..buffers.particles.len())
         .filter(|&i| buffers.particles[i].profile == PROFILE_GAUSSIAN)
-        .filter_map(|i| project(buffers, frame, i).map(|p| (i as u32, p)))
+        .filter_map(|i| project(buffers, frame, k, i).map(|p| (i as u32, p)))
         .collect();
     projected.sort_by(|a, b| a.1.depth.total_cmp(&b.1.depth).then(a.0.cmp(&b.0)));
     let (cols, rows) = tile_grid(frame.width, frame.height);
@@ -254,10 +368,11 @@ mod tests {
     #[test]
     fn each_tile_lists_the_splats_that_touch_it_in_depth_order() {
         let (mut b, frame) = buffers();
-        build(&mut b, &frame);
+        let constants = SplatConstants::three_dgs();
+        build(&mut b, &frame, &constants);
         let (cols, rows) = tile_grid(frame.width, frame.height);
         let culled = (0..b.particles.len())
-            .filter(|&i| project(&b, &frame, i).is_none())
+            .filter(|&i| project(&b, &frame, &constants, i).is_none())
             .count();
         assert!(culled > 0, "some Gaussians are culled");
         assert_eq!(b.splats.len() + culled, b.particles.len());
@@ -278,8 +393,13 @@ mod tests {
                 assert!(listed.windows(2).all(|w| w[0] < w[1]), "front to back");
                 let want: Vec<u32> = (0..b.splats.len() as u32)
                     .filter(|&s| {
-                        let p =
-                            project(&b, &frame, b.splats[s as usize].particle as usize).unwrap();
+                        let p = project(
+                            &b,
+                            &frame,
+                            &constants,
+                            b.splats[s as usize].particle as usize,
+                        )
+                        .unwrap();
                         (p.tiles_x.0..p.tiles_x.1).contains(&x)
                             && (p.tiles_y.0..p.tiles_y.1).contains(&y)
                     })
@@ -288,5 +408,36 @@ mod tests {
             }
         }
         assert_eq!(at as usize, b.tile_entries.len());
+    }
+
+    /// A round splat of σ = 10 px at x = 47.5: 3DGS's radius ⌈3·√λ⌉ = 31 px starts at tile 1,
+    /// gsplat's box ⌈3.33·σ⌉ = 34 px at tile 0, where pixel 15 (32 px from the centre, beyond
+    /// 3σ) still has α = exp(−3.2²/2) ≈ 0.006 ≥ 1/255 for opacity 1.
+    #[test]
+    fn gsplats_box_lists_a_splat_that_3dgs_radius_leaves_out() {
+        let (b, frame) = buffers();
+        let three = SplatConstants::three_dgs();
+        let gsplat_values: Vec<(String, u32)> =
+            crate::approx::methods::splat::preset("gsplat").expect("the gsplat preset");
+        let gsplat = SplatConstants::from_values(&gsplat_values);
+        assert_eq!(gsplat.footprint, Footprint::BoxGsplat);
+        assert_eq!((gsplat.alpha_cap, gsplat.near), (0.999, 0.01));
+        assert_eq!(
+            (three.alpha_cap, three.near, three.dilation),
+            (0.99, 0.2, 0.3)
+        );
+        assert_eq!((three.alpha_skip, three.stop_below), (1.0 / 255.0, 1e-4));
+        let cov = [100.0, 0.0, 100.0];
+        let det = 10000.0;
+        let mean = [47.5, 35.0];
+        let (r3, x3, _) = footprint_tiles(Footprint::Radius3dgs, mean, cov, det, &frame);
+        let (rg, xg, _) = footprint_tiles(Footprint::BoxGsplat, mean, cov, det, &frame);
+        assert_eq!((r3, rg), (31.0, 34.0));
+        assert_eq!(x3.0, 1, "3DGS: from tile 1");
+        assert_eq!(xg.0, 0, "gsplat: from tile 0");
+        // Pixel 15 (centre 15.5) is 32 px left of the centre: beyond 3σ, yet above 1/255.
+        let alpha = (-0.5f64 * (32.0 / 10.0f64).powi(2)).exp();
+        assert!(alpha > 1.0 / 255.0, "{alpha}");
+        drop(b);
     }
 }

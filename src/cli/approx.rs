@@ -53,6 +53,10 @@ pub struct ApproxArgs {
     /// Any parameter of the method, NAME=VALUE (repeatable; VALUE a number or "all").
     #[arg(long = "param", value_name = "NAME=VALUE", value_parser = parse_param)]
     pub params: Vec<(String, u32)>,
+    /// The splat method's constants as this rasteriser has them (docs/design.md §4 `splat`):
+    /// 3dgs (the default) or gsplat; a --param given too overrides one of them.
+    #[arg(long, value_name = "NAME", value_parser = PossibleValuesParser::new(methods::splat::PRESETS.iter().map(|(n, _)| *n)))]
+    pub rasteriser: Option<String>,
     /// Use the adapter whose name contains this (case-insensitive).
     #[arg(long)]
     pub adapter: Option<String>,
@@ -70,6 +74,8 @@ pub struct ApproxArgs {
     /// format of each include with `format = "…"`).
     #[arg(long, value_name = "NAME", value_parser = super::format_parser())]
     pub format: Option<&'static pgt::formats::Format>,
+    #[command(flatten)]
+    pub bare: super::BareFileArgs,
     /// PNG exposure in stops (2^exposure scales the linear image before encoding).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
@@ -100,6 +106,14 @@ impl ApproxArgs {
             (None, None) => None,
         };
         let mut values = Vec::new();
+        if let Some(name) = &self.rasteriser {
+            if !matches!(&method, Some(Method::Builtin(m)) if m.name() == "splat") {
+                anyhow::bail!(
+                    "--rasteriser {name} sets the splat method's constants: add --method splat"
+                );
+            }
+            values = methods::splat::preset(name)?;
+        }
         if let Some(v) = self.samples {
             values.push(("samples".to_string(), v));
         }
@@ -235,13 +249,14 @@ pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
     let (Some(scene_path), Some(output)) = (&args.scene, &args.output) else {
         anyhow::bail!("pgt approx needs a SCENE and -o OUTPUT (or --list-methods)");
     };
-    let options = SceneLoadOptions {
+    let options = args.bare.apply(SceneLoadOptions {
         size: args.size,
         mode: args.mode,
         model: args.model,
         tol: None,
         format: args.format,
-    };
+        ..SceneLoadOptions::default()
+    });
     if let Some(range) = args.frames {
         return approx_frames(&args, scene_path, output, &options, range);
     }

@@ -22,6 +22,8 @@ pub struct CameraArgs {
     /// format of each include with `format = "…"`).
     #[arg(long, value_name = "NAME", value_parser = super::format_parser())]
     pub format: Option<&'static pgt::formats::Format>,
+    #[command(flatten)]
+    pub bare: super::BareFileArgs,
     /// The frame (from 0) of a scene that moves: its particles and camera, as `pgt render
     /// --frames` renders it.
     #[arg(long, value_name = "K")]
@@ -44,11 +46,11 @@ fn write_matrix(t: &mut String, name: &str, m: &MatrixJson) {
 
 /// Runs `pgt camera`.
 pub fn run(args: CameraArgs) -> anyhow::Result<Outcome> {
-    let options = SceneLoadOptions {
+    let options = args.bare.apply(SceneLoadOptions {
         size: args.size,
         format: args.format,
         ..SceneLoadOptions::default()
-    };
+    });
     let scene = pgt::sequence::scene_at_frame(&args.scene, &options, args.frame)?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");

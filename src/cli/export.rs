@@ -23,6 +23,8 @@ pub struct ExportArgs {
     /// format of each include with `format = "…"`).
     #[arg(long, value_name = "NAME", value_parser = super::format_parser())]
     pub format: Option<&'static pgt::formats::Format>,
+    #[command(flatten)]
+    pub bare: super::BareFileArgs,
     /// The frame (from 0) of a scene that moves: its particles and camera, as `pgt render
     /// --frames` renders it.
     #[arg(long, value_name = "K")]
@@ -37,10 +39,10 @@ pub fn run(args: ExportArgs) -> anyhow::Result<Outcome> {
         OutputKind::File(&["csv", "ply"]),
     )])?;
     let format = ExportFormat::from_path(&args.output)?;
-    let options = SceneLoadOptions {
+    let options = args.bare.apply(SceneLoadOptions {
         format: args.format,
         ..SceneLoadOptions::default()
-    };
+    });
     let scene = pgt::sequence::scene_at_frame(&args.scene, &options, args.frame)?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");

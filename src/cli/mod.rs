@@ -117,6 +117,72 @@ pub fn format_parser() -> impl clap::builder::TypedValueParser<Value = &'static 
         .try_map(|name| Format::named(&name).ok_or_else(|| format!("unknown format '{name}'")))
 }
 
+/// The flags of a bare particle file's scene (docs/design.md §1, "A bare particle file"): what
+/// a scene file says with `density` in `[defaults]`, `background` in `[render]` and an
+/// include's `sh`.
+#[derive(Debug, Clone, clap::Args)]
+pub struct BareFileArgs {
+    /// The particles' density profile: constant or gaussian [default: gaussian for a PLY of 3D
+    /// Gaussian splatting, constant otherwise]. A scene file sets `density` in [defaults] or on
+    /// an include.
+    #[arg(long, value_parser = parse_density, value_name = "PROFILE")]
+    pub density: Option<pgt::optics::Profile>,
+    /// Background radiance L_bg, linear RGB: R,G,B or one value for grey [default: black for a
+    /// PLY of 3D Gaussian splatting, the scene's otherwise]. Overrides a scene's [render].
+    #[arg(long, value_parser = parse_background, value_name = "R,G,B")]
+    pub background: Option<[f64; 3]>,
+    /// The colour of a PLY of 3D Gaussian splatting: view (its SH seen from the eye) or dc
+    /// (the degree-0 term) [default: view]. A scene file sets `sh` on the include.
+    #[arg(long, value_parser = parse_sh, value_name = "view|dc")]
+    pub sh: Option<pgt::formats::ShColor>,
+}
+
+impl BareFileArgs {
+    /// The options with these flags set.
+    pub fn apply(&self, options: pgt::scene::SceneLoadOptions) -> pgt::scene::SceneLoadOptions {
+        pgt::scene::SceneLoadOptions {
+            density: self.density,
+            background: self.background,
+            sh: self.sh,
+            ..options
+        }
+    }
+}
+
+fn parse_density(s: &str) -> Result<pgt::optics::Profile, String> {
+    match s {
+        "constant" => Ok(pgt::optics::Profile::Constant),
+        "gaussian" => Ok(pgt::optics::Profile::Gaussian),
+        _ => Err(format!("expected constant or gaussian, got '{s}'")),
+    }
+}
+
+fn parse_sh(s: &str) -> Result<pgt::formats::ShColor, String> {
+    match s {
+        "view" => Ok(pgt::formats::ShColor::View),
+        "dc" => Ok(pgt::formats::ShColor::Dc),
+        _ => Err(format!("expected view or dc, got '{s}'")),
+    }
+}
+
+/// `R,G,B` or one value for grey, each finite and ≥ 0.
+fn parse_background(s: &str) -> Result<[f64; 3], String> {
+    let values: Vec<f64> = s
+        .split(',')
+        .map(|v| v.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("expected R,G,B (numbers ≥ 0) or one number, got '{s}'"))?;
+    let rgb = match values[..] {
+        [g] => [g, g, g],
+        [r, g, b] => [r, g, b],
+        _ => return Err(format!("expected R,G,B or one number, got '{s}'")),
+    };
+    if !rgb.iter().all(|c| c.is_finite() && *c >= 0.0) {
+        return Err(format!("expected finite numbers ≥ 0, got '{s}'"));
+    }
+    Ok(rgb)
+}
+
 /// Parses `WxH`.
 pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
     let (w, h) = s

@@ -44,6 +44,8 @@ pub struct RenderArgs {
     /// format of each include with `format = "…"`).
     #[arg(long, value_name = "NAME", value_parser = super::format_parser())]
     pub format: Option<&'static pgt::formats::Format>,
+    #[command(flatten)]
+    pub bare: super::BareFileArgs,
     /// Absolute radiance tolerance of the quadrature, per pixel and channel.
     #[arg(long)]
     pub tol: Option<f64>,
@@ -74,13 +76,14 @@ pub struct RenderArgs {
 
 impl RenderArgs {
     fn load_options(&self) -> SceneLoadOptions {
-        SceneLoadOptions {
+        self.bare.apply(SceneLoadOptions {
             size: self.size,
             mode: self.mode,
             model: self.model,
             tol: self.tol,
             format: self.format,
-        }
+            ..SceneLoadOptions::default()
+        })
     }
 
     fn render_options(&self) -> anyhow::Result<RenderOptions> {

@@ -587,6 +587,28 @@ fn sh_degree(rest: usize) -> usize {
     }
 }
 
+/// Whether `path` is a PLY file in the layout of 3D Gaussian splatting (not pgt's export): a
+/// bare file of this layout gets the splatting defaults (docs/design.md §1, "A bare particle
+/// file"). Reads the header only; a file that cannot be read or parsed is not one (reading it
+/// then reports why).
+pub fn is_splatting_file(path: &Path) -> bool {
+    use std::io::Read;
+    let mut head = Vec::new();
+    let Ok(file) = std::fs::File::open(path) else {
+        return false;
+    };
+    if file
+        .take(MAX_HEADER_BYTES as u64)
+        .read_to_end(&mut head)
+        .is_err()
+    {
+        return false;
+    }
+    header(path, &head)
+        .and_then(|h| layout(path, &h))
+        .is_ok_and(|(_, l)| matches!(l, Layout::Gaussians(_)))
+}
+
 /// What the reader needs of the include, resolved.
 struct Options {
     extent: f64,

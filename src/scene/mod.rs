@@ -105,6 +105,14 @@ pub struct SceneLoadOptions {
     /// `--format`: the format of a bare particle file whatever its extension (a scene file
     /// names the format of each include with `format = "…"`).
     pub format: Option<&'static crate::formats::Format>,
+    /// `--density`: the density profile of a bare file's particles (a scene file sets
+    /// `density` in `[defaults]`, `[[particles]]` or an include).
+    pub density: Option<crate::optics::Profile>,
+    /// `--background`: L_bg (linear RGB, ≥ 0), overriding the scene.
+    pub background: Option<[f64; 3]>,
+    /// `--sh`: the colour of a bare 3D Gaussian splatting PLY, the DC term or the view-dependent
+    /// SH from the eye (a scene file sets `sh` on its include).
+    pub sh: Option<crate::formats::ShColor>,
 }
 
 /// One particle given by a program rather than a file (the Python package's

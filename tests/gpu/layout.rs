@@ -133,6 +133,13 @@ fn rust_and_wgsl_struct_layouts_agree() {
             ("pair_end", offset_of!(GpuFrame, pair_end)),
             ("row_begin", offset_of!(GpuFrame, row_begin)),
             ("row_count", offset_of!(GpuFrame, row_count)),
+            ("splat_alpha_cap", offset_of!(GpuFrame, splat_alpha_cap)),
+            ("splat_alpha_skip", offset_of!(GpuFrame, splat_alpha_skip)),
+            ("splat_stop_below", offset_of!(GpuFrame, splat_stop_below)),
+            (
+                "splat_stop_inclusive",
+                offset_of!(GpuFrame, splat_stop_inclusive),
+            ),
             ("params", offset_of!(GpuFrame, params)),
         ],
     );

@@ -105,7 +105,7 @@ pub fn check_profile(name: &str, draws_gaussians: bool, scene: &Scene) -> Result
         format!("use a method that draws them: {}", others.join(", "))
     };
     Err(PgtError::Usage(format!(
-        "the {name} method draws particles of constant density; this scene has Gaussian particles (density = \"gaussian\", docs/design.md §9): {instead}"
+        "the {name} method draws particles of constant density; this scene has Gaussian particles (density = \"gaussian\", docs/design.md §9): {instead}, or give them constant density (--density constant for a bare particle file; density = \"constant\" in a scene's [defaults] or include)"
     )))
 }
 
@@ -129,7 +129,7 @@ pub fn check_gaussians_only(name: &str, scene: &Scene) -> Result<()> {
         .map(|m| m.name())
         .collect();
     Err(PgtError::Usage(format!(
-        "the {name} method draws particles of Gaussian density only (docs/design.md §9); this scene has {constant} particles of constant density: use a method that draws constant density{}",
+        "the {name} method draws particles of Gaussian density only (docs/design.md §9); this scene has {constant} particles of constant density: give them Gaussian density (--density gaussian for a bare particle file; density = \"gaussian\" in a scene's [defaults] or include), or use a method that draws constant density{}",
         if others.is_empty() {
             String::new()
         } else {

@@ -111,6 +111,19 @@ pub(super) fn bare_particle_file(path: &Path, options: &SceneLoadOptions) -> Res
     load_bare(path, options).map(|l| l.scene)
 }
 
+/// `--density` and `--sh` choose for a bare particle file; a scene file says it with its keys.
+fn refuse_bare_file_flags(path: &Path, options: &SceneLoadOptions) -> Result<()> {
+    let flag = match (options.density, options.sh) {
+        (Some(_), _) => "--density: a scene file sets density = \"gaussian\" or \"constant\" in [defaults], [[particles]] or an [[include]]",
+        (None, Some(_)) => "--sh: a scene file sets sh = \"view\" or \"dc\" on its [[include]] of a 3D Gaussian splatting PLY",
+        (None, None) => return Ok(()),
+    };
+    Err(crate::error::PgtError::in_file(
+        path,
+        format!("{flag} (the flag applies to a bare particle file)"),
+    ))
+}
+
 /// [`load_toml`] with the particles and lights of [`scene_from_toml_and_particles`], step by
 /// step (the module doc).
 fn load_toml_and_particles(
@@ -121,6 +134,7 @@ fn load_toml_and_particles(
     default_lights: bool,
 ) -> Result<Loaded> {
     let file: SceneFile = toml::from_str(text).map_err(|e| toml_error(path, text, &e))?;
+    refuse_bare_file_flags(path, options)?;
     let source = SourceText { path, text };
     let mut provenance = Provenance::default();
     let render = render::settings(&source, &file.render, options, &mut provenance)?;

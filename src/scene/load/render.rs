@@ -77,7 +77,7 @@ fn check_tol(at: &At, v: f64) -> Result<f64> {
     }
 }
 
-/// `--mode`, `--model` and `--tol` over the scene's settings.
+/// `--mode`, `--model`, `--tol` and `--background` over the scene's settings.
 pub(super) fn apply_overrides(
     mut r: RenderSettings,
     o: &SceneLoadOptions,
@@ -93,6 +93,14 @@ pub(super) fn apply_overrides(
     }
     if let Some(t) = o.tol {
         r.tol = checked_tol_override(t)?;
+    }
+    if let Some(b) = o.background {
+        if !b.iter().all(|c| c.is_finite() && *c >= 0.0) {
+            return Err(PgtError::Usage(format!(
+                "--background must be three finite numbers ≥ 0 (linear RGB), got {b:?}"
+            )));
+        }
+        r.background = glam::DVec3::from(b);
     }
     Ok(r)
 }
@@ -180,6 +188,7 @@ mod tests {
             model: Some(models::EMISSION),
             tol: Some(1e-3),
             format: None,
+            ..SceneLoadOptions::default()
         };
         let s = load(
             "[camera]\nwidth=100\nheight=100\n[render]\nmode = \"volume\"\nmodel = \"lit\"\ntol = 1e-6\n",
