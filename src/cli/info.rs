@@ -4,8 +4,8 @@
 
 use super::Outcome;
 use crate::formats::frames::{open_frames, FrameInfo};
-use crate::formats::topology::{trajectory_format_of, trajectory_summary};
-use crate::formats::{format_of, load_bytes, read_input, Format, IncludeSpec, FORMATS};
+use crate::formats::topology::trajectory_summary;
+use crate::formats::{format_of, load_bytes, particle_formats, read_input, Format, IncludeSpec};
 use crate::scene::{SceneFrames, SceneLoadOptions};
 use clap::Args;
 use glam::DVec3;
@@ -33,7 +33,7 @@ fn file_help() -> String {
         "A particle file or a scene file (.toml). Particle formats (the name for `--format` and \
          for `format` in an [[include]], the extensions, the format):",
     );
-    for f in FORMATS {
+    for f in particle_formats() {
         let ext: Vec<String> = f.extensions.iter().map(|e| format!(".{e}")).collect();
         help.push_str(&format!(
             "\n  {:<6} {:<13} {}",
@@ -201,7 +201,7 @@ pub fn info_of(path: &std::path::Path, format: Option<&'static Format>) -> crate
         info.frames = frames.frame_info();
         return Ok(info);
     }
-    if let Some(format) = trajectory_format_of(path) {
+    if let Some(format) = Format::trajectory_of(path) {
         let (frames, first, warnings) = trajectory_summary(path)?;
         let mut info = summarize(
             name,

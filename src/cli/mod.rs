@@ -16,7 +16,7 @@ pub mod output;
 pub mod render;
 pub mod sweep;
 
-use crate::formats::{Format, FORMATS};
+use crate::formats::{particle_formats, Format};
 use clap::{Parser, Subcommand};
 
 /// What a subcommand ended with, when it did not fail.
@@ -126,10 +126,11 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
 }
 
 /// `--format NAME`: the format of a bare particle file whatever its extension, a name of the
-/// table of formats (`crate::formats::FORMATS`; `--help` lists them).
+/// table of formats that reads particles (`crate::formats::particle_formats`; `--help` lists
+/// them).
 pub fn format_parser() -> impl clap::builder::TypedValueParser<Value = &'static Format> {
     use clap::builder::TypedValueParser;
-    clap::builder::PossibleValuesParser::new(FORMATS.iter().map(|f| f.name))
+    clap::builder::PossibleValuesParser::new(particle_formats().map(|f| f.name))
         .try_map(|name| Format::named(&name).ok_or_else(|| format!("unknown format '{name}'")))
 }
 
