@@ -78,8 +78,7 @@ pub type OpenFrames =
 pub type ReadAtoms = fn(path: &Path, bytes: &[u8]) -> Result<(Vec<atoms::Atom>, Vec<String>)>;
 
 /// Opens a trajectory from its bytes (header read, frames found).
-pub type OpenTrajectory =
-    fn(source: file::ByteSource) -> Result<Box<dyn frame_source::Trajectory>>;
+pub type OpenTrajectory = fn(source: file::ByteSource) -> Result<Box<dyn frame_source::Trajectory>>;
 
 /// One file format: an entry of [`FORMATS`], with what it reads.
 #[derive(Debug)]
