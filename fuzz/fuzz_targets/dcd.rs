@@ -4,7 +4,6 @@
 
 use libfuzzer_sys::fuzz_target;
 use pgt::formats::frames::ByteSource;
-use pgt::formats::topology::Trajectory;
 
 fuzz_target!(|data: &[u8]| {
     let source = ByteSource::from_bytes(std::path::Path::new("fuzz.dcd"), data.to_vec());
