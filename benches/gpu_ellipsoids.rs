@@ -3,7 +3,7 @@
 //! uniform in a cube at protein atom density, the thesis's two lights, Θmax 0.5), once as
 //! spheres and once with every sphere turned into an ellipsoid of the same volume, axis ratios
 //! up to 1:4 and a random orientation (`pgt bench`'s `1uun-ellipsoids` rule,
-//! [`pgt::cli::bench::as_ellipsoids`]). Each method runs on both, taking turns, best of
+//! [`pgt::bench::as_ellipsoids`]). Each method runs on both, taking turns, best of
 //! `PGT_BENCH_REPEAT`; the defaults:
 //!
 //!     PGT_BENCH_SIDE=128 PGT_BENCH_COUNT=11032 PGT_BENCH_REPEAT=3 cargo bench --bench gpu_ellipsoids
@@ -35,7 +35,7 @@ fn main() {
     let repeat: usize = gpu::env_or("PGT_BENCH_REPEAT", "3").parse().unwrap();
     let spheres = gpu::random_cube_scene(count, side);
     let mut ellipsoids = spheres.clone();
-    pgt::cli::bench::as_ellipsoids(&mut ellipsoids.particles);
+    pgt::bench::as_ellipsoids(&mut ellipsoids.particles);
     let volume = |name: &'static str, values: &'static [(&'static str, u32)], model: Model| Case {
         name,
         values,

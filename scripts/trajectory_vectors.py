@@ -20,6 +20,7 @@ import MDAnalysis as mda
 
 root = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).resolve().parents[2] / "shared" / "data"
 traj = root / "trajectories"
+xtc_cases = Path(__file__).resolve().parents[1] / "tests" / "data" / "xtc"
 
 
 def sample(universe, timed=True):
@@ -27,7 +28,7 @@ def sample(universe, timed=True):
     n = universe.atoms.n_atoms
     nf = universe.trajectory.n_frames
     atoms = sorted({0, 1, n // 2, n - 1})
-    frames = sorted({0, 1, nf - 1})
+    frames = sorted({0, min(1, nf - 1), nf - 1})
     out = {
         "frames": nf,
         "atoms": n,
@@ -102,7 +103,12 @@ vectors = {
     "ngl_md_xtc": sample(mda.Universe(str(traj / "ngl_md.gro"), str(traj / "ngl_md.xtc"))),
     "md_ascii_trj_pdb": sample(mda.Universe(str(traj / "md_ascii_trj.pdb")), timed=False),
     "1lvz_pdb": sample(mda.Universe(str(traj / "1LVZ.pdb")), timed=False),
+    "1lvz_cif": sample(mda.Universe(str(traj / "1LVZ.cif")), timed=False),
+    "ala3_pdb": sample(mda.Universe(str(traj / "ala3.pdb")), timed=False),
+    "ngl_md_gro": sample(mda.Universe(str(traj / "ngl_md.gro")), timed=False),
     "2r9r_xyz": sample(mda.Universe(str(traj / "2r9r-1b.xyz")), timed=False),
+    # Written by scripts/xtc_cases.py: the initial small-integer index 0.
+    "xtc_smallidx0": sample(mda.Universe(str(xtc_cases / "smallidx0.xtc"))),
     "testspheres_mmpld": mmpld_v100(root / "mmpld" / "testspheres_old_v100.mmpld"),
 }
 json.dump(vectors, sys.stdout, indent=1)

@@ -249,6 +249,22 @@ impl<'a> At<'a> {
 
 pub type Result<T, E = PgtError> = std::result::Result<T, E>;
 
+/// The one-line message of a failed command: the error and its causes joined by ": ", leaving
+/// out a cause whose text the line already ends with. pgt's own errors put their cause into
+/// their message *and* report it as `source()` (so that a library user can walk the chain);
+/// printing the chain naively would say "stream did not contain valid UTF-8" twice.
+pub fn error_message(e: &anyhow::Error) -> String {
+    let mut line = e.to_string();
+    for cause in e.chain().skip(1) {
+        let cause = cause.to_string();
+        if !line.ends_with(&cause) {
+            line.push_str(": ");
+            line.push_str(&cause);
+        }
+    }
+    line
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -279,5 +295,40 @@ mod tests {
     fn context_prefixes_the_message() {
         let e = PgtError::Usage("bad".into()).context("run 1");
         assert_eq!(e.to_string(), "run 1: bad");
+    }
+}
+
+#[cfg(test)]
+mod message_tests {
+    use super::*;
+
+    fn utf8_error() -> std::io::Error {
+        std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            "stream did not contain valid UTF-8",
+        )
+    }
+
+    #[test]
+    fn a_cause_already_in_the_message_is_said_once() {
+        let e = anyhow::Error::from(PgtError::io("gate.toml", utf8_error()));
+        assert_eq!(
+            error_message(&e),
+            "gate.toml: stream did not contain valid UTF-8"
+        );
+        let e = anyhow::Error::from(PgtError::io("a.toml", utf8_error()).context("run 3"));
+        assert_eq!(
+            error_message(&e),
+            "run 3: a.toml: stream did not contain valid UTF-8"
+        );
+    }
+
+    #[test]
+    fn a_cause_not_in_the_message_is_kept() {
+        let e = anyhow::Error::from(utf8_error()).context("reading the scene");
+        assert_eq!(
+            error_message(&e),
+            "reading the scene: stream did not contain valid UTF-8"
+        );
     }
 }

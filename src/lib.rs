@@ -1,11 +1,12 @@
 //! pgt — particle ground truth.
 //!
-//! Data flows one way (docs/design.md, STYLE.md): scene → geometry → optics → reference | approx →
-//! metrics → report, with the command line on top. This file holds only module lines and
-//! re-exports.
+//! Data flows one way (docs/design.md, tests/architecture.rs): scene → geometry → optics →
+//! reference | approx → metrics → report. The command line (`src/cli/`, a module of the `pgt`
+//! binary) and the Python package (`python/`) sit on top and only translate. This file holds
+//! only module lines and re-exports.
 
 pub mod approx;
-pub mod cli;
+pub mod bench;
 pub mod color;
 pub mod error;
 pub mod formats;
@@ -21,5 +22,5 @@ pub mod sequence;
 pub mod signals;
 pub mod sweep;
 
-pub use error::{PgtError, Result};
+pub use error::{error_message, PgtError, Result};
 pub use scene::{Scene, SceneLoadOptions};

@@ -1,7 +1,9 @@
 //! The `pgt` binary: parse, run, map the outcome to an exit code (docs/design.md §7: 0 success,
 //! 1 gate failed, 2 error).
 
-use pgt::cli::{self, Outcome};
+mod cli;
+
+use cli::Outcome;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -25,7 +27,7 @@ fn main() -> ExitCode {
         Ok(Outcome::Success) => ExitCode::SUCCESS,
         Ok(Outcome::GateFailed) => ExitCode::from(1),
         Err(e) => {
-            eprintln!("error: {}", cli::error_message(&e));
+            eprintln!("error: {}", pgt::error::error_message(&e));
             ExitCode::from(2)
         }
     }

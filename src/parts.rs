@@ -345,6 +345,29 @@ pub fn read_part(path: &Path) -> Result<Part> {
     })
 }
 
+/// Reads the part files and joins them ([`merge`]): the whole image and its `err` layer where
+/// the parts have one (`pgt merge`, `pgt.merge`).
+pub fn merge_files(paths: &[PathBuf]) -> Result<(RgbImage, Option<RgbImage>)> {
+    let mut parts = Vec::with_capacity(paths.len());
+    for path in paths {
+        parts.push((path.clone(), read_part(path)?));
+    }
+    merge(&parts)
+}
+
+/// The largest and the mean value of an error image over pixels and channels: the figures
+/// `pgt render` and `pgt merge` print for the whole image's error estimate.
+pub fn error_figures(error: &RgbImage) -> (f64, f64) {
+    let (max, sum) = error
+        .pixels
+        .iter()
+        .flatten()
+        .fold((0.0f64, 0.0f64), |(m, s), &v| {
+            (m.max(v as f64), s + v as f64)
+        });
+    (max, sum / (3 * error.pixels.len()).max(1) as f64)
+}
+
 /// Joins parts into the whole image and its error layer, after checking that they are exactly
 /// the N parts of one render: same image size, part count, render hash and layers, each index
 /// once, none missing. Every error names the file at fault.

@@ -14,6 +14,9 @@ use std::sync::{Mutex, MutexGuard};
 /// Temporary paths to remove on a signal, with the id of the guard that registered each.
 static REGISTRY: Mutex<Vec<(u64, PathBuf)>> = Mutex::new(Vec::new());
 static NEXT_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+/// Outputs made final by [`TempGuard::finish`] in this process (the frames of `--frames` that an
+/// interrupt leaves in place).
+static FINISHED: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 fn registry() -> MutexGuard<'static, Vec<(u64, PathBuf)>> {
     // A panic elsewhere while holding the lock must not stop the cleanup.
@@ -34,6 +37,7 @@ impl TempGuard {
         let result = finish();
         if result.is_ok() {
             list.retain(|(id, _)| *id != self.id);
+            FINISHED.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
         }
         drop(list);
         result
@@ -80,17 +84,32 @@ pub fn install() -> std::io::Result<()> {
         .name("pgt-signals".into())
         .spawn(move || {
             if let Some(signal) = signals.forever().next() {
-                let name = if signal == SIGINT { "SIGINT" } else { "SIGTERM" };
+                let name = if signal == SIGINT {
+                    "SIGINT"
+                } else {
+                    "SIGTERM"
+                };
                 // Holding the lock to the end: no new temporary file appears, no rename starts.
                 let list = registry();
                 let removed = list.iter().filter(|(_, p)| remove(p)).count();
-                eprintln!(
-                    "error: interrupted by {name}; {removed} temporary file(s) removed, no output written"
-                );
+                let finished = FINISHED.load(std::sync::atomic::Ordering::Relaxed);
+                eprintln!("error: {}", interrupted_line(name, removed, finished));
                 std::process::exit(exit_code(signal).into());
             }
         })?;
     Ok(())
+}
+
+/// What an interrupt did: the temporary files removed, and the outputs this run finished
+/// before it, which stay (the frames of `--frames`).
+fn interrupted_line(signal: &str, removed: usize, finished: u64) -> String {
+    if finished == 0 {
+        format!("interrupted by {signal}; {removed} temporary file(s) removed, no output written")
+    } else {
+        format!(
+            "interrupted by {signal}; {removed} temporary file(s) removed; the {finished} output file(s) finished before it are kept"
+        )
+    }
 }
 
 /// Removes a file or a folder with its contents; whether something was there.
@@ -122,6 +141,22 @@ mod tests {
         gb.finish(|| Ok::<_, ()>(())).unwrap();
         assert_eq!(count(&b), 0);
         assert_eq!((exit_code(2), exit_code(15)), (130, 143));
+    }
+
+    #[test]
+    fn the_interrupt_line_says_what_was_kept() {
+        let none = interrupted_line("SIGINT", 1, 0);
+        assert!(
+            none.ends_with("1 temporary file(s) removed, no output written"),
+            "{none}"
+        );
+        let kept = interrupted_line("SIGTERM", 2, 7);
+        assert!(
+            kept.contains("SIGTERM")
+                && kept.contains("the 7 output file(s) finished before it are kept"),
+            "{kept}"
+        );
+        assert!(!kept.contains("no output written"), "{kept}");
     }
 
     #[test]

@@ -7,7 +7,9 @@
 //!   module's `mod.rs` is its face (it declares, re-exports and may orchestrate its files) and
 //!   is not a node, and test code (`#[cfg(test)]` items, `tests.rs`, `*_tests.rs`) is left out;
 //! * no function outside tests (test modules and test files) is longer than
-//!   [`MAX_FUNCTION_LINES`] lines;
+//!   [`MAX_FUNCTION_LINES`] lines, in `src/` and in the Python package's `python/src/` alike;
+//! * the command line is a shell over the library: nothing outside `src/cli/` and `src/main.rs`
+//!   names `crate::cli` or `pgt::cli`, and `python/src/` names no `pgt::cli`;
 //! * the contract is inside the repository: every `§N` the code cites is a heading of
 //!   `docs/design.md`, every `docs/….md` it names exists (with the heading it quotes), and every
 //!   relative link of README.md and `docs/` resolves (to a file, and to a heading where it has
@@ -528,10 +530,22 @@ fn top_level_modules_have_no_cycle() {
     }
 }
 
+/// The Rust sources of the Python package.
+fn python_src_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("python")
+        .join("src")
+}
+
 #[test]
 fn no_function_is_longer_than_the_limit() {
     let mut files = Vec::new();
     rust_files(&src_dir(), &mut files);
+    rust_files(&python_src_dir(), &mut files);
+    assert!(
+        files.iter().any(|f| f.ends_with("python/src/scene.rs")),
+        "the scan did not reach python/src"
+    );
     let mut long = Vec::new();
     for f in files.iter().filter(|f| !is_test_file(f)) {
         let text = std::fs::read_to_string(f).unwrap();
@@ -544,6 +558,79 @@ fn no_function_is_longer_than_the_limit() {
         "functions over {MAX_FUNCTION_LINES} lines:\n{}",
         long.join("\n")
     );
+}
+
+/// Whether `text`'s code (comments left out) names the command line's module: `crate::cli`
+/// or `pgt::cli`, as a path of its own (`pgt::client` is not it).
+fn names_the_cli(text: &str) -> bool {
+    let code = strip_comments(text);
+    ["crate::cli", "pgt::cli"].iter().any(|needle| {
+        code.match_indices(needle).any(|(i, _)| {
+            let before = code[..i].chars().next_back();
+            let after = code[i + needle.len()..].chars().next();
+            !before.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_')
+                && !after.is_some_and(|c| c.is_ascii_alphanumeric() || c == '_')
+        })
+    })
+}
+
+/// The files under `src` (but `src/cli/` and `src/main.rs`) and `python_src` that name the
+/// command line's module.
+fn files_naming_the_cli(src: &Path, python_src: &Path) -> Vec<PathBuf> {
+    let mut files = Vec::new();
+    rust_files(src, &mut files);
+    rust_files(python_src, &mut files);
+    files
+        .into_iter()
+        .filter(|f| !(f.starts_with(src.join("cli")) || *f == src.join("main.rs")))
+        .filter(|f| names_the_cli(&std::fs::read_to_string(f).unwrap()))
+        .collect()
+}
+
+#[test]
+fn only_the_binary_uses_the_command_line() {
+    let found = files_naming_the_cli(&src_dir(), &python_src_dir());
+    assert!(
+        found.is_empty(),
+        "files outside src/cli/ and src/main.rs that use the command line's module (move what they use into the library):\n{}",
+        found
+            .iter()
+            .map(|f| f.display().to_string())
+            .collect::<Vec<_>>()
+            .join("\n")
+    );
+    let lib = std::fs::read_to_string(src_dir().join("lib.rs")).unwrap();
+    assert!(
+        !strip_comments(&lib).contains("mod cli"),
+        "src/lib.rs declares the cli module; it belongs to the binary (src/main.rs)"
+    );
+}
+
+#[test]
+fn the_cli_scan_finds_a_use_of_the_cli() {
+    // A scratch tree: a library file and a Python file that use the CLI, one that only
+    // mentions it in a comment or names a look-alike, and the CLI's own files.
+    let root = std::env::temp_dir().join(format!("pgt-arch-cli-{}", std::process::id()));
+    let (src, py) = (root.join("src"), root.join("python/src"));
+    std::fs::create_dir_all(src.join("cli")).unwrap();
+    std::fs::create_dir_all(&py).unwrap();
+    std::fs::write(src.join("lib.rs"), "pub mod a;\n").unwrap();
+    std::fs::write(src.join("a.rs"), "use crate::cli::render::f;\n").unwrap();
+    std::fs::write(
+        src.join("b.rs"),
+        "// crate::cli in a comment\nuse crate::client::X;\n",
+    )
+    .unwrap();
+    std::fs::write(src.join("main.rs"), "mod cli;\nuse crate::cli::run;\n").unwrap();
+    std::fs::write(src.join("cli/mod.rs"), "use crate::cli::x;\n").unwrap();
+    std::fs::write(py.join("p.rs"), "let m = pgt::cli::error_message(&e);\n").unwrap();
+    let found = files_naming_the_cli(&src, &py);
+    std::fs::remove_dir_all(&root).unwrap();
+    let names: Vec<String> = found
+        .iter()
+        .map(|f| f.file_name().unwrap().to_string_lossy().into_owned())
+        .collect();
+    assert_eq!(names, vec!["a.rs".to_string(), "p.rs".to_string()]);
 }
 
 #[test]

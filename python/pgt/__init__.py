@@ -15,7 +15,10 @@ as the ``pgt`` command line: the values are the CLI's, bit for bit.
 Scenes: load_scene, Scene.from_arrays, directional_light, point_light; load_frames -> Frames
 (trajectories, sequences, camera orbits: .frame(t) is a Scene).
 Rendering: render (exact, CPU), approx (GPU methods and WGSL files), approx_methods.
-Measuring: compare -> Comparison (.gate, .summary, .write_report).
+Measuring: compare -> Comparison (.gate, .summary, .write_report) of two images, or
+SequenceComparison (.summary, .verdict, .passed) of two sequences of frames; sweep (an
+experiment file and its report).
+Cluster renders and speed: merge (the parts of `pgt render --part`), bench.
 Images: read_image, write_image (EXR with the err layer, PNG).
 Errors: Error, InputError (ValueError), FileError (OSError), GpuError, NoAdapterError;
 warnings: PgtWarning.
@@ -41,8 +44,12 @@ from ._pgt import (
     PerChannel,
     RenderResult,
     Scene,
+    SequenceComparison,
     approx_methods,
+    bench,
+    merge,
     read_image,
+    sweep,
     write_image,
 )
 
@@ -63,15 +70,19 @@ __all__ = [
     "PgtWarning",
     "RenderResult",
     "Scene",
+    "SequenceComparison",
     "approx",
     "approx_methods",
+    "bench",
     "compare",
     "directional_light",
     "load_frames",
     "load_scene",
+    "merge",
     "point_light",
     "read_image",
     "render",
+    "sweep",
     "write_image",
 ]
 
@@ -90,8 +101,9 @@ def load_scene(
     format: Optional[str] = None,
 ) -> Scene:
     """Load a scene: a scene file (.toml) or a bare particle file (PDB, mmCIF, VRML, MMPLD,
-    XYZ, CSV), which gets the default scene (camera framing the particles from -z, the
-    thesis's two lights, black background).
+    XYZ, CSV, GRO, PLY), which gets the default scene (camera framing the particles from -z,
+    the thesis's two lights, black background). A scene moves when its includes play frames
+    (trajectories, models, sequences): see ``load_frames``.
 
     Arguments (the overrides of ``pgt render SCENE``):
       path   scene file (.toml) or a bare particle file.
@@ -293,7 +305,10 @@ def compare(
     ppd: float = _pgt.DEFAULT_PIXELS_PER_DEGREE,
     flip_exposures: Optional[Tuple[float, float]] = None,
     layer: Optional[str] = None,
-) -> Comparison:
+    pop_threshold: Optional[float] = None,
+    gate: Union[None, Mapping[str, Any], PathLike] = None,
+    report: Optional[PathLike] = None,
+) -> Union[Comparison, SequenceComparison]:
     """Compare an approximation with the reference (``pgt compare``): SSIM, RMSE, PSNR, mean
     absolute and relative error, max absolute error, FLIP, per channel and mean, and the maps.
 
@@ -312,7 +327,17 @@ def compare(
       flip_exposures HDR-FLIP exposure range (start, stop) in stops [from the reference].
       layer          EXR layer to compare (channels LAYER.R/G/B) in both files.
 
-    Returns a Comparison: ``.ssim``, ``.rmse``, ``.psnr``, ``.mean_abs``, ``.mean_rel``
+    Two sequences of frames (each a folder, or a printf pattern such as ``ref/f_%04d.exr``)
+    are compared frame by frame, with the temporal error of every frame after the first
+    (docs/design.md §10), as ``pgt compare REF_SEQ APPROX_SEQ`` does:
+      pop_threshold  the temporal error above which a pixel pops [0.05 × the data range].
+      gate           a dict of thresholds or a gate file: the per-image ones held by every
+                     frame, the temporal ones (max_temporal_p99, ...) by the worst frame.
+      report         a folder for the report that plays the sequences.
+    It returns a SequenceComparison: ``.summary()`` (the CLI's JSON), ``.verdict``,
+    ``.passed``, ``.frames``, ``.report_page``. A sequence against one image is an InputError.
+
+    Returns a Comparison (two images): ``.ssim``, ``.rmse``, ``.psnr``, ``.mean_abs``, ``.mean_rel``
     (PerChannel: .r .g .b .mean), ``.max_abs``, ``.flip``, the maps ``.abs_error``,
     ``.rel_error``, ``.ssim_map``, ``.flip_map``, and ``.gate(dict or path)``,
     ``.summary()``, ``.verdict()``, ``.write_report(directory)``.
@@ -320,6 +345,31 @@ def compare(
     Arrays are copied once (into pgt's image type); NaN and infinity are refused with an
     InputError naming the argument. The GIL is released while measuring.
     """
+    paths = [p for p in (reference, approximation) if isinstance(p, (str, os.PathLike))]
+    sequences = [_pgt.is_sequence(p) for p in paths]
+    if len(paths) == 2 and all(sequences):
+        if layer is not None:
+            raise InputError("layer compares one layer of two images; it does not apply to sequences")
+        return _pgt.compare_sequences(
+            reference,
+            approximation,
+            data_range=data_range,
+            flip=flip,
+            ppd=ppd,
+            flip_exposures=flip_exposures,
+            pop_threshold=pop_threshold,
+            gate=gate,
+            report=report,
+        )
+    if any(sequences):
+        raise InputError(
+            "compare two sequences of frames (folders or %d patterns) or two images, not a sequence and an image"
+        )
+    for name, value in (("pop_threshold", pop_threshold), ("gate", gate), ("report", report)):
+        if value is not None:
+            raise InputError(
+                f"{name} applies to sequences of frames; for two images use Comparison.gate() and .write_report()"
+            )
     if isinstance(reference, RenderResult):
         if reference_err is None:
             reference_err = reference.err
@@ -338,4 +388,3 @@ def compare(
         flip_exposures=flip_exposures,
         layer=layer,
     )
-

@@ -153,6 +153,7 @@ class GateResult:
     @property
     def verdict(self) -> str: ...
     def __bool__(self) -> bool: ...
+    def __str__(self) -> str: ...
 
 @final
 class Comparison:
@@ -274,3 +275,49 @@ def write_image(
     err: Optional[npt.ArrayLike] = None,
     exposure: float = 0.0,
 ) -> None: ...
+
+class SequenceComparison:
+    @property
+    def frames(self) -> int: ...
+    @property
+    def verdict(self) -> str: ...
+    @property
+    def passed(self) -> Optional[bool]: ...
+    @property
+    def report_page(self) -> Optional[pathlib.Path]: ...
+    def summary(self) -> Dict[str, Any]: ...
+
+def is_sequence(path: _Path) -> bool: ...
+def compare_sequences(
+    reference: _Path,
+    approximation: _Path,
+    *,
+    data_range: Optional[float] = None,
+    flip: bool = True,
+    ppd: float = ...,
+    flip_exposures: Optional[Tuple[float, float]] = None,
+    pop_threshold: Optional[float] = None,
+    gate: Any = None,
+    report: Optional[_Path] = None,
+) -> SequenceComparison: ...
+def sweep(
+    experiment: _Path,
+    report: _Path,
+    *,
+    size: Optional[Tuple[int, int]] = None,
+    threads: Optional[int] = None,
+) -> Tuple[int, pathlib.Path]: ...
+def merge(
+    parts: Sequence[_Path], output: Optional[_Path] = None, *, exposure: float = 0.0
+) -> Tuple[_Image, Optional[_Image]]: ...
+def bench(
+    *,
+    size: int = 512,
+    workloads: Sequence[str] = ("1uun", "random", "million"),
+    no_baselines: bool = False,
+    accuracy: bool = False,
+    threads: Optional[int] = None,
+    repeat: int = 1,
+    frames: Optional[int] = None,
+    data: _Path = "../shared/data",
+) -> str: ...

@@ -94,7 +94,8 @@ impl From<&LibGateCheck> for GateCheck {
 }
 
 /// A gate evaluated on a comparison, as `pgt compare --gate` evaluates it. True in a boolean
-/// context when every threshold passed: `assert result, result.verdict` in a test.
+/// context when every threshold passed: `assert (g := cmp.gate(...)), g.verdict` in a test
+/// (the verdict names the thresholds that failed).
 #[pyclass(frozen, module = "pgt")]
 pub struct GateResult {
     /// True when every threshold passed, False when one failed, None for an empty gate.
@@ -123,12 +124,30 @@ impl GateResult {
     fn __repr__(&self) -> String {
         format!("<pgt.GateResult {}>", self.verdict)
     }
+
+    /// The verdict, so that an assertion on the result shows which threshold failed.
+    fn __str__(&self) -> String {
+        self.verdict.clone()
+    }
 }
 
 /// The gate of a `gate=` argument: a dict with the keys of a gate file, the path of a gate
 /// file (TOML), or None for no thresholds. A comparison is of two images, so a threshold on
 /// the temporal error of a sequence is refused, as `pgt compare` refuses it on two images.
 fn gate_from(py: Python<'_>, gate: Option<&Bound<'_, PyAny>>) -> PyResult<Gate> {
+    let gate = gate_of_any_kind(py, gate)?;
+    if let Some((name, _)) = gate.temporal_keys().first() {
+        return Err(input_error(
+            py,
+            format!("gate: {name} gates the temporal error of a sequence of frames; a comparison is of two images"),
+        ));
+    }
+    Ok(gate)
+}
+
+/// The gate of a `gate=` argument (a dict, the path of a gate file or None), per-image and
+/// temporal thresholds alike.
+pub fn gate_of_any_kind(py: Python<'_>, gate: Option<&Bound<'_, PyAny>>) -> PyResult<Gate> {
     const NAME: &str = "gate";
     let Some(gate) = gate.filter(|g| !g.is_none()) else {
         return Ok(Gate::default());
@@ -147,12 +166,6 @@ fn gate_from(py: Python<'_>, gate: Option<&Bound<'_, PyAny>>) -> PyResult<Gate> 
         })?;
         Gate::load(&path).py_err(py)?
     };
-    if let Some((name, _)) = gate.temporal_keys().first() {
-        return Err(input_error(
-            py,
-            format!("gate: {name} gates the temporal error of a sequence of frames; a comparison is of two images"),
-        ));
-    }
     Ok(gate)
 }
 
@@ -502,7 +515,9 @@ pub fn compare(
         let (pair, estimate) = rayon::join(
             || -> anyhow::Result<(RgbImage, RgbImage)> {
                 match (reference, approximation) {
-                    (Input::File(r), Input::File(a)) => pgt::cli::compare::load_pair(&r, &a, layer),
+                    (Input::File(r), Input::File(a)) => {
+                        pgt::image_io::load_pair(&r, &a, layer, &pgt::reference::render_scene_file)
+                    }
                     (r, a) => Ok((read(r, layer)?, read(a, layer)?)),
                 }
             },

@@ -2,7 +2,7 @@
 //! root, `InputError` (also a `ValueError`) for bad input and arguments, `FileError` (also an
 //! `OSError`, with `errno`) for a file that cannot be read or written, `GpuError` (also a
 //! `RuntimeError`) and its `NoAdapterError` for the GPU side. The message is the CLI's
-//! (`pgt::cli::error_message`), so a Python user reads what a shell user reads.
+//! (`pgt::error::error_message`), so a Python user reads what a shell user reads.
 
 use pgt::PgtError;
 use pyo3::exceptions::PyKeyboardInterrupt;
@@ -60,7 +60,7 @@ pub fn to_py(py: Python<'_>, e: PgtError) -> PyErr {
     exception(
         py,
         name,
-        pgt::cli::error_message(&anyhow::Error::from(e)),
+        pgt::error::error_message(&anyhow::Error::from(e)),
         errno,
     )
 }
@@ -68,7 +68,7 @@ pub fn to_py(py: Python<'_>, e: PgtError) -> PyErr {
 /// An error of the CLI's functions (an `anyhow` chain): classified by the first library error
 /// or I/O error in the chain, an `InputError` otherwise.
 pub fn anyhow_to_py(py: Python<'_>, e: anyhow::Error) -> PyErr {
-    let message = pgt::cli::error_message(&e);
+    let message = pgt::error::error_message(&e);
     let (name, errno) = e
         .chain()
         .find_map(|c| {

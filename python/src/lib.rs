@@ -1,15 +1,15 @@
 //! The extension module `pgt._pgt` of the Python package `pgt` (docs/design.md §11): the pgt
 //! library with numpy arrays in and out. Every function reaches the library entry point the
 //! CLI reaches (`Scene::load`, `reference::render_controlled`, `approx::render_approx`,
-//! `report::Compared`, `image_io`), so values are the CLI's bit for bit; this crate only turns
+//! `report::Compared`, `report::sequence_compare`, `parts`, `bench`, `image_io`), so values are the CLI's bit for bit; this crate only turns
 //! Python arguments into the library's types and results into arrays. The Python half of the
 //! package (`pgt/__init__.py`) holds the documented public functions.
 //!
 //! * [`arrays`]: numpy in and out, and where values are copied.
 //! * [`errors`]: the `pgt.Error` hierarchy.
 //! * [`settings`]: keyword arguments as scene-file and gate-file tables.
-//! * [`scene`], [`frames`], [`render`], [`approx`], [`compare`], [`images`]: one per part of
-//!   the API.
+//! * [`scene`], [`frames`], [`render`], [`approx`], [`compare`], [`sequences`], [`tools`]
+//!   (sweep, merge, bench), [`images`]: one per part of the API.
 
 mod approx;
 mod arrays;
@@ -19,7 +19,9 @@ mod frames;
 mod images;
 mod render;
 mod scene;
+mod sequences;
 mod settings;
+mod tools;
 
 use pyo3::prelude::*;
 
@@ -45,6 +47,8 @@ fn _pgt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(approx::approx, m)?)?;
     m.add_function(wrap_pyfunction!(approx::approx_methods, m)?)?;
     compare::register(m)?;
+    sequences::register(m)?;
+    tools::register(m)?;
     m.add_function(wrap_pyfunction!(images::read_image, m)?)?;
     m.add_function(wrap_pyfunction!(images::write_image, m)?)?;
     Ok(())

@@ -212,7 +212,14 @@ pub fn render(
     })?
     .map_err(|e| to_py(py, e))?;
     let s = out.stats;
-    if let Some(w) = pgt::cli::render::unconverged_warning(&s, scene.render.tol) {
+    if let Some(w) = pgt::reference::unconverged_warning(&s, scene.render.tol) {
+        warn(py, &w, 2)?;
+    }
+    let above_tol = out
+        .error
+        .as_ref()
+        .and_then(|err| pgt::reference::err_above_tol_warning(err, scene.render.tol, scene));
+    if let Some(w) = above_tol {
         warn(py, &w, 2)?;
     }
     Ok(RenderResult {

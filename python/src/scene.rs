@@ -172,6 +172,33 @@ fn put(table: &mut toml::Table, key: &str, value: Option<&Bound<'_, PyAny>>) -> 
     Ok(())
 }
 
+/// The particles' shape among `from_arrays`' arguments (which were given): radii for
+/// spheres or semi-axes for ellipsoids, rotations only with semi-axes.
+fn shape_arguments(py: Python<'_>, radii: bool, semi_axes: bool, rotations: bool) -> PyResult<()> {
+    match (radii, semi_axes) {
+        (true, true) => {
+            return Err(input_error(
+                py,
+                format!("{FROM_ARRAYS}: give radii (spheres) or semi_axes (ellipsoids), not both"),
+            ))
+        }
+        (false, false) => {
+            return Err(input_error(
+                py,
+                format!("{FROM_ARRAYS}: give radii (spheres) or semi_axes (ellipsoids)"),
+            ))
+        }
+        _ => {}
+    }
+    if rotations && !semi_axes {
+        return Err(input_error(
+            py,
+            format!("{FROM_ARRAYS}: rotations turn ellipsoids; give semi_axes with them"),
+        ));
+    }
+    Ok(())
+}
+
 #[pymethods]
 impl Scene {
     /// A scene from particle arrays, with the defaults of `pgt render PARTICLES` (a bare
@@ -249,29 +276,12 @@ impl Scene {
             semi_axes.filter(|v| !v.is_none()),
             rotations.filter(|v| !v.is_none()),
         );
-        match (&radii, &semi_axes) {
-            (Some(_), Some(_)) => {
-                return Err(input_error(
-                    py,
-                    format!(
-                        "{FROM_ARRAYS}: give radii (spheres) or semi_axes (ellipsoids), not both"
-                    ),
-                ))
-            }
-            (None, None) => {
-                return Err(input_error(
-                    py,
-                    format!("{FROM_ARRAYS}: give radii (spheres) or semi_axes (ellipsoids)"),
-                ))
-            }
-            _ => {}
-        }
-        if rotations.is_some() && semi_axes.is_none() {
-            return Err(input_error(
-                py,
-                format!("{FROM_ARRAYS}: rotations turn ellipsoids; give semi_axes with them"),
-            ));
-        }
+        shape_arguments(
+            py,
+            radii.is_some(),
+            semi_axes.is_some(),
+            rotations.is_some(),
+        )?;
         let radii: Option<Floats<Ix1>> = radii
             .map(|r| floats("radii", r, &[Size::Is(n)]))
             .transpose()
@@ -371,7 +381,7 @@ impl Scene {
             Vec::with_capacity(n),
         );
         for p in particles {
-            let [x, y, z, r, red, green, blue, theta, s] = pgt::cli::export::row(p);
+            let [x, y, z, r, red, green, blue, theta, s] = pgt::scene::export::row(p);
             center.extend([x, y, z]);
             radius.push(r);
             color.extend([red, green, blue]);
@@ -387,7 +397,7 @@ impl Scene {
         if particles.iter().any(|p| p.ellipsoid.is_some()) {
             let (mut axes, mut rotation) = (Vec::with_capacity(3 * n), Vec::with_capacity(4 * n));
             for p in particles {
-                let row = pgt::cli::export::ellipsoid_row(p);
+                let row = pgt::scene::export::ellipsoid_row(p);
                 axes.extend_from_slice(&row[3..6]);
                 rotation.extend_from_slice(&row[6..10]);
             }
@@ -415,7 +425,7 @@ impl Scene {
                 ),
             ));
         };
-        let cam = pgt::cli::camera::camera_json(&self.inner);
+        let cam = self.inner.camera_json();
         let projection = &cam.projection[chosen.key()];
         let matrix = |rows: &[[f64; 4]; 4]| {
             vec_to_array(py, rows.iter().flatten().copied().collect(), Ix2(4, 4))
@@ -431,7 +441,7 @@ impl Scene {
         )?;
         out.set_item("convention", &projection.convention)?;
         out.set_item("eye", vec3(cam.eye))?;
-        out.set_item("look_at", vec3(cam.look_at))?;
+        out.set_item("eye_plus_forward", vec3(cam.eye_plus_forward))?;
         out.set_item("forward", vec3(cam.forward))?;
         out.set_item("right", vec3(cam.right))?;
         out.set_item("up", vec3(cam.up))?;

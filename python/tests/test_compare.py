@@ -94,6 +94,16 @@ def test_gates_as_the_cli_evaluates_them(pair, tmp_path, run_cli):
     assert cmp.summary(tight)["passed"] is False and cmp.summary()["passed"] is None
 
 
+def test_the_readme_assert_pattern_names_the_failed_gate(pair):
+    truth, approx, _, _ = pair
+    cmp = pgt.compare(truth, approx)
+    with pytest.raises(AssertionError) as failed:
+        assert (gate := cmp.gate({"min_ssim": 0.999999})), gate.verdict
+    assert str(failed.value).startswith("FAIL") and "min_ssim = " in str(failed.value)
+    # The result prints as its verdict, so a bare `assert cmp.gate(...)` shows it too.
+    assert str(cmp.gate({"min_ssim": 0.999999})) == cmp.gate({"min_ssim": 0.999999}).verdict
+
+
 def test_gate_errors(pair, tmp_path):
     truth, approx, _, _ = pair
     cmp = pgt.compare(truth, approx)

@@ -162,7 +162,7 @@ def test_camera_matrices_are_what_pgt_camera_prints(example, run_cli):
         np.testing.assert_array_equal(cam["view"], np.array(printed["view"]["row_major"]))
         assert cam["depth_range"] == tuple(want["depth_range"])
         assert cam["convention"] == want["convention"]
-        for key in ("eye", "look_at", "forward", "right", "up", "background"):
+        for key in ("eye", "eye_plus_forward", "forward", "right", "up", "background"):
             np.testing.assert_array_equal(cam[key], printed[key])
         for key in ("fov_y_deg", "fov_x_deg", "tan_half_fov_y", "width", "height", "aspect", "near", "far"):
             assert cam[key] == printed[key], key

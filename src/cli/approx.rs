@@ -1,14 +1,14 @@
 //! `pgt approx SCENE --method thesis --samples 100 --n-exact 5 -o OUT` (docs/design.md §4, §7): the
 //! GPU approximation, or a user's method with `--shader FILE.wgsl`. The methods and their
-//! parameters come from the registry (`crate::approx::methods`); `--list-methods` prints it.
+//! parameters come from the registry (`pgt::approx::methods`); `--list-methods` prints it.
 
 use super::output::{check_outputs, Output, OutputKind};
 use super::Outcome;
-use crate::approx::{self, methods, ApproxParams, Method, Timing, N_EXACT_ALL};
-use crate::image_io::write_image;
-use crate::scene::{Model, RenderMode, SceneLoadOptions};
 use clap::builder::PossibleValuesParser;
 use clap::Args;
+use pgt::approx::{self, methods, ApproxParams, Method, Timing, N_EXACT_ALL};
+use pgt::image_io::write_image;
+use pgt::scene::{Model, RenderMode, SceneLoadOptions};
 use std::path::PathBuf;
 use std::time::{Duration, Instant};
 
@@ -26,11 +26,11 @@ pub struct ApproxArgs {
     /// frame), as an include's `frames`. A frame whose EXR already holds this render (same scene, method,
     /// parameters and adapter) is skipped.
     #[arg(long, value_name = "RANGE")]
-    pub frames: Option<crate::sequence::FrameRange>,
+    pub frames: Option<pgt::sequence::FrameRange>,
     /// With --frames: approximate only part I of N of the frames (every N-th from the I-th; I
     /// from 0, as job arrays count).
-    #[arg(long, value_parser = crate::parts::parse_part, value_name = "I/N", requires = "frames")]
-    pub part: Option<crate::parts::PartOf>,
+    #[arg(long, value_parser = pgt::parts::parse_part, value_name = "I/N", requires = "frames")]
+    pub part: Option<pgt::parts::PartOf>,
     /// Approximation method (see --list-methods) [default: opaque for opaque scenes, thesis
     /// otherwise].
     #[arg(long, value_parser = PossibleValuesParser::new(methods::names()), conflicts_with = "shader")]
@@ -69,7 +69,7 @@ pub struct ApproxArgs {
     /// The format of a bare particle file, whatever its extension (a scene file names the
     /// format of each include with `format = "…"`).
     #[arg(long, value_name = "NAME", value_parser = super::format_parser())]
-    pub format: Option<&'static crate::formats::Format>,
+    pub format: Option<&'static pgt::formats::Format>,
     /// PNG exposure in stops (2^exposure scales the linear image before encoding).
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true)]
     pub exposure: f32,
@@ -282,7 +282,7 @@ pub fn run(args: ApproxArgs) -> anyhow::Result<Outcome> {
         output.display(),
         scene.camera.width,
         scene.camera.height,
-        super::render::particles_text(&scene),
+        scene.particles_text(),
         scene.lights.len(),
         out.method.name(),
         describe_params(&out.method, &out.params),
@@ -304,13 +304,13 @@ fn approx_frames(
     scene_path: &std::path::Path,
     output: &std::path::Path,
     options: &SceneLoadOptions,
-    range: crate::sequence::FrameRange,
+    range: pgt::sequence::FrameRange,
 ) -> anyhow::Result<Outcome> {
     let (frames, list, pattern) =
         super::frames::open_sequence(scene_path, options, args.exposure, range, args.part, output)?;
     let params = args.params()?;
     let progress = super::frames::FrameProgress::new("approx", list.len());
-    let out = crate::sequence::render::approx_frames(
+    let out = pgt::sequence::render::approx_frames(
         &frames,
         &list,
         &pattern,
@@ -326,7 +326,7 @@ fn approx_frames(
         .frames
         .iter()
         .map(|f| match f {
-            crate::sequence::render::FrameDone::Rendered { seconds, .. } => *seconds,
+            pgt::sequence::render::FrameDone::Rendered { seconds, .. } => *seconds,
             _ => 0.0,
         })
         .sum();
@@ -364,7 +364,7 @@ fn approx_frames(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::approx::dispatch::PassProgress;
+    use pgt::approx::dispatch::PassProgress;
 
     fn pass(passes: u32) -> PassProgress {
         PassProgress {

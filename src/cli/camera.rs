@@ -1,12 +1,12 @@
 //! `pgt camera SCENE [--json]` (docs/design.md §7): the scene's camera (after default framing) as a
 //! rasterising engine wants it: eye, basis, fov, size, the pixel-centre convention, the view
 //! matrix and a projection matrix per graphics API with near/far from the scene's bounds
-//! ([`crate::geometry::projection`]).
+//! ([`pgt::geometry::projection`]).
 
 use super::Outcome;
-use crate::geometry::projection::{CameraJson, MatrixJson};
-use crate::scene::{Scene, SceneLoadOptions};
 use clap::Args;
+use pgt::geometry::projection::{CameraJson, MatrixJson};
+use pgt::scene::SceneLoadOptions;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
@@ -21,7 +21,7 @@ pub struct CameraArgs {
     /// The format of a bare particle file, whatever its extension (a scene file names the
     /// format of each include with `format = "…"`).
     #[arg(long, value_name = "NAME", value_parser = super::format_parser())]
-    pub format: Option<&'static crate::formats::Format>,
+    pub format: Option<&'static pgt::formats::Format>,
     /// The frame (from 0) of a scene that moves: its particles and camera, as `pgt render
     /// --frames` renders it.
     #[arg(long, value_name = "K")]
@@ -29,15 +29,6 @@ pub struct CameraArgs {
     /// Print JSON on stdout instead of text.
     #[arg(long)]
     pub json: bool,
-}
-
-/// The camera JSON of a loaded scene.
-pub fn camera_json(scene: &Scene) -> CameraJson {
-    CameraJson::new(
-        &scene.camera,
-        scene.particles.iter().map(|p| (p.center, p.radius)),
-        scene.render.background,
-    )
 }
 
 fn write_matrix(t: &mut String, name: &str, m: &MatrixJson) {
@@ -58,11 +49,11 @@ pub fn run(args: CameraArgs) -> anyhow::Result<Outcome> {
         format: args.format,
         ..SceneLoadOptions::default()
     };
-    let scene = super::frames::scene_at_frame(&args.scene, &options, args.frame)?;
+    let scene = pgt::sequence::scene_at_frame(&args.scene, &options, args.frame)?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
-    let cam = camera_json(&scene);
+    let cam = scene.camera_json();
     let text = if args.json {
         serde_json::to_string_pretty(&cam)? + "\n"
     } else {

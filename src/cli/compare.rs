@@ -6,13 +6,13 @@
 
 use super::output::{check_outputs, Output, OutputKind};
 use super::Outcome;
-use crate::image_io::{read_image_layer, ReadImage, RgbImage};
-use crate::metrics::gate::Gate;
-use crate::metrics::{CompareOptions, DataRangeSource};
-use crate::report::{self, Compared, ReportOptions};
 use anyhow::Context;
 use clap::Args;
-use std::path::{Path, PathBuf};
+use pgt::image_io::load_pair;
+use pgt::metrics::gate::Gate;
+use pgt::metrics::{CompareOptions, DataRangeSource};
+use pgt::report::{self, Compared, ReportOptions};
+use std::path::PathBuf;
 use std::time::Instant;
 
 #[derive(Debug, Args)]
@@ -67,7 +67,7 @@ pub struct CompareArgs {
     #[arg(long)]
     pub max_temporal_p99: Option<f64>,
     /// FLIP's viewing condition in pixels per degree.
-    #[arg(long, default_value_t = crate::metrics::flip::DEFAULT_PIXELS_PER_DEGREE)]
+    #[arg(long, default_value_t = pgt::metrics::flip::DEFAULT_PIXELS_PER_DEGREE)]
     pub ppd: f32,
 }
 
@@ -91,7 +91,7 @@ pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
         error_scale: args.error_scale,
         rel_scale: args.rel_scale,
     };
-    crate::report::compared::check_options(&options, &report_options)?;
+    pgt::report::compared::check_options(&options, &report_options)?;
     let mut gate = match &args.gate {
         Some(path) => Gate::load(path)?,
         None => Gate::default(),
@@ -106,8 +106,15 @@ pub fn run(args: CompareArgs) -> anyhow::Result<Outcome> {
     }
     // The reference's error estimate is a second read of its EXR: done beside the pair's.
     let (pair, estimate) = rayon::join(
-        || load_pair(&args.reference, &args.approximation, args.layer.as_deref()),
-        || crate::image_io::read_reference_estimate(&args.reference, args.layer.as_deref()),
+        || {
+            load_pair(
+                &args.reference,
+                &args.approximation,
+                args.layer.as_deref(),
+                &pgt::reference::render_scene_file,
+            )
+        },
+        || pgt::image_io::read_reference_estimate(&args.reference, args.layer.as_deref()),
     );
     let (reference, approximation) = pair?;
     let labels = (
@@ -170,7 +177,7 @@ fn compare_sequences(args: &CompareArgs, gate: &Gate) -> anyhow::Result<Option<O
         anyhow::bail!("--pop-threshold must be a finite number ≥ 0");
     }
     let sequences =
-        [&args.reference, &args.approximation].map(|p| crate::sequence::compare::is_sequence(p));
+        [&args.reference, &args.approximation].map(|p| pgt::sequence::compare::is_sequence(p));
     match sequences {
         [true, true] => {
             if args.layer.is_some() {
@@ -178,7 +185,7 @@ fn compare_sequences(args: &CompareArgs, gate: &Gate) -> anyhow::Result<Option<O
                     "--layer compares one layer of two images; it does not apply to sequences"
                 );
             }
-            let seq = super::compare_frames::SequenceArgs {
+            let seq = pgt::report::sequence_compare::SequenceArgs {
                 reference: &args.reference,
                 approximation: &args.approximation,
                 options: CompareOptions {
@@ -188,10 +195,9 @@ fn compare_sequences(args: &CompareArgs, gate: &Gate) -> anyhow::Result<Option<O
                     flip_exposures: args.flip_exposures,
                 },
                 pop_threshold: args.pop_threshold,
-                json: args.json.as_deref(),
                 report: args.report.as_deref(),
             };
-            return super::compare_frames::run(&seq, gate).map(Some);
+            return super::compare_frames::run(&seq, gate, args.json.as_deref()).map(Some);
         }
         [true, false] | [false, true] => {
             let (seq, one) = if sequences[0] {
@@ -228,98 +234,4 @@ fn parse_exposures(s: &str) -> Result<(f32, f32), String> {
     } else {
         Err(err())
     }
-}
-
-/// An image file, or a scene file (`.toml`) rendered on the fly by the exact reference with its
-/// default options (docs/design.md §5 "Inputs: … or scenes rendered on the fly").
-/// Whether a path names a scene (`.toml`) rather than an image.
-fn is_scene(path: &Path) -> bool {
-    path.extension()
-        .and_then(|e| e.to_str())
-        .is_some_and(|e| e.eq_ignore_ascii_case("toml"))
-}
-
-fn read_or_render(path: &Path, layer: Option<&str>) -> anyhow::Result<ReadImage> {
-    if !is_scene(path) {
-        return Ok(read_image_layer(path, layer)?);
-    }
-    if layer.is_some_and(|l| !l.is_empty()) {
-        anyhow::bail!(
-            "{}: --layer applies to EXR files, not to a scene",
-            path.display()
-        );
-    }
-    let scene = crate::scene::Scene::load(path, &crate::scene::SceneLoadOptions::default())?;
-    for w in &scene.warnings {
-        eprintln!("warning: {w}");
-    }
-    let options = crate::reference::RenderOptions {
-        progress: super::stderr_is_terminal(),
-        ..Default::default()
-    };
-    let out = crate::reference::render(&scene, &options)?;
-    eprintln!(
-        "rendered the reference of {} in {:.2} s",
-        path.display(),
-        out.stats.seconds
-    );
-    if let Some(w) = super::render::unconverged_warning(&out.stats, scene.render.tol) {
-        eprintln!("warning: {w}");
-    }
-    Ok(ReadImage {
-        image: out.image,
-        channels: 3,
-    })
-}
-
-/// Reads both images (or renders scenes) and checks they can be compared: same size and channel count (an error
-/// naming both files otherwise).
-pub fn load_pair(
-    reference: &Path,
-    approximation: &Path,
-    layer: Option<&str>,
-) -> anyhow::Result<(RgbImage, RgbImage)> {
-    // Two files are read at once (a 4K pair: half the reading time on two cores); a scene
-    // renders alone, with its progress bar, and only once the reference is there.
-    let (r, a) = if is_scene(reference) || is_scene(approximation) {
-        let r = read_or_render(reference, layer)?;
-        (r, read_or_render(approximation, layer)?)
-    } else {
-        let (r, a) = rayon::join(
-            || read_or_render(reference, layer),
-            || read_or_render(approximation, layer),
-        );
-        (r?, a?)
-    };
-    if (r.image.width, r.image.height) != (a.image.width, a.image.height) {
-        anyhow::bail!(
-            "images differ in size: {} is {}x{}, {} is {}x{}",
-            reference.display(),
-            r.image.width,
-            r.image.height,
-            approximation.display(),
-            a.image.width,
-            a.image.height
-        );
-    }
-    if r.channels != a.channels {
-        anyhow::bail!(
-            "images differ in channel count: {} has {}, {} has {}",
-            reference.display(),
-            r.channels,
-            approximation.display(),
-            a.channels
-        );
-    }
-    for (path, img) in [(reference, &r.image), (approximation, &a.image)] {
-        if let Some((x, y, c)) = crate::metrics::first_non_finite(img) {
-            anyhow::bail!(
-                "{}: non-finite value ({}) at pixel ({x}, {y}), channel {}; NaN and infinity cannot be compared",
-                path.display(),
-                img.get(x, y)[c],
-                crate::metrics::CHANNELS[c]
-            );
-        }
-    }
-    Ok((r.image, a.image))
 }

@@ -1,294 +1,32 @@
 //! `pgt compare REF_SEQUENCE APPROX_SEQUENCE` (docs/design.md §10): both arguments folders or
-//! printf patterns of frames. Per frame the metrics of docs/design.md §5, the temporal error of
-//! every frame after the first, the gate (the per-image thresholds held by every frame, the
-//! temporal ones by the worst frame), a JSON summary and a report that plays the sequences.
+//! printf patterns of frames. The comparison, the gate, the verdict and the report are the
+//! library's ([`pgt::report::sequence_compare`]); this file prints them.
 
 use super::Outcome;
-use crate::metrics::gate::{Gate, GateCheck};
-use crate::metrics::CompareOptions;
-use crate::report::sequence_page::{write_frame_images, write_sequence_page, SequencePage};
-use crate::report::summary::short;
-use crate::sequence::compare::{compare_sequences, pair_sequences, SequenceComparison};
+use pgt::metrics::gate::Gate;
+use pgt::report::sequence_compare::{compare_sequence_files, SequenceArgs};
 use std::path::Path;
 
-/// The per-image checks of each frame: (frame, its checks).
-type FrameChecks = Vec<(usize, Vec<GateCheck>)>;
-
-/// The JSON summary of a sequence comparison.
-#[derive(Debug, serde::Serialize)]
-struct SequenceSummary<'a> {
-    reference: String,
-    approximation: String,
-    #[serde(flatten)]
-    comparison: &'a SequenceComparison,
-    checks: &'a [GateCheck],
-    /// Frames that failed a per-image threshold.
-    failed_frames: Vec<usize>,
-    passed: Option<bool>,
-}
-
-/// What `pgt compare` hands over when both its arguments are sequences.
-pub struct SequenceArgs<'a> {
-    pub reference: &'a Path,
-    pub approximation: &'a Path,
-    pub options: CompareOptions,
-    pub pop_threshold: Option<f64>,
-    pub json: Option<&'a Path>,
-    pub report: Option<&'a Path>,
-}
-
-pub fn run(args: &SequenceArgs, gate: &Gate) -> anyhow::Result<Outcome> {
-    let pairs = pair_sequences(args.reference, args.approximation)?;
-    let options = args.options;
-    let frame_gate = gate.per_frame();
-    let mut frame_checks: FrameChecks = Vec::new();
-    let run_compare = |dir: Option<&Path>| -> crate::Result<(SequenceComparison, FrameChecks)> {
-        let mut checks_of_frames = Vec::new();
-        let mut pop_threshold = args.pop_threshold;
-        let cmp = compare_sequences(&pairs, &options, args.pop_threshold, &mut |view| {
-            if !frame_gate.is_empty() {
-                let checks =
-                    frame_gate.evaluate(view.comparison, view.reference, view.approximation)?;
-                checks_of_frames.push((view.figures.frame, checks));
-            }
-            if let Some(dir) = dir {
-                let threshold = *pop_threshold.get_or_insert(
-                    crate::sequence::compare::POP_THRESHOLD_SHARE * view.comparison.data_range,
-                );
-                write_frame_images(dir, &view, threshold)?;
-            }
-            Ok(())
-        })?;
-        Ok((cmp, checks_of_frames))
-    };
-    let mut report_page = None;
-    let cmp = match args.report {
-        None => {
-            let (cmp, checks) = run_compare(None)?;
-            frame_checks = checks;
-            cmp
-        }
-        Some(dir) => {
-            let mut out = None;
-            let page = crate::image_io::write_folder_atomically(dir, |tmp| {
-                let (cmp, per_frame) = run_compare(Some(tmp))?;
-                let (checks, failed) = evaluate(gate, &cmp, &per_frame);
-                frame_checks = per_frame;
-                let verdict = verdict(&cmp, &checks, &failed);
-                let page = write_sequence_page(
-                    tmp,
-                    &cmp,
-                    &SequencePage {
-                        reference: &args.reference.display().to_string(),
-                        approximation: &args.approximation.display().to_string(),
-                        verdict: &verdict,
-                        checks: &checks,
-                    },
-                )?;
-                out = Some(cmp);
-                Ok(page)
-            })?;
-            report_page = Some(dir.join(page.file_name().unwrap_or_default()));
-            out.ok_or_else(|| anyhow::anyhow!("the report was written without a comparison"))?
-        }
-    };
-    let (checks, failed_frames) = evaluate(gate, &cmp, &frame_checks);
-    let verdict = verdict(&cmp, &checks, &failed_frames);
-    if let Some(page) = report_page {
+/// Runs the comparison and prints the verdict and the JSON summary (`--json`, `-` for stdout).
+pub fn run(args: &SequenceArgs, gate: &Gate, json: Option<&Path>) -> anyhow::Result<Outcome> {
+    let outcome = compare_sequence_files(args, gate)?;
+    if let Some(page) = &outcome.report_page {
         eprintln!("report: {}", page.display());
     }
-    let passed =
-        (!gate.is_empty()).then(|| checks.iter().all(|c| c.passed) && failed_frames.is_empty());
-    let summary = SequenceSummary {
-        reference: args.reference.display().to_string(),
-        approximation: args.approximation.display().to_string(),
-        comparison: &cmp,
-        checks: &checks,
-        failed_frames,
-        passed,
-    };
-    match args.json {
+    let verdict = &outcome.verdict;
+    match json {
         Some(path) if path.as_os_str() == "-" => {
-            super::print_stdout(&(serde_json::to_string_pretty(&summary)? + "\n"))?;
+            super::print_stdout(&outcome.summary_json()?)?;
             eprintln!("{verdict}");
         }
         Some(path) => {
-            crate::report::text::write_text(
-                path,
-                &(serde_json::to_string_pretty(&summary)? + "\n"),
-            )?;
+            pgt::report::text::write_text(path, &outcome.summary_json()?)?;
             super::print_stdout(&format!("{verdict}\n"))?;
         }
         None => super::print_stdout(&format!("{verdict}\n"))?,
     }
-    Ok(match passed {
+    Ok(match outcome.passed {
         Some(false) => Outcome::GateFailed,
         _ => Outcome::Success,
     })
-}
-
-/// The gate's checks: each per-image threshold at its worst frame, then the temporal ones at
-/// theirs; and the frames that failed a per-image threshold.
-fn evaluate(
-    gate: &Gate,
-    cmp: &SequenceComparison,
-    frame_checks: &[(usize, Vec<GateCheck>)],
-) -> (Vec<GateCheck>, Vec<usize>) {
-    let mut failed = Vec::new();
-    // Every frame has the same checks in the same order: keep, per position, the frame
-    // furthest on the failing side of the threshold.
-    let mut worst: Vec<(usize, GateCheck)> = Vec::new();
-    for (frame, list) in frame_checks {
-        if list.iter().any(|c| !c.passed) {
-            failed.push(*frame);
-        }
-        for (i, c) in list.iter().enumerate() {
-            match worst.get_mut(i) {
-                None => worst.push((*frame, c.clone())),
-                Some((f, k)) => {
-                    let worse = if c.lower_bound {
-                        c.value < k.value
-                    } else {
-                        c.value > k.value
-                    };
-                    if worse {
-                        *f = *frame;
-                        *k = c.clone();
-                    }
-                }
-            }
-        }
-    }
-    let mut checks: Vec<GateCheck> = worst
-        .into_iter()
-        .map(|(frame, c)| GateCheck {
-            name: format!("{} (worst frame: {frame})", c.name),
-            ..c
-        })
-        .collect();
-    for (name, threshold) in gate.temporal_keys() {
-        let value = cmp
-            .frames
-            .iter()
-            .filter_map(|f| f.temporal.as_ref())
-            .map(|t| match name {
-                "max_temporal_p99" => t.p99.mean,
-                "max_temporal_mean" => t.mean.mean,
-                _ => t.pops as f64,
-            })
-            .fold(0.0, f64::max);
-        checks.push(GateCheck {
-            name: name.to_string(),
-            value,
-            threshold,
-            passed: value <= threshold,
-            lower_bound: false,
-        });
-    }
-    (checks, failed)
-}
-
-/// The one-line verdict: frames, the worst figures, the gate.
-fn verdict(cmp: &SequenceComparison, checks: &[GateCheck], failed: &[usize]) -> String {
-    let mut line = format!("{} frames", cmp.frames.len());
-    if let Some(f) = cmp.worst_ssim() {
-        line += &format!(
-            ", lowest SSIM {} (frame {})",
-            short(f.ssim.unwrap_or(f64::NAN)),
-            f.frame
-        );
-    }
-    if let Some(f) = cmp.worst_temporal() {
-        let t = f.temporal.as_ref().map_or(0.0, |t| t.p99.mean);
-        line += &format!(", largest temporal p99 {} (frame {})", short(t), f.frame);
-    }
-    let pops: usize = cmp
-        .frames
-        .iter()
-        .filter_map(|f| f.temporal.as_ref().map(|t| t.pops))
-        .sum();
-    line += &format!(", {pops} pops above {}", short(cmp.pop_threshold));
-    if checks.is_empty() {
-        return line;
-    }
-    let failing: Vec<&GateCheck> = checks.iter().filter(|c| !c.passed).collect();
-    if failing.is_empty() {
-        format!("PASS: {line}")
-    } else {
-        let names: Vec<String> = failing
-            .iter()
-            .map(|c| {
-                format!(
-                    "{} = {} (threshold {})",
-                    c.name,
-                    short(c.value),
-                    short(c.threshold)
-                )
-            })
-            .collect();
-        let frames = if failed.is_empty() {
-            String::new()
-        } else {
-            format!("; {} frame(s) failed a per-frame threshold", failed.len())
-        };
-        format!("FAIL: {line}; {}{frames}", names.join(", "))
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn check(name: &str, value: f64, threshold: f64, lower_bound: bool) -> GateCheck {
-        let passed = if lower_bound {
-            value >= threshold
-        } else {
-            value <= threshold
-        };
-        GateCheck {
-            name: name.into(),
-            value,
-            threshold,
-            passed,
-            lower_bound,
-        }
-    }
-
-    #[test]
-    fn each_check_is_reported_at_its_worst_frame() {
-        let frames: FrameChecks = vec![
-            (
-                0,
-                vec![
-                    check("channels.min_ssim[R]", 0.99, 0.95, true),
-                    check("max_rmse", 0.03, 0.05, false),
-                ],
-            ),
-            (
-                1,
-                vec![
-                    check("channels.min_ssim[R]", 0.90, 0.95, true),
-                    check("max_rmse", 0.01, 0.05, false),
-                ],
-            ),
-            (
-                2,
-                vec![
-                    check("channels.min_ssim[R]", 0.97, 0.95, true),
-                    check("max_rmse", 0.04, 0.05, false),
-                ],
-            ),
-        ];
-        let cmp = SequenceComparison {
-            frames: Vec::new(),
-            pop_threshold: 0.05,
-            data_range: 1.0,
-        };
-        let (checks, failed) = evaluate(&Gate::default(), &cmp, &frames);
-        assert_eq!(failed, vec![1]);
-        assert_eq!(checks[0].name, "channels.min_ssim[R] (worst frame: 1)");
-        assert!(!checks[0].passed);
-        assert_eq!(checks[1].name, "max_rmse (worst frame: 2)");
-        assert_eq!(checks[1].value, 0.04);
-    }
 }

@@ -1,34 +1,15 @@
-//! `pgt export SCENE -o particles.csv|.ply` (docs/design.md §7): the resolved particles — centre,
-//! radius, linear colour, extinction σ and opacity Θmax — exactly as pgt renders them (after
-//! includes, defaults, `radius_scale`, filters and σ = λκ or −ln(1−Θmax)/(2r)), so that an
-//! outside renderer draws the same data.
-//!
-//! * **CSV**: header `x,y,z,radius,red,green,blue,opacity,sigma`, one particle a line, every
-//!   number in Rust's shortest round-trip notation (reading it back as f64 gives the same bits).
-//!   σ = ∞ (Θmax = 1, a perfectly absorbing ball) is written `inf`, which C's `strtod`, Python's
-//!   `float`, numpy and Rust's `f64::from_str` all read as +∞. The file is also a particle file
-//!   pgt reads back without a warning: its CSV reader takes `sigma` as the particle's σ, bit for
-//!   bit, and checks that `opacity` agrees with it (`crate::formats::xyz_csv`).
-//! * **PLY**: `binary_little_endian 1.0`, one `vertex` element per particle with `double`
-//!   properties `x y z radius red green blue opacity sigma`; σ = ∞ is the IEEE 754 +∞ double.
-//!   pgt's PLY reader (`crate::formats::ply`) reads it back, σ bit for bit.
-//!
-//! Θmax = 1 − e^{−2rσ} (docs/design.md §1 inverted; for a particle given by κ it is the opacity that
-//! the resolved σ has along a diameter).
-//!
-//! **Ellipsoids** (docs/design.md §9): where the scene has any, both formats replace `radius`
-//! with the semi-axes `sx sy sz` and the unit quaternion `qw qx qy qz` (a sphere's row has three
-//! equal semi-axes and the identity), the columns pgt's CSV reader takes, and Θmax is the
-//! opacity along the shortest diameter (r the shortest semi-axis above).
+//! `pgt export SCENE -o particles.csv|.ply` (docs/design.md §7): the resolved particles, exactly
+//! as pgt renders them, for an outside renderer. The columns are the scene's
+//! ([`pgt::scene::export`]), the file formats the formats' ([`pgt::formats::export`]).
 
 use super::output::{check_outputs, Output, OutputKind};
 use super::Outcome;
-use crate::error::PgtError;
-use crate::image_io::write_atomically;
-use crate::scene::{Particle, SceneLoadOptions};
 use clap::Args;
-use std::io::Write;
-use std::path::{Path, PathBuf};
+use pgt::formats::export::ExportFormat;
+use pgt::image_io::write_atomically;
+use pgt::scene::export::write_particles;
+use pgt::scene::SceneLoadOptions;
+use std::path::PathBuf;
 
 /// Options of `pgt export`.
 #[derive(Debug, Args)]
@@ -41,156 +22,11 @@ pub struct ExportArgs {
     /// The format of a bare particle file, whatever its extension (a scene file names the
     /// format of each include with `format = "…"`).
     #[arg(long, value_name = "NAME", value_parser = super::format_parser())]
-    pub format: Option<&'static crate::formats::Format>,
+    pub format: Option<&'static pgt::formats::Format>,
     /// The frame (from 0) of a scene that moves: its particles and camera, as `pgt render
     /// --frames` renders it.
     #[arg(long, value_name = "K")]
     pub frame: Option<usize>,
-}
-
-/// The export formats.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum ExportFormat {
-    Csv,
-    Ply,
-}
-
-impl ExportFormat {
-    /// From the output's extension.
-    pub fn from_path(path: &Path) -> crate::Result<Self> {
-        match path
-            .extension()
-            .and_then(|e| e.to_str())
-            .map(str::to_ascii_lowercase)
-            .as_deref()
-        {
-            Some("csv") => Ok(ExportFormat::Csv),
-            Some("ply") => Ok(ExportFormat::Ply),
-            _ => Err(PgtError::Usage(format!(
-                "{}: unknown export format; use a .csv or .ply extension",
-                path.display()
-            ))),
-        }
-    }
-}
-
-/// The column names, in the order both formats store them.
-pub const COLUMNS: [&str; 9] = [
-    "x", "y", "z", "radius", "red", "green", "blue", "opacity", "sigma",
-];
-
-/// The columns of a scene with ellipsoids, in the order both formats store them.
-pub const ELLIPSOID_COLUMNS: [&str; 15] = [
-    "x", "y", "z", "sx", "sy", "sz", "qw", "qx", "qy", "qz", "red", "green", "blue", "opacity",
-    "sigma",
-];
-
-/// The columns for `particles`: [`ELLIPSOID_COLUMNS`] where any is an ellipsoid, else
-/// [`COLUMNS`].
-pub fn columns(particles: &[Particle]) -> &'static [&'static str] {
-    if particles.iter().any(|p| p.ellipsoid.is_some()) {
-        &ELLIPSOID_COLUMNS
-    } else {
-        &COLUMNS
-    }
-}
-
-/// Θmax = 1 − e^{−2rσ}, the opacity along a diameter (docs/design.md §1), the shortest one of an
-/// ellipsoid (§9); for a Gaussian 1 − e^{−√(2π)·s_min·σ}, the opacity through its centre along
-/// its shortest axis (§9, "The opacity of a Gaussian"); 1 for σ = ∞. `expm1` keeps small
-/// opacities exact.
-pub fn opacity_of(p: &Particle) -> f64 {
-    let r = p.ellipsoid.map_or(p.radius, |e| e.shortest_semi_axis());
-    let depth = p.profile.centre_depth(r, p.sigma);
-    if p.sigma == f64::INFINITY {
-        1.0
-    } else {
-        -(-depth).exp_m1()
-    }
-}
-
-/// A particle's row, in [`COLUMNS`] order.
-pub fn row(p: &Particle) -> [f64; 9] {
-    [
-        p.center.x,
-        p.center.y,
-        p.center.z,
-        p.radius,
-        p.color.x,
-        p.color.y,
-        p.color.z,
-        opacity_of(p),
-        p.sigma,
-    ]
-}
-
-/// A particle's row, in [`ELLIPSOID_COLUMNS`] order.
-pub fn ellipsoid_row(p: &Particle) -> [f64; 15] {
-    let (s, q) = p
-        .ellipsoid
-        .map_or((glam::DVec3::splat(p.radius), glam::DQuat::IDENTITY), |e| {
-            (e.semi_axes(), e.rotation())
-        });
-    [
-        p.center.x,
-        p.center.y,
-        p.center.z,
-        s.x,
-        s.y,
-        s.z,
-        q.w,
-        q.x,
-        q.y,
-        q.z,
-        p.color.x,
-        p.color.y,
-        p.color.z,
-        opacity_of(p),
-        p.sigma,
-    ]
-}
-
-/// The rows of `particles` in the order of [`columns`].
-fn rows(particles: &[Particle]) -> impl Iterator<Item = Vec<f64>> + '_ {
-    let ellipsoids = columns(particles).len() == ELLIPSOID_COLUMNS.len();
-    particles.iter().map(move |p| {
-        if ellipsoids {
-            ellipsoid_row(p).to_vec()
-        } else {
-            row(p).to_vec()
-        }
-    })
-}
-
-/// Writes the CSV form (see the module docs).
-pub fn write_csv(w: &mut impl Write, particles: &[Particle]) -> std::io::Result<()> {
-    writeln!(w, "{}", columns(particles).join(","))?;
-    for r in rows(particles) {
-        let cells: Vec<String> = r.iter().map(|v| format!("{v:?}")).collect();
-        writeln!(w, "{}", cells.join(","))?;
-    }
-    Ok(())
-}
-
-/// Writes the binary PLY form (see the module docs).
-pub fn write_ply(w: &mut impl Write, particles: &[Particle]) -> std::io::Result<()> {
-    writeln!(w, "ply")?;
-    writeln!(w, "format binary_little_endian 1.0")?;
-    writeln!(
-        w,
-        "comment pgt export: linear RGB colour, opacity = Theta_max, sigma = extinction in 1/m (inf for opacity 1)"
-    )?;
-    writeln!(w, "element vertex {}", particles.len())?;
-    for c in columns(particles) {
-        writeln!(w, "property double {c}")?;
-    }
-    writeln!(w, "end_header")?;
-    for r in rows(particles) {
-        for v in r {
-            w.write_all(&v.to_le_bytes())?;
-        }
-    }
-    Ok(())
 }
 
 /// Runs `pgt export`.
@@ -205,7 +41,7 @@ pub fn run(args: ExportArgs) -> anyhow::Result<Outcome> {
         format: args.format,
         ..SceneLoadOptions::default()
     };
-    let scene = super::frames::scene_at_frame(&args.scene, &options, args.frame)?;
+    let scene = pgt::sequence::scene_at_frame(&args.scene, &options, args.frame)?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
@@ -216,9 +52,8 @@ pub fn run(args: ExportArgs) -> anyhow::Result<Outcome> {
             "warning: the scene's Gaussian particles are written with their standard deviations and peak σ, but the file does not say they are Gaussians: include it with density = \"gaussian\" to read them back as they are"
         );
     }
-    write_atomically(&args.output, |w| match format {
-        ExportFormat::Csv => write_csv(w, &scene.particles),
-        ExportFormat::Ply => write_ply(w, &scene.particles),
+    write_atomically(&args.output, |w| {
+        write_particles(w, format, &scene.particles)
     })?;
     eprintln!(
         "exported {} particles to {}",

@@ -3,12 +3,12 @@
 //! current frames' own progress on a terminal).
 
 use super::output::{check_outputs, Output, OutputKind};
-use crate::approx::dispatch::PassProgress;
-use crate::parts::PartOf;
-use crate::reference::RenderControl;
-use crate::scene::{SceneFrames, SceneLoadOptions};
-use crate::sequence::render::{FrameDone, FrameWatch};
-use crate::sequence::{frames_in, frames_of_part, FrameRange, SequencePattern};
+use pgt::approx::dispatch::PassProgress;
+use pgt::parts::PartOf;
+use pgt::reference::RenderControl;
+use pgt::scene::{SceneFrames, SceneLoadOptions};
+use pgt::sequence::render::{FrameDone, FrameWatch};
+use pgt::sequence::{frames_in, frames_of_part, FrameRange, SequencePattern};
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -50,20 +50,6 @@ pub fn open_sequence(
         }
     }
     Ok((frames, list, pattern))
-}
-
-/// The scene of frame `frame` of a scene file (`--frame K` of `pgt camera` and `pgt export`), or
-/// the scene as `pgt render` loads it without one; a frame past the end is an error naming the
-/// scene and its frame count.
-pub fn scene_at_frame(
-    scene: &Path,
-    options: &SceneLoadOptions,
-    frame: Option<usize>,
-) -> anyhow::Result<crate::scene::Scene> {
-    match frame {
-        None => Ok(crate::scene::Scene::load(scene, options)?),
-        Some(k) => Ok(SceneFrames::load(scene, options)?.frame(k)?),
-    }
 }
 
 /// How often a progress line is printed off a terminal.

@@ -1,12 +1,12 @@
 //! `pgt gen random --count N --seed S [--box …] [--radius a..b] -o FILE` (docs/design.md §7): the
-//! synthetic random set of [`crate::formats::random`], written as CSV, atomically.
+//! synthetic random set of [`pgt::formats::random`], written as CSV, atomically.
 
 use super::output::{check_outputs, Output, OutputKind};
 use super::Outcome;
-use crate::formats::random::{particles, write_csv, RandomSpec, THESIS_COUNT};
-use crate::image_io::write_atomically;
 use clap::{Args, Subcommand};
 use glam::DVec3;
+use pgt::formats::random::{particles, write_csv, RandomSpec, THESIS_COUNT};
+use pgt::image_io::write_atomically;
 use std::path::PathBuf;
 
 /// Most particles `pgt gen random` writes (about 7.5 GB of CSV); a typo beyond it is refused
@@ -25,7 +25,7 @@ pub struct GenArgs {
 #[derive(Debug, Subcommand)]
 pub enum GenKind {
     /// Uniformly random spheres in a box (the thesis's random set: 73,642 particles).
-    /// The random set of [`crate::formats::random`].
+    /// The random set of [`pgt::formats::random`].
     Random(RandomArgs),
 }
 

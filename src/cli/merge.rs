@@ -1,14 +1,14 @@
 //! `pgt merge PART... -o OUT`: the whole image from the parts of a cluster render (docs/design.md §7,
 //! docs/cluster.md), bit-identical to a one-machine `pgt render`, err layer included. The checks and
-//! the part format are in [`crate::parts`]: a file that is not a part, a missing or duplicated
+//! the part format are in [`pgt::parts`]: a file that is not a part, a missing or duplicated
 //! part, or parts of different renders exit 2 with a message naming the file, and nothing is
 //! written.
 
 use super::output::{check_outputs, Output, OutputKind};
 use super::Outcome;
-use crate::image_io::{write_image, RgbImage};
-use crate::parts::{merge, read_part};
 use clap::Args;
+use pgt::image_io::{write_image, RgbImage};
+use pgt::parts::{error_figures, merge_files};
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
@@ -29,30 +29,19 @@ pub fn run(args: MergeArgs) -> anyhow::Result<Outcome> {
     if !args.exposure.is_finite() {
         anyhow::bail!("--exposure must be a finite number");
     }
-    let mut parts = Vec::with_capacity(args.parts.len());
-    for path in &args.parts {
-        parts.push((path.clone(), read_part(path)?));
-    }
-    let (image, error) = merge(&parts)?;
+    let (image, error) = merge_files(&args.parts)?;
     let layers: Vec<(&str, &RgbImage)> = error.iter().map(|e| ("err", e)).collect();
     write_image(&args.output, &image, &layers, args.exposure)?;
     let mut line = format!(
         "merged {} parts into {} ({}x{})",
-        parts.len(),
+        args.parts.len(),
         args.output.display(),
         image.width,
         image.height
     );
     if let Some(e) = &error {
         // The same figures `pgt render` prints for the whole image.
-        let (max, sum) = e
-            .pixels
-            .iter()
-            .flatten()
-            .fold((0.0f64, 0.0f64), |(m, s), &v| {
-                (m.max(v as f64), s + v as f64)
-            });
-        let mean = sum / (3 * e.pixels.len()).max(1) as f64;
+        let (max, mean) = error_figures(e);
         line += &format!(", error estimate max {max:.3e} mean {mean:.3e}");
     }
     eprintln!("{line}");

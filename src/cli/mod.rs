@@ -3,7 +3,6 @@
 
 pub mod approx;
 pub mod bench;
-pub mod bench_frames;
 pub mod camera;
 pub mod compare;
 pub mod compare_frames;
@@ -16,8 +15,8 @@ pub mod output;
 pub mod render;
 pub mod sweep;
 
-use crate::formats::{particle_formats, Format};
 use clap::{Parser, Subcommand};
+use pgt::formats::{particle_formats, Format};
 
 /// What a subcommand ended with, when it did not fail.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -26,22 +25,6 @@ pub enum Outcome {
     Success,
     /// A gate that failed: exit 1.
     GateFailed,
-}
-
-/// The one-line message of a failed command: the error and its causes joined by ": ", leaving
-/// out a cause whose text the line already ends with. pgt's own errors put their cause into
-/// their message *and* report it as `source()` (so that a library user can walk the chain);
-/// printing the chain naively would say "stream did not contain valid UTF-8" twice.
-pub fn error_message(e: &anyhow::Error) -> String {
-    let mut line = e.to_string();
-    for cause in e.chain().skip(1) {
-        let cause = cause.to_string();
-        if !line.ends_with(&cause) {
-            line.push_str(": ");
-            line.push_str(&cause);
-        }
-    }
-    line
 }
 
 #[derive(Debug, Parser)]
@@ -65,7 +48,8 @@ pub enum Command {
     Compare(compare::CompareArgs),
     /// Render the reference once and an approximation per parameter set; report with plots.
     Sweep(sweep::SweepArgs),
-    /// Particle count, bounds, radius range and colours of a particle or scene file.
+    /// Particle count, bounds, radius range and colours of a particle, trajectory or scene file,
+    /// and its frames (count, atoms per frame, time step) where it has them.
     Info(info::InfoArgs),
     /// Generate synthetic data sets (`pgt gen random`).
     Gen(gen::GenArgs),
@@ -126,7 +110,7 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
 }
 
 /// `--format NAME`: the format of a bare particle file whatever its extension, a name of the
-/// table of formats that reads particles (`crate::formats::particle_formats`; `--help` lists
+/// table of formats that reads particles (`pgt::formats::particle_formats`; `--help` lists
 /// them).
 pub fn format_parser() -> impl clap::builder::TypedValueParser<Value = &'static Format> {
     use clap::builder::TypedValueParser;
@@ -145,7 +129,7 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
             .map_err(|_| format!("expected WIDTHxHEIGHT with positive integers, got '{s}'"))
     };
     let (w, h) = (parse(w)?, parse(h)?);
-    crate::scene::check_image_size(w as i64, h as i64)
+    pgt::scene::check_image_size(w as i64, h as i64)
 }
 
 /// What `render` and `approx` do before any work, once their outputs are checked
@@ -153,13 +137,13 @@ pub fn parse_size(s: &str) -> Result<(u32, u32), String> {
 /// render), load the scene, print its warnings.
 pub fn load_scene_for(
     scene: &std::path::Path,
-    options: &crate::scene::SceneLoadOptions,
+    options: &pgt::scene::SceneLoadOptions,
     exposure: f32,
-) -> anyhow::Result<crate::scene::Scene> {
+) -> anyhow::Result<pgt::scene::Scene> {
     if !exposure.is_finite() {
         anyhow::bail!("--exposure must be a finite number");
     }
-    let scene = crate::scene::Scene::load(scene, options)?;
+    let scene = pgt::scene::Scene::load(scene, options)?;
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
@@ -182,40 +166,4 @@ pub fn print_stdout(text: &str) -> anyhow::Result<()> {
 pub fn stderr_is_terminal() -> bool {
     use std::io::IsTerminal;
     std::io::stderr().is_terminal()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::error::PgtError;
-
-    fn utf8_error() -> std::io::Error {
-        std::io::Error::new(
-            std::io::ErrorKind::InvalidData,
-            "stream did not contain valid UTF-8",
-        )
-    }
-
-    #[test]
-    fn a_cause_already_in_the_message_is_said_once() {
-        let e = anyhow::Error::from(PgtError::io("gate.toml", utf8_error()));
-        assert_eq!(
-            error_message(&e),
-            "gate.toml: stream did not contain valid UTF-8"
-        );
-        let e = anyhow::Error::from(PgtError::io("a.toml", utf8_error()).context("run 3"));
-        assert_eq!(
-            error_message(&e),
-            "run 3: a.toml: stream did not contain valid UTF-8"
-        );
-    }
-
-    #[test]
-    fn a_cause_not_in_the_message_is_kept() {
-        let e = anyhow::Error::from(utf8_error()).context("reading the scene");
-        assert_eq!(
-            error_message(&e),
-            "reading the scene: stream did not contain valid UTF-8"
-        );
-    }
 }

@@ -6,8 +6,8 @@
 //! a file is wanted (or a file where a folder is wanted); and the folder it goes into exists or
 //! can be made: the nearest folder that exists on its path is a folder pgt can write into
 //! (checked by creating and removing a temporary file there). Missing folders are not made
-//! here: the writers make them when they write ([`crate::image_io::write_atomically`],
-//! [`crate::image_io::write_folder_atomically`]), so a command that fails leaves nothing.
+//! here: the writers make them when they write ([`pgt::image_io::write_atomically`],
+//! [`pgt::image_io::write_folder_atomically`]), so a command that fails leaves nothing.
 
 use std::path::{Path, PathBuf};
 

@@ -2,11 +2,11 @@
 
 use super::output::{check_outputs, Output, OutputKind};
 use super::Outcome;
-use crate::image_io::write_image;
-use crate::parts::PartOf;
-use crate::reference::{self, Integrator, RenderOptions};
-use crate::scene::{Model, RenderMode, Scene, SceneLoadOptions};
 use clap::{Args, ValueEnum};
+use pgt::image_io::write_image;
+use pgt::parts::PartOf;
+use pgt::reference::{self, Integrator, RenderOptions};
+use pgt::scene::{Model, RenderMode, SceneLoadOptions};
 use std::path::PathBuf;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -30,7 +30,7 @@ pub struct RenderArgs {
     /// skipped, so an interrupted sequence resumes; with --part I/N, this task renders every
     /// N-th frame of the range from the I-th.
     #[arg(long, value_name = "RANGE")]
-    pub frames: Option<crate::sequence::FrameRange>,
+    pub frames: Option<pgt::sequence::FrameRange>,
     /// Image size WIDTHxHEIGHT, overriding the scene.
     #[arg(long, value_parser = super::parse_size)]
     pub size: Option<(u32, u32)>,
@@ -43,7 +43,7 @@ pub struct RenderArgs {
     /// The format of a bare particle file, whatever its extension (a scene file names the
     /// format of each include with `format = "…"`).
     #[arg(long, value_name = "NAME", value_parser = super::format_parser())]
-    pub format: Option<&'static crate::formats::Format>,
+    pub format: Option<&'static pgt::formats::Format>,
     /// Absolute radiance tolerance of the quadrature, per pixel and channel.
     #[arg(long)]
     pub tol: Option<f64>,
@@ -65,10 +65,10 @@ pub struct RenderArgs {
     /// Render only part I of N (I from 0, as job arrays count; the part holds the rows y with
     /// y mod N = I) into an EXR part file, to be joined by `pgt merge` (see `pgt::parts`).
     /// With --frames, part I of N is every N-th frame from the I-th, written whole.
-    #[arg(long, value_parser = crate::parts::parse_part, value_name = "I/N")]
+    #[arg(long, value_parser = pgt::parts::parse_part, value_name = "I/N")]
     pub part: Option<PartOf>,
     /// The former name of `--part`: still accepted, with a warning.
-    #[arg(long, value_parser = crate::parts::parse_part, value_name = "I/N", hide = true, conflicts_with = "part")]
+    #[arg(long, value_parser = pgt::parts::parse_part, value_name = "I/N", hide = true, conflicts_with = "part")]
     pub tile: Option<PartOf>,
 }
 
@@ -128,14 +128,14 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
         return render_part(&args, &scene, &render_options, part);
     }
     let out = reference::render(&scene, &render_options)?;
-    let layers: Vec<(&str, &crate::image_io::RgbImage)> =
+    let layers: Vec<(&str, &pgt::image_io::RgbImage)> =
         out.error.iter().map(|e| ("err", e)).collect();
     write_image(&args.output, &out.image, &layers, args.exposure)?;
     let s = &out.stats;
     let rays = s.primary_rays + s.shadow_rays;
-    let particles = particles_text(&scene);
+    let particles = scene.particles_text();
     let mut line = format!(
-        "rendered {} ({}x{}, {particles}, {} lights) in {:.2} s: {} primary + {} shadow rays, {:.3} Mrays/s",
+        "rendered {} ({}x{}, {particles}, {} lights) in {:.2} s: {} primary + {} shadow rays, {}",
         args.output.display(),
         scene.camera.width,
         scene.camera.height,
@@ -143,37 +143,34 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
         s.seconds,
         s.primary_rays,
         s.shadow_rays,
-        rays as f64 / s.seconds.max(1e-9) / 1e6
+        ray_rate_text(rays, s.seconds)
     );
     if let (Some(max), Some(mean)) = (s.max_error, s.mean_error) {
         line += &format!(", error estimate max {max:.3e} mean {mean:.3e}");
     }
     eprintln!("{line}");
-    if let Some(warning) = unconverged_warning(s, scene.render.tol) {
+    if let Some(warning) = reference::unconverged_warning(s, scene.render.tol) {
+        eprintln!("warning: {warning}");
+    }
+    let above_tol = out
+        .error
+        .as_ref()
+        .and_then(|err| reference::err_above_tol_warning(err, scene.render.tol, &scene));
+    if let Some(warning) = above_tol {
         eprintln!("warning: {warning}");
     }
     Ok(Outcome::Success)
 }
 
-/// docs/design.md §3: a pixel that does not converge is reported, not hidden. The count and the pixel
-/// with the largest error estimate, or `None` when every pixel reached `tol`.
-pub fn unconverged_warning(stats: &reference::RenderStats, tol: f64) -> Option<String> {
-    let (x, y, e) = stats.worst_unconverged?;
-    Some(format!(
-        "{} pixel(s) did not reach tol {tol:e}; the worst is ({x}, {y}) with error estimate {e:.3e} (its err value says how far off it may be)",
-        stats.unconverged
-    ))
-}
-
 /// `--part I/N`: renders and writes one part (`pgt::parts`), with a one-line summary.
 fn render_part(
     args: &RenderArgs,
-    scene: &crate::scene::Scene,
+    scene: &pgt::scene::Scene,
     options: &RenderOptions,
     which: PartOf,
 ) -> anyhow::Result<Outcome> {
-    let (part, s) = crate::parts::render_part(scene, options, which)?;
-    crate::parts::write_part(&args.output, &part)?;
+    let (part, s) = pgt::parts::render_part(scene, options, which)?;
+    pgt::parts::write_part(&args.output, &part)?;
     eprintln!(
         "rendered part {which} ({} of {} rows of {}x{}) into {} in {:.2} s: {} primary + {} shadow rays",
         part.image.height,
@@ -192,7 +189,7 @@ fn render_part(
 /// with a progress bar over the frames and a summary line.
 fn render_frames(
     args: &RenderArgs,
-    range: crate::sequence::FrameRange,
+    range: pgt::sequence::FrameRange,
     part: Option<PartOf>,
 ) -> anyhow::Result<Outcome> {
     let render_options = args.render_options()?;
@@ -205,7 +202,7 @@ fn render_frames(
         &args.output,
     )?;
     let progress = super::frames::FrameProgress::new("render", list.len());
-    let summary = crate::sequence::render::render_frames(
+    let summary = pgt::sequence::render::render_frames(
         &frames,
         &list,
         &pattern,
@@ -241,29 +238,25 @@ fn render_frames(
     }
     Ok(Outcome::Success)
 }
-
-/// "11032 spheres", "4 particles, 3 of them ellipsoids" or "1971 Gaussians": the particles of a
-/// summary line.
-pub(crate) fn particles_text(scene: &Scene) -> String {
-    let n = scene.particles.len();
-    if n > 0
-        && scene
-            .particles
-            .iter()
-            .all(|p| p.profile == crate::optics::Profile::Gaussian)
-    {
-        return format!("{n} Gaussians");
+/// Rays per second in words: `R Mrays/s` with three decimals, or `R rays/s` where that would
+/// read 0.000 (a slow render of a small image).
+fn ray_rate_text(rays: u64, seconds: f64) -> String {
+    let rate = rays as f64 / seconds.max(1e-9);
+    if rate >= 1e3 {
+        format!("{:.3} Mrays/s", rate / 1e6)
+    } else {
+        format!("{rate:.1} rays/s")
     }
-    let ellipsoids = scene
-        .particles
-        .iter()
-        .filter(|p| p.ellipsoid.is_some())
-        .count();
-    match ellipsoids {
-        0 => format!("{} spheres", scene.particles.len()),
-        n => format!(
-            "{} particles, {n} of them ellipsoids",
-            scene.particles.len()
-        ),
+}
+
+#[cfg(test)]
+mod tests {
+    use super::ray_rate_text;
+
+    #[test]
+    fn slow_renders_state_their_rate_in_rays_not_zero_mrays() {
+        assert_eq!(ray_rate_text(4_096, 38.8), "105.6 rays/s");
+        assert_eq!(ray_rate_text(2_500_000, 2.0), "1.250 Mrays/s");
+        assert_eq!(ray_rate_text(1_000, 1.0), "0.001 Mrays/s");
     }
 }

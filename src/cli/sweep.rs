@@ -1,13 +1,12 @@
 //! `pgt sweep EXPERIMENT.toml --report DIR` (docs/design.md §5, §7): argument handling only. The
-//! experiment format and the running are in [`crate::sweep`], the page, plots and JSON in
-//! [`crate::report::sweep_page`].
+//! experiment format and the running are in [`pgt::sweep`], the page, plots and JSON in
+//! [`pgt::report::sweep_page`].
 
 use super::output::{check_outputs, Output, OutputKind};
 use super::Outcome;
-use crate::image_io::write_folder_atomically;
-use crate::report::sweep_page::write_sweep_report;
-use crate::sweep::{load_scene, run_sweep, Experiment, Progress, SweepOptions};
 use clap::Args;
+use pgt::report::sweep_page::{sweep_into_report, SweepWatch};
+use pgt::sweep::{load_scene, Experiment, Progress};
 use std::path::PathBuf;
 
 #[derive(Debug, Args)]
@@ -39,9 +38,6 @@ pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
     for w in &scene.warnings {
         eprintln!("warning: {w}");
     }
-    // The report is written into a temporary folder that takes the report's place at the end
-    // (an interrupted sweep leaves no half-written report); the reference cache lives in the
-    // report folder itself, so that it survives from one sweep to the next.
     let terminal = super::stderr_is_terminal();
     let mut lines = RunLines {
         bar: None,
@@ -49,21 +45,14 @@ pub fn run(args: SweepArgs) -> anyhow::Result<Outcome> {
         done: 0,
         total: experiment.runs.len(),
     };
-    let outcome = write_folder_atomically(&args.report, |tmp| {
-        let options = SweepOptions {
-            dir: tmp.to_path_buf(),
-            cache: args.report.join("cache"),
-            threads: args.threads,
-            progress: terminal,
-        };
-        let results = run_sweep(&experiment, &scene, &options, |p| lines.show(p));
-        if let Some(bar) = &lines.bar {
-            bar.finish_and_clear();
-        }
-        let results = results?;
-        write_sweep_report(tmp, &results)?;
-        Ok((results.runs.len(), args.report.join("index.html")))
-    });
+    let outcome = sweep_into_report(
+        &args.report,
+        &experiment,
+        &scene,
+        args.threads,
+        terminal,
+        &mut lines,
+    );
     let (runs, page) = outcome?;
     super::print_stdout(&format!("sweep: {runs} runs, report {}\n", page.display()))?;
     Ok(Outcome::Success)
@@ -78,7 +67,7 @@ struct RunLines {
     total: usize,
 }
 
-impl RunLines {
+impl SweepWatch for RunLines {
     fn show(&mut self, p: Progress) {
         match p {
             Progress::Reference(r) => {
@@ -133,6 +122,14 @@ impl RunLines {
         }
     }
 
+    fn runs_done(&mut self) {
+        if let Some(bar) = &self.bar {
+            bar.finish_and_clear();
+        }
+    }
+}
+
+impl RunLines {
     /// A line on stderr, above the bar where there is one.
     fn line(&self, text: String) {
         match &self.bar {

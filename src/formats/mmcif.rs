@@ -34,7 +34,7 @@ pub const FORMAT: Format = Format {
 /// grouped by model: fine for NMR ensembles; MD trajectories belong in DCD or XTC.
 pub fn open_frames(
     spec: &IncludeSpec,
-    source: super::frame_source::ByteSource,
+    source: super::file::ByteSource,
 ) -> Result<Box<dyn super::frame_source::FrameSource>> {
     let bytes = source.read_all("the file")?;
     let (atoms, warnings) = read_atoms(source.path(), &bytes)?;

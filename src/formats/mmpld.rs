@@ -1,7 +1,7 @@
 //! MegaMol particle lists (MMPLD), versions 1.0–1.3, little-endian.
 //!
-//! Layout (from UniStuttgart-VISUS/mmpld and MegaMol's `MMPLDDataSource.cpp`; see
-//! `../shared/data/SOURCES.md`): a 60-byte header (`"MMPLD\0"`, `u16` version = 100·major+minor,
+//! Layout (from UniStuttgart-VISUS/mmpld and MegaMol's `MMPLDDataSource.cpp`; docs/design.md
+//! §6, "MMPLD"): a 60-byte header (`"MMPLD\0"`, `u16` version = 100·major+minor,
 //! `u32` frames, two `f32[6]` boxes), a seek table of `frames + 1` `u64` offsets (the last is the
 //! end of the data; a table of only `frames` entries, as the mmpld library writes, is accepted
 //! too), then per frame: `f32` timestamp (version ≥ 1.2), `i32` list count, and per list:

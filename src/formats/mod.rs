@@ -26,6 +26,7 @@
 pub mod atoms;
 pub mod dcd;
 pub mod elements;
+pub mod export;
 pub mod file;
 pub mod frame_source;
 pub mod frames;
@@ -38,6 +39,7 @@ pub mod profile;
 pub mod psf;
 pub mod random;
 pub mod record;
+pub mod summary;
 pub mod topology;
 pub mod vrml;
 pub mod xtc;

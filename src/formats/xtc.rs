@@ -301,8 +301,19 @@ fn decode_frame(
     let minint: [i32; 3] = std::array::from_fn(|c| be_i32(bytes, at + 4 + 4 * c));
     let maxint: [i32; 3] = std::array::from_fn(|c| be_i32(bytes, at + 16 + 4 * c));
     let smallidx = be_i32(bytes, at + 28);
-    let block_at = at + PRELUDE_BYTES as usize + if magic == MAGIC_2023 { 8 } else { 4 };
-    let block = bytes.get(block_at..).unwrap_or_default();
+    let count_at = at + PRELUDE_BYTES as usize;
+    let (count, block_at) = if magic == MAGIC_2023 {
+        (be_u64(bytes, count_at), count_at + 8)
+    } else {
+        (u64::from(be_i32(bytes, count_at) as u32), count_at + 4)
+    };
+    // The stream ends at the block's byte count: the padding to 4 bytes is no part of it.
+    let block_end = usize::try_from(count)
+        .ok()
+        .and_then(|c| block_at.checked_add(c))
+        .unwrap_or(usize::MAX)
+        .min(bytes.len());
+    let block = bytes.get(block_at..block_end).unwrap_or_default();
     let ints = decompress(block, atoms, minint, maxint, smallidx)
         .map_err(|(k, m)| (block_at as u64 + k, m))?;
     let inv = 1.0f32 / precision;
@@ -398,6 +409,23 @@ fn bits_of(size: u64) -> u32 {
     (64 - size.leading_zeros()).min(32)
 }
 
+/// The number of values each integer coordinate takes, max − min + 1, refused where the range
+/// is negative or exceeds what 32 bits hold.
+fn coordinate_sizes(minint: [i32; 3], maxint: [i32; 3]) -> std::result::Result<[u64; 3], Corrupt> {
+    let mut sizes = [0u64; 3];
+    for c in 0..3 {
+        let size = i64::from(maxint[c]) - i64::from(minint[c]) + 1;
+        if !(1..=i64::from(u32::MAX)).contains(&size) {
+            return Err((
+                0,
+                "the coordinate range (maximum − minimum) is negative or too large".to_string(),
+            ));
+        }
+        sizes[c] = size as u64;
+    }
+    Ok(sizes)
+}
+
 /// The integer positions of `atoms` atoms from a compressed block (the module doc's algorithm,
 /// libxdrfile's `xdrfile_decompress_coord_float` after the prelude). Errors carry the byte
 /// offset in the block.
@@ -409,17 +437,7 @@ fn decompress(
     smallidx: i32,
 ) -> std::result::Result<Vec<[i32; 3]>, Corrupt> {
     let corrupt = |at: usize, m: &str| -> Corrupt { (at as u64, m.to_string()) };
-    let mut sizes = [0u64; 3];
-    for c in 0..3 {
-        let size = i64::from(maxint[c]) - i64::from(minint[c]) + 1;
-        if !(1..=i64::from(u32::MAX)).contains(&size) {
-            return Err(corrupt(
-                0,
-                "the coordinate range (maximum − minimum) is negative or too large",
-            ));
-        }
-        sizes[c] = size as u64;
-    }
+    let sizes = coordinate_sizes(minint, maxint)?;
     let large = sizes.iter().any(|&s| s > 0xff_ffff);
     let field_bits = sizes.map(bits_of);
     let product_bits = 128
@@ -428,15 +446,15 @@ fn decompress(
             .leading_zeros();
     let mut smallidx = usize::try_from(smallidx)
         .ok()
-        .filter(|i| (FIRSTIDX..MAGICINTS.len()).contains(i))
+        .filter(|&i| i < MAGICINTS.len())
         .ok_or_else(|| {
             corrupt(
                 0,
-                &format!("the small-integer index {smallidx} is outside 9..=72"),
+                &format!("the small-integer index {smallidx} is outside 0..=72"),
             )
         })?;
     let magic = |i: usize| u64::from(MAGICINTS[i]);
-    let mut smaller = magic(FIRSTIDX.max(smallidx - 1)) / 2;
+    let mut smaller = magic(FIRSTIDX.max(smallidx.saturating_sub(1))) / 2;
     let mut smallnum = magic(smallidx) / 2;
     let mut bits = Bits {
         data: block,
@@ -444,7 +462,9 @@ fn decompress(
         lastbits: 0,
         lastbyte: 0,
     };
-    let mut out: Vec<[i32; 3]> = Vec::with_capacity(atoms);
+    // Every atom takes at least one bit of the block, so the block bounds the allocation and a
+    // header that lies about the atom count ends in an error, not in a huge reservation.
+    let mut out: Vec<[i32; 3]> = Vec::with_capacity(atoms.min(block.len().saturating_mul(8)));
     let mut run = 0i32;
     let add = |a: [i32; 3], b: [i32; 3]| std::array::from_fn(|c| a[c].wrapping_add(b[c]));
     while out.len() < atoms {
@@ -476,6 +496,16 @@ fn decompress(
             }
             let offset = smallnum as i32;
             let size = magic(smallidx);
+            if size == 0 {
+                // libxdrfile divides by this radix (or reads an unset byte at index 0): no
+                // decoder can unpack small atoms below the first index.
+                return Err(corrupt(
+                    bits.next,
+                    &format!(
+                        "a run of small atoms at the small-integer index {smallidx}, below the first usable index {FIRSTIDX}"
+                    ),
+                ));
+            }
             for k in (0..run).step_by(3) {
                 let small = bits.packed(smallidx as u32, [size; 3])?;
                 let mut current: [i32; 3] =
@@ -495,8 +525,8 @@ fn decompress(
         let new_idx = smallidx as i64 + i64::from(is_smaller);
         smallidx = usize::try_from(new_idx)
             .ok()
-            .filter(|i| (FIRSTIDX..MAGICINTS.len()).contains(i))
-            .ok_or_else(|| corrupt(bits.next, "the small-integer index leaves 9..=72"))?;
+            .filter(|&i| i < MAGICINTS.len())
+            .ok_or_else(|| corrupt(bits.next, "the small-integer index leaves 0..=72"))?;
         if is_smaller < 0 {
             smallnum = smaller;
             smaller = if smallidx > FIRSTIDX {

@@ -230,9 +230,11 @@ pub struct ProjectionJson {
 pub struct CameraJson {
     /// Eye position (world, metres).
     pub eye: [f64; 3],
-    /// The point looked at (eye + f).
-    pub look_at: [f64; 3],
-    /// Unit viewing direction f = normalize(look_at − position).
+    /// eye + f: the point one unit in front of the eye on the view axis. It is not the scene's
+    /// `look_at` (which may lie anywhere on that axis, and which a framed or moving camera does
+    /// not have); as the target of a look-at function it gives the same view matrix.
+    pub eye_plus_forward: [f64; 3],
+    /// Unit viewing direction f (the scene's normalize(look_at − position)).
     pub forward: [f64; 3],
     /// Unit r = normalize(f × up): image x grows along it.
     pub right: [f64; 3],
@@ -300,7 +302,7 @@ impl CameraJson {
             .collect();
         CameraJson {
             eye: camera.position.to_array(),
-            look_at: (camera.position + camera.forward).to_array(),
+            eye_plus_forward: (camera.position + camera.forward).to_array(),
             forward: camera.forward.to_array(),
             right: camera.right.to_array(),
             up: camera.up.to_array(),

@@ -3,14 +3,29 @@
 //! Every write is atomic: a temporary file in the target folder, renamed at the end.
 
 mod folder;
+mod pair;
 mod read;
 mod write;
 
 pub use folder::write_folder_atomically;
+pub use pair::{is_scene, load_pair, RenderScene};
 pub use read::{read_exr_layer, read_image, read_image_layer, read_reference_estimate, ReadImage};
 pub use write::{
     linear_to_srgb8, write_atomically, write_exr_with_header, write_image, ImageFormat,
 };
+
+/// Channel names in the order pgt stores them.
+pub const CHANNELS: [&str; 3] = ["R", "G", "B"];
+
+/// The first non-finite value of an image, as (x, y, channel).
+pub fn first_non_finite(image: &RgbImage) -> Option<(u32, u32, usize)> {
+    let w = image.width.max(1) as usize;
+    image.pixels.iter().enumerate().find_map(|(i, p)| {
+        p.iter()
+            .position(|v| !v.is_finite())
+            .map(|c| ((i % w) as u32, (i / w) as u32, c))
+    })
+}
 
 /// A linear RGB image, row-major, row 0 at the top.
 #[derive(Debug, Clone, PartialEq)]

@@ -19,8 +19,9 @@ pub use errors::ChannelErrors;
 pub use flip::Flip;
 pub use ssim::ChannelSsim;
 
-/// Channel names in the order pgt stores them.
-pub const CHANNELS: [&str; 3] = ["R", "G", "B"];
+/// Channel names in the order pgt stores them, and the first non-finite value of an image: the
+/// images' own facts ([`crate::image_io`]), which the metrics name too.
+pub use crate::image_io::{first_non_finite, CHANNELS};
 
 /// A per-channel value and the mean of the three (docs/design.md §5).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -118,16 +119,6 @@ impl Comparison {
     pub fn flip_mean(&self) -> Option<f64> {
         self.flip.as_ref().ok().map(|f| f.mean)
     }
-}
-
-/// The first non-finite value of an image, as (x, y, channel).
-pub fn first_non_finite(image: &RgbImage) -> Option<(u32, u32, usize)> {
-    let w = image.width.max(1) as usize;
-    image.pixels.iter().enumerate().find_map(|(i, p)| {
-        p.iter()
-            .position(|v| !v.is_finite())
-            .map(|c| ((i % w) as u32, (i / w) as u32, c))
-    })
 }
 
 /// Whether every value lies in [0, 1] (an LDR image).

@@ -90,6 +90,16 @@ pub struct RenderStats {
     pub worst_unconverged: Option<(u32, u32, f64)>,
 }
 
+/// docs/design.md §3: a pixel that does not converge is reported, not hidden. The count and the pixel
+/// with the largest error estimate, or `None` when every pixel reached `tol`.
+pub fn unconverged_warning(stats: &RenderStats, tol: f64) -> Option<String> {
+    let (x, y, e) = stats.worst_unconverged?;
+    Some(format!(
+        "{} pixel(s) did not reach tol {tol:e}; the worst is ({x}, {y}) with error estimate {e:.3e} (its err value says how far off it may be)",
+        stats.unconverged
+    ))
+}
+
 /// A finished reference render.
 #[derive(Debug, Clone)]
 pub struct RenderOutput {
@@ -113,6 +123,32 @@ pub fn render_controlled(
 ) -> Result<RenderOutput> {
     let estimator = estimator_for(scene, options)?;
     render_with_control(&scene.camera, estimator.as_ref(), options, control)
+}
+
+/// A scene file rendered by the exact reference with its default options, as `pgt compare`
+/// renders a scene given in place of an image (docs/design.md §5): its warnings, the time taken
+/// and any pixel that did not reach `tol` are printed on stderr, a progress bar where stderr is
+/// a terminal.
+pub fn render_scene_file(path: &std::path::Path) -> anyhow::Result<RgbImage> {
+    use std::io::IsTerminal;
+    let scene = Scene::load(path, &crate::scene::SceneLoadOptions::default())?;
+    for w in &scene.warnings {
+        eprintln!("warning: {w}");
+    }
+    let options = RenderOptions {
+        progress: std::io::stderr().is_terminal(),
+        ..Default::default()
+    };
+    let out = render(&scene, &options)?;
+    eprintln!(
+        "rendered the reference of {} in {:.2} s",
+        path.display(),
+        out.stats.seconds
+    );
+    if let Some(w) = unconverged_warning(&out.stats, scene.render.tol) {
+        eprintln!("warning: {w}");
+    }
+    Ok(out.image)
 }
 
 /// Shared between a running render and the thread that waits for it: how many blocks of how
@@ -351,6 +387,43 @@ pub fn worse_unconverged(
         Some((x, y, w)) if !(e > w || (e == w && (py, px) < (y, x))) => worst,
         _ => Some((px, py, e)),
     }
+}
+
+/// docs/design.md §3 and §9: a pixel whose err exceeds `tol` although its quadrature converged
+/// is reported too (err also bounds what the reference leaves out: with Gaussians, the depth
+/// beyond the cut-off of k σ, so a small `gaussian_cutoff` makes err large everywhere). The
+/// count and the pixel with the largest err, or `None` when every err is within `tol`.
+pub fn err_above_tol_warning(err: &RgbImage, tol: f64, scene: &Scene) -> Option<String> {
+    let mut count = 0u64;
+    let mut worst: Option<(u32, u32, f64)> = None;
+    for (i, e) in err.pixels.iter().enumerate() {
+        let e = f64::from(e[0].max(e[1]).max(e[2]));
+        if e > tol {
+            count += 1;
+            let (px, py) = (
+                (i % err.width as usize) as u32,
+                (i / err.width as usize) as u32,
+            );
+            worst = worse_unconverged(worst, (px, py, e));
+        }
+    }
+    let (x, y, e) = worst?;
+    let gaussians = scene
+        .particles
+        .iter()
+        .any(|p| p.profile == crate::optics::Profile::Gaussian);
+    let why = match (gaussians, scene.render.gaussian_cutoff) {
+        (true, Some(k)) => format!(
+            ": it bounds the depth of the Gaussians the rays pass beyond the cut-off gaussian_cutoff = {k} σ; a larger cut-off (or none, to choose it from tol) makes it smaller"
+        ),
+        (true, None) => {
+            ": it bounds what the rays leave out (Gaussian tails, and with scattering lights the shadow rays' missed depth)".to_string()
+        }
+        (false, _) => String::new(),
+    };
+    Some(format!(
+        "{count} pixel(s) have err above tol {tol:e}; the largest is {e:.3e} at ({x}, {y}){why}"
+    ))
 }
 
 /// Runs `work` on a pool of `threads` workers (`--threads`), or on rayon's global pool.

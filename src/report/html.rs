@@ -140,22 +140,7 @@ pub fn write_report(dir: &Path, inputs: &ReportInputs) -> Result<std::path::Path
         )),
     });
     if let Ok(flip) = &cmp.flip {
-        heatmap(&flip.map, w, h, UNIT, ColorMap::Magma).write_png(&dir.join("flip.png"))?;
-        figures.push(Figure {
-            file: "flip.png",
-            title: if flip.exposures.is_some() { "HDR-FLIP" } else { "FLIP (LDR)" }.into(),
-            caption: match flip.exposures {
-                Some((a, b, n)) => format!(
-                    "magma, scale 0 … 1, {:.1} pixels per degree, ACES, {n} exposures {a:.2} … {b:.2} stops, 8-bit per exposure",
-                    flip.pixels_per_degree
-                ),
-                None => format!(
-                    "magma, scale 0 … 1, {:.1} pixels per degree",
-                    flip.pixels_per_degree
-                ),
-            },
-            bar: Some(colorbar_svg(UNIT, ColorMap::Magma, "FLIP", "bar-flip")),
-        });
+        figures.push(flip_figure(dir, flip, w, h)?);
         layers_owned.push(("flip", maps::gray_image(w, h, &flip.map)));
     }
     let layers: Vec<(&str, &RgbImage)> = layers_owned.iter().map(|(n, i)| (*n, i)).collect();
@@ -169,6 +154,26 @@ pub fn write_report(dir: &Path, inputs: &ReportInputs) -> Result<std::path::Path
     let path = dir.join("index.html");
     write_text(&path, &page)?;
     Ok(path)
+}
+
+/// The FLIP map's heatmap, written into `dir`, and its figure (LDR- or HDR-FLIP).
+fn flip_figure(dir: &Path, flip: &crate::metrics::Flip, w: u32, h: u32) -> Result<Figure> {
+    heatmap(&flip.map, w, h, UNIT, ColorMap::Magma).write_png(&dir.join("flip.png"))?;
+    Ok(Figure {
+        file: "flip.png",
+        title: if flip.exposures.is_some() { "HDR-FLIP" } else { "FLIP (LDR)" }.into(),
+        caption: match flip.exposures {
+            Some((a, b, n)) => format!(
+                "magma, scale 0 … 1, {:.1} pixels per degree, ACES, {n} exposures {a:.2} … {b:.2} stops, 8-bit per exposure",
+                flip.pixels_per_degree
+            ),
+            None => format!(
+                "magma, scale 0 … 1, {:.1} pixels per degree",
+                flip.pixels_per_degree
+            ),
+        },
+        bar: Some(colorbar_svg(UNIT, ColorMap::Magma, "FLIP", "bar-flip")),
+    })
 }
 
 /// The viewer of one comparison: reference against approximation, the abs-error heatmap in the

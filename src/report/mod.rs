@@ -18,6 +18,7 @@ pub mod summary;
 pub use html::{write_report, ReportInputs, ReportOptions};
 pub use summary::Summary;
 pub mod plot;
+pub mod sequence_compare;
 pub mod sequence_page;
 pub mod sequence_probe;
 pub mod sweep_page;

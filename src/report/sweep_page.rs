@@ -13,11 +13,52 @@ use super::text::{escape, write_text};
 use super::viewer::{write_viewer, Viewer, ViewerImage};
 use super::{heatmap, ColorMap, Scale};
 use crate::error::{PgtError, Result};
+use crate::image_io::write_folder_atomically;
 use crate::metrics::Comparison;
-use crate::sweep::{ParamValue, RunResult, SweepResults};
+use crate::scene::Scene;
+use crate::sweep::{
+    run_sweep, Experiment, ParamValue, Progress, RunResult, SweepOptions, SweepResults,
+};
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
+
+/// What follows a sweep as it runs ([`sweep_into_report`]): the reference, each run as it
+/// starts and ends, and the end of the runs (before the report is written).
+pub trait SweepWatch {
+    /// One step of the sweep.
+    fn show(&mut self, progress: Progress);
+    /// Every run has ended (or one failed); the report is written next.
+    fn runs_done(&mut self) {}
+}
+
+/// Runs the experiment on its scene and writes the report into the folder `report`
+/// (docs/design.md §5, `pgt sweep`): the report is written into a temporary folder that takes
+/// the report's place at the end (an interrupted sweep leaves no half-written report); the
+/// reference cache lives in `report/cache`, so that it survives from one sweep to the next.
+/// Returns the number of runs and the report's page.
+pub fn sweep_into_report(
+    report: &Path,
+    experiment: &Experiment,
+    scene: &Scene,
+    threads: Option<usize>,
+    progress: bool,
+    watch: &mut dyn SweepWatch,
+) -> Result<(usize, PathBuf)> {
+    write_folder_atomically(report, |tmp| {
+        let options = SweepOptions {
+            dir: tmp.to_path_buf(),
+            cache: report.join("cache"),
+            threads,
+            progress,
+        };
+        let results = run_sweep(experiment, scene, &options, |p| watch.show(p));
+        watch.runs_done();
+        let results = results?;
+        write_sweep_report(tmp, &results)?;
+        Ok((results.runs.len(), report.join("index.html")))
+    })
+}
 
 /// Writes the heatmaps, plots, `index.html` and `sweep.json` into `dir` (where the sweep wrote
 /// its images); returns the page's path.

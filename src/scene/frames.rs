@@ -3,9 +3,10 @@
 //! those that do (includes whose source plays frames, the camera path).
 //!
 //! An include **plays** when its source has frames ([`crate::formats::frames::open_frames`]:
-//! MMPLD frames, PDB/mmCIF models, XYZ frames, a trajectory, a sequence), its selection
-//! (`frames`, `frame_step`) holds more than one, and it does not pin one (`frame = k`,
-//! `model = m`). Every playing include must play the same number of frames: that is the
+//! MMPLD frames, PDB/mmCIF models, XYZ frames, a trajectory, a sequence) and it does not pin
+//! one (`frame = k`, `model = m`): an include that names a `trajectory`, `sequence` or `frames`
+//! plays whatever their count (one frame is a sequence of one); a file that merely has frames
+//! (a multi-model PDB) plays when its selection holds more than one. Every playing include must play the same number of frames: that is the
 //! scene's frame count (without a playing include the count is open: only the camera moves).
 //! Scene frame i shows source frame `start + i·step` of each playing include.
 //!
@@ -216,7 +217,9 @@ fn open_playing(scene: &Scene, group: &IncludeGroup) -> Result<Option<Playing>> 
         Some(_) => spec.path.clone(),
         None => source.path().to_path_buf(),
     };
-    Ok((selection.len() > 1).then(|| Playing {
+    // A trajectory, sequence or frame selection named in the include plays even when it holds
+    // one frame (a sequence of one); a file that merely has frames plays when it has several.
+    Ok((selection.len() > 1 || uses_frames(spec)).then(|| Playing {
         source,
         selection,
         range: group.range.clone(),

@@ -4,11 +4,13 @@
 //! field; `provenance` keeps where the settings were chosen, for the errors of renderers that
 //! refuse a combination of them.
 
+pub mod export;
 mod file;
 mod frames;
 mod framing;
 mod load;
 mod provenance;
+pub mod summary;
 
 pub use crate::formats::{ColorBy, IncludeSpec, ParticleRecord};
 pub use frames::SceneFrames;
@@ -217,6 +219,40 @@ impl Scene {
         self.particles
             .iter()
             .any(|p| p.profile == Profile::Gaussian)
+    }
+
+    /// The camera as a rasterising engine wants it (`pgt camera`, docs/design.md §7): eye, basis,
+    /// fov, size, the view matrix and a projection matrix per graphics API, with near/far from the
+    /// particles' bounds ([`crate::geometry::projection`]).
+    pub fn camera_json(&self) -> crate::geometry::projection::CameraJson {
+        crate::geometry::projection::CameraJson::new(
+            &self.camera,
+            self.particles.iter().map(|p| (p.center, p.radius)),
+            self.render.background,
+        )
+    }
+
+    /// "11032 spheres", "4 particles, 3 of them ellipsoids" or "1971 Gaussians": the particles of a
+    /// summary line.
+    pub fn particles_text(&self) -> String {
+        let n = self.particles.len();
+        if n > 0
+            && self
+                .particles
+                .iter()
+                .all(|p| p.profile == Profile::Gaussian)
+        {
+            return format!("{n} Gaussians");
+        }
+        let ellipsoids = self
+            .particles
+            .iter()
+            .filter(|p| p.ellipsoid.is_some())
+            .count();
+        match ellipsoids {
+            0 => format!("{} spheres", self.particles.len()),
+            n => format!("{} particles, {n} of them ellipsoids", self.particles.len()),
+        }
     }
 
     fn bvh_over(&self, keep: impl Fn(usize) -> bool) -> crate::geometry::Bvh {

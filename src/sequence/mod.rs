@@ -47,6 +47,20 @@ pub fn frames_in(range: FrameRange, scene: &Path, count: Option<usize>) -> Resul
     Ok((range.start..end).collect())
 }
 
+/// The scene of frame `frame` of a scene file (`--frame K` of `pgt camera` and `pgt export`), or
+/// the scene as `pgt render` loads it without one; a frame past the end is an error naming the
+/// scene and its frame count.
+pub fn scene_at_frame(
+    scene: &Path,
+    options: &crate::scene::SceneLoadOptions,
+    frame: Option<usize>,
+) -> Result<crate::scene::Scene> {
+    match frame {
+        None => crate::scene::Scene::load(scene, options),
+        Some(k) => crate::scene::SceneFrames::load(scene, options)?.frame(k),
+    }
+}
+
 /// The frames of part `part` of a list (`--part I/N` with `--frames`): the frames at positions
 /// k with k mod N = I, as the rows of an image part (`crate::parts`).
 pub fn frames_of_part(frames: &[usize], part: crate::parts::PartOf) -> Vec<usize> {

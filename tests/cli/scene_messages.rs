@@ -153,3 +153,22 @@ fn a_missing_trajectory_is_named_at_its_key() {
         "{err}"
     );
 }
+
+#[test]
+fn a_small_gaussian_cutoff_renders_with_a_warning_that_err_exceeds_tol() {
+    // With k = 1 every ray adds the depth of the Gaussian it passes outside 1 σ: err is large
+    // everywhere, honestly, and the user is told why.
+    let cut = GAUSSIANS.replace("[render]\n", "[render]\ngaussian_cutoff = 1.0\n");
+    let (code, err, written, _) = render(&cut, &[]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(written);
+    assert!(
+        err.contains("warning: 36 pixel(s) have err above tol 1e-5")
+            && err.contains("gaussian_cutoff = 1 σ"),
+        "{err}"
+    );
+    // The default cut-off keeps err within tol: no such warning.
+    let (code, err, _, _) = render(GAUSSIANS, &[]);
+    assert_eq!(code, Some(0), "{err}");
+    assert!(!err.contains("err above tol"), "{err}");
+}

@@ -194,3 +194,54 @@ fn sigint_while_a_report_is_written_leaves_no_report_and_no_temporary_folder() {
         "the folder changed: {err}"
     );
 }
+
+#[test]
+fn sigint_during_frames_keeps_the_finished_frames_and_says_how_many() {
+    let dir = tempfile::tempdir().unwrap();
+    let csv = slow_scene(dir.path());
+    let scene = dir.path().join("orbit.toml");
+    std::fs::write(
+        &scene,
+        "[camera]\nwidth = 160\nheight = 160\n\n[camera.orbit]\naxis = [0.0, 1.0, 0.0]\ndegrees_per_frame = 3.0\n\n[render]\nmodel = \"emission\"\ntol = 1e-9\n\n[[include]]\npath = \"particles.csv\"\n",
+    )
+    .unwrap();
+    assert!(csv.exists());
+    let frames = dir.path().join("frames");
+    let child = pgt()
+        .arg("render")
+        .arg(&scene)
+        .args(["--frames", "0..200", "-o"])
+        .arg(frames.join("f_%03d.exr"))
+        .spawn()
+        .unwrap();
+    wait_for_handlers(&child);
+    // Once the first frame is on disk, and long before the 200th.
+    let start = Instant::now();
+    while !frames.join("f_000.exr").exists() {
+        assert!(
+            start.elapsed() < Duration::from_secs(60),
+            "no frame within 60 s"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    send(&child, "INT");
+    let (status, err) = finish(child);
+    assert_eq!(status, Some(130), "{err}");
+    let kept: Vec<String> = std::fs::read_dir(&frames)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    assert!(
+        kept.iter()
+            .all(|n| n.starts_with("f_") && n.ends_with(".exr")),
+        "only finished frames stay: {kept:?}"
+    );
+    assert!(!kept.is_empty() && kept.len() < 200, "{kept:?}");
+    assert!(
+        err.contains(&format!(
+            "the {} output file(s) finished before it are kept",
+            kept.len()
+        )) && !err.contains("no output written"),
+        "{err}"
+    );
+}

@@ -430,3 +430,34 @@ fn an_include_emptied_by_its_filters_names_the_filter() {
         3
     );
 }
+
+#[test]
+fn info_says_what_it_reports_of_trajectories_in_help_and_text() {
+    let help = pgt(&["info", "--help"]);
+    let help = String::from_utf8_lossy(&help.stdout);
+    for word in [
+        "dcd",
+        ".xtc",
+        "GRO",
+        "PSF",
+        "frame count",
+        "atoms per frame",
+        "time step",
+    ] {
+        assert!(
+            help.contains(word),
+            "`pgt info --help` lacks {word}: {help}"
+        );
+    }
+    // The text of a bare DCD ends with its frames line (stdout, after the other lines).
+    let dcd = shared_or_skip!("trajectories/ala3.dcd");
+    let out = pgt(&["info", dcd.to_str().expect("utf8")]);
+    assert!(out.status.success());
+    let text = String::from_utf8_lossy(&out.stdout);
+    let last = text.lines().last().unwrap_or_default();
+    assert!(
+        text.starts_with(&format!("{} (dcd)", dcd.display()))
+            && last.starts_with("frames:    256 (42 atoms per frame, time step "),
+        "{text}"
+    );
+}

@@ -193,15 +193,12 @@ fn multi_model_pdb_and_mmcif_and_multi_frame_xyz() {
         "1lvz_pdb",
         false,
     );
-    // The mmCIF of the same entry holds the same models.
+    // The mmCIF of the same entry holds the same models; MDAnalysis's own mmCIF reader (gemmi)
+    // reads its first model, which pgt's frame 0 matches.
     let cif = shared_or_skip!("trajectories/1LVZ.cif");
-    check_against(
-        open_frames(&IncludeSpec::bare(&cif))
-            .expect("opens")
-            .as_ref(),
-        "1lvz_pdb",
-        false,
-    );
+    let cif_frames = open_frames(&IncludeSpec::bare(&cif)).expect("opens");
+    check_against(cif_frames.as_ref(), "1lvz_pdb", false);
+    check_first_frame(cif_frames.as_ref(), "1lvz_cif");
     let xyz = shared_or_skip!("trajectories/2r9r-1b.xyz");
     check_against(
         open_frames(&IncludeSpec::bare(&xyz))
@@ -255,6 +252,107 @@ fn every_mmpld_frame_matches_a_struct_reading() {
     let whole = pgt::formats::load_particles(&spec).expect("frame 37");
     let one = source.read_frame(37).expect("frame 37");
     assert_eq!(whole.records, one.particles.records);
+}
+
+/// Frame 0 of `source` against the vectors of `key`, a reader that sees one frame.
+fn check_first_frame(source: &dyn FrameSource, key: &str) {
+    let all = vectors();
+    let v = &all[key];
+    assert_eq!(v["frames"].as_u64(), Some(1), "{key}: one frame");
+    let frame = source.read_frame(0).expect("frame 0");
+    assert_eq!(
+        frame.particles.records.len() as u64,
+        v["atoms"].as_u64().expect("atoms"),
+        "{key}"
+    );
+    for (k, a) in v["atom_indices"]
+        .as_array()
+        .expect("atoms")
+        .iter()
+        .enumerate()
+    {
+        let a = a.as_u64().expect("index") as usize;
+        let expected = position(&v["positions"]["0"][k]);
+        let got = frame.particles.records[a].center;
+        assert!(
+            (got - expected).abs().max_element() <= TOL,
+            "{key} atom {a}: {got} vs {expected}"
+        );
+    }
+}
+
+#[test]
+fn single_frame_topologies_match_mdanalysis() {
+    let pdb = shared_or_skip!("trajectories/ala3.pdb");
+    let source = open_frames(&IncludeSpec::bare(&pdb)).expect("opens");
+    check_against(source.as_ref(), "ala3_pdb", false);
+    let gro = shared_or_skip!("trajectories/ngl_md.gro");
+    let source = open_frames(&IncludeSpec::bare(&gro)).expect("opens");
+    check_against(source.as_ref(), "ngl_md_gro", false);
+}
+
+/// tests/data/xtc/ (scripts/xtc_cases.py): small XTC files at the decoder's edges.
+fn xtc_case(name: &str) -> PathBuf {
+    crate::support::local(&format!("xtc/{name}.xtc"))
+}
+
+#[test]
+fn xtc_with_the_small_integer_index_zero_reads_as_mdanalysis_reads_it() {
+    let t = open_trajectory_file(&xtc_case("smallidx0")).expect("opens");
+    let all = vectors();
+    let v = &all["xtc_smallidx0"];
+    assert_eq!(t.frames() as u64, v["frames"].as_u64().expect("frames"));
+    assert_eq!(t.atoms() as u64, v["atoms"].as_u64().expect("atoms"));
+    assert_eq!(t.time_step_ps(), v["time_step_ps"].as_f64());
+    let mut p = Vec::new();
+    for f in [0usize, 1] {
+        t.read_positions(f, &mut p).expect("decodes");
+        for (k, a) in v["atom_indices"]
+            .as_array()
+            .expect("atoms")
+            .iter()
+            .enumerate()
+        {
+            let a = a.as_u64().expect("index") as usize;
+            let expected = position(&v["positions"][f.to_string()][k]);
+            assert!(
+                (p[a] - expected).abs().max_element() <= TOL,
+                "frame {f} atom {a}: {} vs {expected}",
+                p[a]
+            );
+        }
+    }
+}
+
+#[test]
+fn xtc_frames_the_reference_decoder_cannot_decode_are_refused_by_file_frame_and_byte() {
+    let mut p = Vec::new();
+    // A run of small atoms at index 0: libxdrfile divides by the radix 0 there.
+    let t = open_trajectory_file(&xtc_case("run_at_smallidx0")).expect("opens");
+    let e = err_of(t.read_positions(0, &mut p));
+    assert!(
+        e.contains("run_at_smallidx0.xtc") && e.contains("frame 0") && e.contains("index 0"),
+        "{e}"
+    );
+    // 13 atoms said, 12 in the block: the 13th is not decoded from the padding.
+    let t = open_trajectory_file(&xtc_case("over_block")).expect("opens");
+    assert_eq!(t.atoms(), 13);
+    let e = err_of(t.read_positions(0, &mut p));
+    assert!(
+        e.contains("over_block.xtc")
+            && e.contains("frame 0")
+            && e.contains("byte ")
+            && e.contains("ends before every atom"),
+        "{e}"
+    );
+    // 2^31 - 1 atoms said over 8 bytes: an error, not a 25 GB reservation and an abort.
+    let t = open_trajectory_file(&xtc_case("lying_count")).expect("opens");
+    assert_eq!(t.atoms(), i32::MAX as usize);
+    let e = err_of(t.read_positions(0, &mut p));
+    assert!(
+        e.contains("lying_count.xtc") && e.contains("frame 0"),
+        "{e}"
+    );
 }
 
 /// A temporary folder for a scene and its files.
@@ -610,4 +708,50 @@ fn opening_and_reading_a_frame_reads_that_frame_not_the_trajectory() {
         );
         assert!(for_frame > 0);
     }
+}
+
+#[test]
+fn a_trajectory_of_one_frame_plays_as_a_sequence_of_one() {
+    let psf = shared_or_skip!("trajectories/ala3.psf");
+    let dcd = shared_or_skip!("trajectories/ala3.dcd");
+    let dir = scratch("one-frame");
+    // ala3.dcd's header (276 bytes, its frame count NSET at byte 8) and its first frame (528).
+    let mut bytes = std::fs::read(&dcd).expect("read")[..276 + 528].to_vec();
+    bytes[8..12].copy_from_slice(&1i32.to_le_bytes());
+    let one = dir.join("one.dcd");
+    std::fs::write(&one, &bytes).expect("write");
+    let scene_path = dir.join("s.toml");
+    std::fs::write(
+        &scene_path,
+        format!(
+            "[camera]\nwidth = 16\nheight = 16\n\n[[include]]\npath = \"{}\"\ntrajectory = \"{}\"\n",
+            psf.display(),
+            one.display()
+        ),
+    )
+    .expect("write");
+    let frames = SceneFrames::load(&scene_path, &SceneLoadOptions::default()).expect("loads");
+    assert_eq!(frames.frame_count(), Some(1));
+    let info = frames.frame_info().expect("a sequence of one");
+    assert_eq!((info.count, info.atoms_per_frame), (1, Some(42)));
+    let f0 = frames.frame(0).expect("frame 0");
+    let direct = open_frames(&trajectory_spec(&psf, &dcd))
+        .expect("opens")
+        .read_frame(0)
+        .expect("source frame 0");
+    let centres: Vec<DVec3> = f0.particles.iter().map(|p| p.center).collect();
+    let expected: Vec<DVec3> = direct.particles.records.iter().map(|r| r.center).collect();
+    assert_eq!(centres, expected);
+    // A PDB of one model is a particle file, not a sequence: it does not play.
+    let pdb = shared_or_skip!("trajectories/ala3.pdb");
+    std::fs::write(
+        &scene_path,
+        format!(
+            "[camera]\nwidth = 16\nheight = 16\n\n[[include]]\npath = \"{}\"\n",
+            pdb.display()
+        ),
+    )
+    .expect("write");
+    let frames = SceneFrames::load(&scene_path, &SceneLoadOptions::default()).expect("loads");
+    assert_eq!(frames.frame_count(), None);
 }

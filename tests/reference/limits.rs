@@ -131,7 +131,7 @@ fn a_ray_through_a_point_light_inside_gas_is_reported() {
     let (x, y, e) = st.worst_unconverged.unwrap();
     assert_eq!((x, y), (1, 1));
     assert!(e > s.render.tol);
-    let warning = pgt::cli::render::unconverged_warning(st, s.render.tol).unwrap();
+    let warning = pgt::reference::unconverged_warning(st, s.render.tol).unwrap();
     assert!(warning.contains("(1, 1)") && warning.contains("did not reach tol"));
     // Everything else converged, and a converged render has no warning.
     s.lights = vec![Light::Directional {
@@ -140,5 +140,5 @@ fn a_ray_through_a_point_light_inside_gas_is_reported() {
     }];
     let out = pgt::reference::render(&s, &pgt::reference::RenderOptions::default()).unwrap();
     assert_eq!(out.stats.unconverged, 0);
-    assert!(pgt::cli::render::unconverged_warning(&out.stats, s.render.tol).is_none());
+    assert!(pgt::reference::unconverged_warning(&out.stats, s.render.tol).is_none());
 }

@@ -20,7 +20,7 @@
 //! (a mesh PLY is never read as spheres). Elements other than `vertex` are skipped.
 //!
 //! **pgt's own PLY.** A vertex element with pgt export's properties (`x y z`, `radius` or
-//! `sx sy sz qw qx qy qz`, `red green blue opacity sigma`, `crate::cli::export`) is read as
+//! `sx sy sz qw qx qy qz`, `red green blue opacity sigma`, `crate::scene::export`) is read as
 //! the CSV reader reads the same columns: every value as it is, σ bit for bit, so an export
 //! reads back as the particles it was written from.
 //!
