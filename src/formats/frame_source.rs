@@ -4,8 +4,7 @@
 //! files through the byte layer ([`super::file`]). The readers (one file per format) implement
 //! these; [`super::frames`] opens the source an include names and chooses its frames.
 
-// xtc.rs names `ByteSource` here until it takes it from the byte layer.
-pub(super) use super::file::ByteSource;
+use super::file::ByteSource;
 use super::{IncludeSpec, LoadedParticles};
 use crate::error::{PgtError, Result};
 use glam::DVec3;
@@ -135,18 +134,4 @@ pub trait Trajectory: Send + Sync {
     /// entries), and the frame's time in ps where the file gives one. A truncated or corrupt
     /// frame is an error that names the file, the frame and the byte.
     fn read_positions(&self, index: usize, out: &mut Vec<DVec3>) -> Result<Option<f64>>;
-}
-
-/// How xtc.rs declares itself until it is moved onto the table's [`super::Format`] (its entry
-/// of [`super::FORMATS`] is made from this).
-#[derive(Debug)]
-pub struct TrajectoryFormat {
-    /// Its name (`"xtc"`).
-    pub name: &'static str,
-    /// File name extensions, lower case, without the dot.
-    pub extensions: &'static [&'static str],
-    /// One line for people.
-    pub description: &'static str,
-    /// The reader.
-    pub open: super::OpenTrajectory,
 }

@@ -134,18 +134,8 @@ pub static FORMATS: &[&Format] = &[
     &ply::FORMAT,
     &psf::FORMAT,
     &dcd::FORMAT,
-    &XTC,
+    &xtc::FORMAT,
 ];
-
-/// XTC's entry (xtc.rs declares itself as a [`frame_source::TrajectoryFormat`] until it is
-/// moved onto the table's [`Format`]).
-const XTC: Format = Format {
-    name: xtc::FORMAT.name,
-    extensions: xtc::FORMAT.extensions,
-    description: xtc::FORMAT.description,
-    trajectory: Some(xtc::FORMAT.open),
-    ..Format::NOTHING
-};
 
 impl PartialEq for Format {
     fn eq(&self, other: &Format) -> bool {
