@@ -4,11 +4,10 @@
 
 use libfuzzer_sys::fuzz_target;
 use pgt::formats::frames::ByteSource;
-use pgt::formats::topology::Trajectory;
 
 fuzz_target!(|data: &[u8]| {
     let source = ByteSource::from_bytes(std::path::Path::new("fuzz.dcd"), data.to_vec());
-    if let Ok(t) = (pgt::formats::dcd::FORMAT.open)(source) {
+    if let Ok(t) = pgt::formats::dcd::open(source) {
         let mut positions = Vec::new();
         for k in 0..t.frames().min(64) {
             let _ = t.read_positions(k, &mut positions);

@@ -70,7 +70,7 @@ pub fn warn_all(py: Python<'_>, scene: &pgt::Scene, stacklevel: i32) -> PyResult
 /// A `format=` argument: the name of a particle format, as `--format` takes it.
 fn parse_format(py: Python<'_>, name: &str) -> PyResult<&'static pgt::formats::Format> {
     pgt::formats::Format::named(name).ok_or_else(|| {
-        let names: Vec<&str> = pgt::formats::FORMATS.iter().map(|f| f.name).collect();
+        let names: Vec<&str> = pgt::formats::particle_formats().map(|f| f.name).collect();
         input_error(
             py,
             format!(

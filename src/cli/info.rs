@@ -6,8 +6,7 @@
 use super::Outcome;
 use clap::Args;
 use pgt::formats::summary::Info;
-use pgt::formats::topology::TRAJECTORY_FORMATS;
-use pgt::formats::FORMATS;
+use pgt::formats::{particle_formats, FORMATS};
 use pgt::scene::summary::info_of;
 use std::path::PathBuf;
 
@@ -38,14 +37,14 @@ fn file_help() -> String {
         "A particle file, an MD trajectory or a scene file (.toml). Particle formats (the name for \
          `--format` and for `format` in an [[include]], the extensions, the format):",
     );
-    for f in FORMATS {
+    for f in particle_formats() {
         help.push_str(&format_line(f.name, f.extensions, f.description));
     }
     help.push_str(
         "\nMD trajectories (alone, or in a scene as `trajectory = \"…\"` beside a topology: PDB, \
          mmCIF, GRO or PSF):",
     );
-    for f in TRAJECTORY_FORMATS {
+    for f in FORMATS.iter().filter(|f| f.trajectory.is_some()) {
         help.push_str(&format_line(f.name, f.extensions, f.description));
     }
     help.push_str(

@@ -16,7 +16,7 @@ pub mod render;
 pub mod sweep;
 
 use clap::{Parser, Subcommand};
-use pgt::formats::{Format, FORMATS};
+use pgt::formats::{particle_formats, Format};
 
 /// What a subcommand ended with, when it did not fail.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -110,10 +110,11 @@ pub fn run(cli: Cli) -> anyhow::Result<Outcome> {
 }
 
 /// `--format NAME`: the format of a bare particle file whatever its extension, a name of the
-/// table of formats (`pgt::formats::FORMATS`; `--help` lists them).
+/// table of formats that reads particles (`pgt::formats::particle_formats`; `--help` lists
+/// them).
 pub fn format_parser() -> impl clap::builder::TypedValueParser<Value = &'static Format> {
     use clap::builder::TypedValueParser;
-    clap::builder::PossibleValuesParser::new(FORMATS.iter().map(|f| f.name))
+    clap::builder::PossibleValuesParser::new(particle_formats().map(|f| f.name))
         .try_map(|name| Format::named(&name).ok_or_else(|| format!("unknown format '{name}'")))
 }
 

@@ -31,19 +31,22 @@
 //! **Time.** The time step is DELTA · NSAVC · 0.04888821 ps (the AKMA time unit, as MDAnalysis
 //! and VMD convert it); frame k is at k times that, from the first frame.
 
-use super::frame_source::ByteSource;
-use super::frame_source::{Trajectory, TrajectoryFormat};
+use super::file::fortran::RecordError;
+use super::file::{ByteSource, Fortran, Reader};
+use super::frame_source::Trajectory;
+use super::Format;
 use crate::error::{PgtError, Result};
 use glam::DVec3;
 use std::path::Path;
 use std::sync::Mutex;
 
-/// DCD in the table of trajectory formats ([`super::topology::TRAJECTORY_FORMATS`]).
-pub const FORMAT: TrajectoryFormat = TrajectoryFormat {
+/// DCD in the table of formats ([`super::FORMATS`]): a trajectory.
+pub const FORMAT: Format = Format {
     name: "dcd",
     extensions: &["dcd"],
     description: "CHARMM/NAMD/LAMMPS/OpenMM DCD (Å)",
-    open,
+    trajectory: Some(open),
+    ..Format::NOTHING
 };
 
 /// Picoseconds per AKMA time unit (CHARMM's internal time unit).
@@ -54,61 +57,10 @@ const HEADER_RECORD: u64 = 84;
 /// Bytes of a unit-cell record's payload (six `f64`).
 const CELL_RECORD: u64 = 48;
 
-/// How numbers and record markers are stored.
-#[derive(Debug, Clone, Copy)]
-struct Encoding {
-    little: bool,
-    /// Bytes of a record marker: 4 or 8.
-    marker: u64,
-}
-
-impl Encoding {
-    fn i32(self, b: &[u8], at: usize) -> i32 {
-        let mut a = [0u8; 4];
-        if let Some(s) = b.get(at..at + 4) {
-            a.copy_from_slice(s);
-        }
-        if self.little {
-            i32::from_le_bytes(a)
-        } else {
-            i32::from_be_bytes(a)
-        }
-    }
-    fn f32(self, b: &[u8], at: usize) -> f32 {
-        f32::from_bits(self.i32(b, at) as u32)
-    }
-    fn f64(self, b: &[u8], at: usize) -> f64 {
-        let mut a = [0u8; 8];
-        if let Some(s) = b.get(at..at + 8) {
-            a.copy_from_slice(s);
-        }
-        if self.little {
-            f64::from_le_bytes(a)
-        } else {
-            f64::from_be_bytes(a)
-        }
-    }
-    fn marker_value(self, b: &[u8], at: usize) -> u64 {
-        if self.marker == 4 {
-            u64::from(self.i32(b, at) as u32)
-        } else {
-            let mut a = [0u8; 8];
-            if let Some(s) = b.get(at..at + 8) {
-                a.copy_from_slice(s);
-            }
-            if self.little {
-                u64::from_le_bytes(a)
-            } else {
-                u64::from_be_bytes(a)
-            }
-        }
-    }
-}
-
 /// An open DCD file.
 struct Dcd {
     source: ByteSource,
-    enc: Encoding,
+    records: Fortran,
     atoms: usize,
     /// 0-based indices of the free atoms, where atoms are fixed (NAMNF > 0).
     free: Option<Vec<usize>>,
@@ -124,91 +76,55 @@ struct Dcd {
     fixed: Mutex<Option<Vec<DVec3>>>,
 }
 
-/// Reads one record at `at`: its payload, after checking both markers against `expected`
-/// (`None`: any length that fits the file).
-fn record(
-    source: &ByteSource,
-    enc: Encoding,
-    at: u64,
-    expected: Option<u64>,
-    what: &str,
-) -> Result<(Vec<u8>, u64)> {
-    let m = source.read_at(at, enc.marker, &format!("the length marker of {what}"))?;
-    let len = enc.marker_value(&m, 0);
-    if let Some(e) = expected.filter(|&e| e != len) {
-        return Err(PgtError::at_byte(
-            source.path(),
-            at,
-            format!("{what}: the record length marker is {len}, expected {e}"),
-        ));
-    }
-    let payload = source.read_at(at + enc.marker, len, what)?;
-    let end_at = at + enc.marker + len;
-    let m2 = source.read_at(end_at, enc.marker, &format!("the closing marker of {what}"))?;
-    if enc.marker_value(&m2, 0) != len {
-        return Err(PgtError::at_byte(
-            source.path(),
-            end_at,
-            format!(
-                "{what}: the closing record marker is {}, expected {len} (a corrupt file)",
-                enc.marker_value(&m2, 0)
-            ),
-        ));
-    }
-    Ok((payload, end_at + enc.marker))
-}
-
-/// The byte order and marker size, from the first marker (84).
-fn encoding(source: &ByteSource) -> Result<Encoding> {
+/// The byte order and marker size: those in which the first marker reads 84.
+fn layout(source: &ByteSource) -> Result<Fortran> {
     let b = source.read_at(0, source.len().min(8), "the first record marker")?;
-    let four = |little| Encoding { little, marker: 4 };
-    let eight = |little| Encoding { little, marker: 8 };
-    for enc in [four(true), four(false), eight(true), eight(false)] {
-        if b.len() as u64 >= enc.marker && enc.marker_value(&b, 0) == HEADER_RECORD {
-            return Ok(enc);
-        }
-    }
-    Err(PgtError::at_byte(
-        source.path(),
-        0,
-        "not a DCD file: the first record marker is not 84 in either byte order",
-    ))
+    Fortran::detect(&b, HEADER_RECORD).ok_or_else(|| {
+        PgtError::at_byte(
+            source.path(),
+            0,
+            "not a DCD file: the first record marker is not 84 in either byte order",
+        )
+    })
 }
 
-/// The [`super::frame_source::OpenTrajectory`] of DCD: the header records, the free-atom list and the
+/// The [`super::OpenTrajectory`] of DCD: the header records, the free-atom list and the
 /// frame count from the file's length.
 pub fn open(source: ByteSource) -> Result<Box<dyn Trajectory>> {
-    let enc = encoding(&source)?;
+    let records = layout(&source)?;
     let path = source.path().to_path_buf();
-    let (head, at) = record(&source, enc, 0, Some(HEADER_RECORD), "the header record")?;
+    let (head, at) = records.read(&source, 0, Some(HEADER_RECORD), "the header record")?;
     if head.get(..4) != Some(b"CORD".as_slice()) {
         return Err(PgtError::at_byte(
             &path,
-            enc.marker,
+            records.marker,
             format!(
                 "not a coordinate DCD file: expected \"CORD\", found {:?}",
                 String::from_utf8_lossy(head.get(..4).unwrap_or_default())
             ),
         ));
     }
-    let icntrl = |k: usize| enc.i32(&head, 4 + 4 * k);
-    let charmm = icntrl(19) != 0;
-    let nset = icntrl(0);
-    let nsavc = icntrl(2).max(1);
-    let namnf = icntrl(8);
+    let header = payload(&path, &head, records.marker, &source, records);
+    let icntrl = |k: usize| header.number_at::<i32>(4 + 4 * k, "a control word of the header");
+    let charmm = icntrl(19)? != 0;
+    let nset = icntrl(0)?;
+    let nsavc = icntrl(2)?.max(1);
+    let namnf = icntrl(8)?;
     let delta = if charmm {
-        f64::from(enc.f32(&head, 4 + 4 * 9))
+        f64::from(header.number_at::<f32>(4 + 4 * 9, "DELTA")?)
     } else {
-        enc.f64(&head, 4 + 4 * 9)
+        header.number_at::<f64>(4 + 4 * 9, "DELTA")?
     };
-    let (has_cell, has_4d) = (charmm && icntrl(10) != 0, charmm && icntrl(11) != 0);
-    let (_, at) = record(&source, enc, at, None, "the title record")?;
-    let (natom_rec, at) = record(&source, enc, at, Some(4), "the atom-count record")?;
-    let atoms = enc.i32(&natom_rec, 0);
+    let (has_cell, has_4d) = (charmm && icntrl(10)? != 0, charmm && icntrl(11)? != 0);
+    let (_, at) = records.read(&source, at, None, "the title record")?;
+    let (natom_rec, at) = records.read(&source, at, Some(4), "the atom-count record")?;
+    let natom_at = at - 4 - records.marker;
+    let atoms = payload(&path, &natom_rec, natom_at, &source, records)
+        .number_at::<i32>(0, "the atom count")?;
     if atoms < 1 {
         return Err(PgtError::at_byte(
             &path,
-            at - 4 - enc.marker,
+            natom_at,
             format!("the atom count is {atoms}; a DCD trajectory needs at least one atom"),
         ));
     }
@@ -216,22 +132,16 @@ pub fn open(source: ByteSource) -> Result<Box<dyn Trajectory>> {
     if !(0..atoms as i64).contains(&i64::from(namnf)) {
         return Err(PgtError::at_byte(
             &path,
-            enc.marker + 4 + 4 * 8,
+            records.marker + 4 + 4 * 8,
             format!("the header says {namnf} fixed atoms, but there are {atoms} atoms"),
         ));
     }
-    let (free, at) = free_atoms(&source, enc, at, atoms, namnf as usize)?;
-    let coordinates = |n: usize| 3 * (4 * n as u64 + 2 * enc.marker);
+    let (free, at) = free_atoms(&source, records, at, atoms, namnf as usize)?;
+    let m = records.marker;
+    let coordinates = |n: usize| 3 * (4 * n as u64 + 2 * m);
     let extra = |n: usize| {
-        (if has_cell {
-            CELL_RECORD + 2 * enc.marker
-        } else {
-            0
-        }) + (if has_4d {
-            4 * n as u64 + 2 * enc.marker
-        } else {
-            0
-        })
+        (if has_cell { CELL_RECORD + 2 * m } else { 0 })
+            + (if has_4d { 4 * n as u64 + 2 * m } else { 0 })
     };
     let n_later = free.as_ref().map_or(atoms, Vec::len);
     let first_frame_bytes = coordinates(atoms) + extra(atoms);
@@ -273,7 +183,7 @@ pub fn open(source: ByteSource) -> Result<Box<dyn Trajectory>> {
         (delta.is_finite() && delta > 0.0).then(|| delta * f64::from(nsavc) * AKMA_PS);
     Ok(Box::new(Dcd {
         source,
-        enc,
+        records,
         atoms,
         free,
         has_cell,
@@ -292,7 +202,7 @@ pub fn open(source: ByteSource) -> Result<Box<dyn Trajectory>> {
 /// lie in 1..=N in the file, and the offset after the record.
 fn free_atoms(
     source: &ByteSource,
-    enc: Encoding,
+    records: Fortran,
     at: u64,
     atoms: usize,
     fixed: usize,
@@ -301,11 +211,12 @@ fn free_atoms(
         return Ok((None, at));
     }
     let n = atoms - fixed;
-    let (list, next) = record(source, enc, at, Some(4 * n as u64), "the free-atom list")?;
-    let list_at = at + enc.marker;
+    let (list, next) = records.read(source, at, Some(4 * n as u64), "the free-atom list")?;
+    let list_at = at + records.marker;
+    let list = payload(source.path(), &list, list_at, source, records);
     let mut free = Vec::with_capacity(n);
     for k in 0..n {
-        let i = enc.i32(&list, 4 * k);
+        let i = list.number_at::<i32>(4 * k, "a free atom's index")?;
         if !(1..=atoms as i64).contains(&i64::from(i)) {
             return Err(PgtError::at_byte(
                 source.path(),
@@ -316,6 +227,18 @@ fn free_atoms(
         free.push(i as usize - 1);
     }
     Ok((Some(free), next))
+}
+
+/// A reader over `bytes`, a record's payload (or a frame) read from file offset `at` of
+/// `source`, in the file's byte order.
+fn payload<'a>(
+    path: &'a Path,
+    bytes: &'a [u8],
+    at: u64,
+    source: &ByteSource,
+    records: Fortran,
+) -> Reader<'a> {
+    Reader::window(path, bytes, at, source.len(), "record", records.endian)
 }
 
 impl Dcd {
@@ -356,29 +279,25 @@ impl Dcd {
         let bytes = self
             .source
             .read_at(start, size, &format!("frame {index}"))?;
-        let enc = self.enc;
-        let m = enc.marker as usize;
+        let records = self.records;
         let mut at = 0usize;
         let mut take = |len: usize, what: &str| -> Result<usize> {
-            let first = enc.marker_value(&bytes, at);
-            let second = enc.marker_value(&bytes, at + m + len);
-            if first != len as u64 || second != len as u64 {
-                let bad_at = if first != len as u64 {
-                    at
-                } else {
-                    at + m + len
-                };
-                return Err(PgtError::at_byte(
+            let payload_at = records.record_in(&bytes, at, len).map_err(|e| match e {
+                RecordError::Markers { at: bad_at, opening, closing } => PgtError::at_byte(
                     path,
                     start + bad_at as u64,
                     format!(
-                        "frame {index}: the {what} record has length markers {first} and {second}, expected {len} (a corrupt frame)"
+                        "frame {index}: the {what} record has length markers {opening} and {closing}, expected {len} (a corrupt frame)"
                     ),
-                ));
-            }
-            let payload = at + m;
-            at += len + 2 * m;
-            Ok(payload)
+                ),
+                RecordError::CutShort { at } => PgtError::at_byte(
+                    path,
+                    start + at as u64,
+                    format!("frame {index}: the {what} record is cut short (a corrupt frame)"),
+                ),
+            })?;
+            at = payload_at + len + records.marker as usize;
+            Ok(payload_at)
         };
         if self.has_cell {
             take(CELL_RECORD as usize, "unit-cell")?;
@@ -387,9 +306,13 @@ impl Dcd {
         if self.has_4d {
             take(4 * n, "fourth-dimension")?;
         }
+        let frame = payload(path, &bytes, start, &self.source, records);
         let mut out = Vec::with_capacity(n);
         for k in 0..n {
-            let v: [f32; 3] = std::array::from_fn(|c| enc.f32(&bytes, axes[c] + 4 * k));
+            let mut v = [0f32; 3];
+            for (c, x) in v.iter_mut().enumerate() {
+                *x = frame.number_at(axes[c] + 4 * k, "a coordinate")?;
+            }
             if let Some(c) = v.iter().position(|x| !x.is_finite()) {
                 return Err(PgtError::at_byte(
                     path,

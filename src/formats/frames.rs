@@ -21,9 +21,9 @@
 //! * `frame = k` (or `model = m` for PDB/mmCIF): the include shows that one frame in every scene
 //!   frame (the static selection it always was).
 
+pub use super::file::{scan_lines, ByteSource, ReadSeek};
 pub use super::frame_source::{
-    finish_frame, past_the_end, scan_lines, ByteSource, Frame, FrameInfo, FrameSource, ReadSeek,
-    TextFrames,
+    finish_frame, past_the_end, Frame, FrameInfo, FrameSource, TextFrames,
 };
 use super::{format_of, Format, IncludeSpec, LoadedParticles};
 use crate::error::{PgtError, Result};

@@ -12,6 +12,7 @@
 //! numbers) must be present: a file cut short is refused.
 
 use super::atoms::{atoms_to_particles, md_element, Atom};
+use super::file::lines;
 use super::{Format, IncludeSpec, LoadedParticles};
 use crate::error::{PgtError, Result};
 use glam::DVec3;
@@ -26,9 +27,9 @@ pub const FORMAT: Format = Format {
     extensions: &["gro"],
     description: "GROMACS GRO (fixed columns, nm)",
     particles: "atom lines",
-    read,
-    details: None,
-    frames: None,
+    read: Some(read),
+    topology: Some(read_atoms),
+    ..Format::NOTHING
 };
 
 /// The [`super::Reader`] of GRO: every atom, then the include's selections (`chains` do not
@@ -55,22 +56,15 @@ fn field_width(line: &[u8]) -> usize {
     }
 }
 
-/// Columns `from..to` (0-based, end excluded) of a line, as text.
+/// Columns `from..to` of a line (0-based, end excluded, as the module doc numbers them),
+/// trimmed.
 fn columns(line: &[u8], from: usize, to: usize) -> String {
-    let a = from.min(line.len());
-    let b = to.min(line.len());
-    String::from_utf8_lossy(line.get(a..b).unwrap_or_default())
-        .trim()
-        .to_string()
+    super::file::columns(line, from + 1, to).trim().to_string()
 }
 
 /// Reads the atoms of the first frame of a GRO file, positions in Å.
 pub fn read_atoms(path: &Path, bytes: &[u8]) -> Result<(Vec<Atom>, Vec<String>)> {
-    let mut lines = bytes
-        .split(|&b| b == b'\n')
-        .map(|l| l.strip_suffix(b"\r").unwrap_or(l))
-        .enumerate()
-        .map(|(i, l)| (i + 1, l));
+    let mut lines = lines(bytes, 1);
     if lines.next().is_none() || bytes.is_empty() {
         return Err(PgtError::in_file(
             path,

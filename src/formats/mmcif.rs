@@ -9,6 +9,7 @@
 
 use super::atoms::{atoms_to_particles, infer_element, Atom};
 use super::elements::Element;
+use super::file::text::finite_number;
 use super::{Format, IncludeSpec, LoadedParticles};
 use crate::error::{PgtError, Result};
 use glam::DVec3;
@@ -20,9 +21,11 @@ pub const FORMAT: Format = Format {
     extensions: &["cif", "mmcif"],
     description: "mmCIF / PDBx",
     particles: "_atom_site rows",
-    read,
+    read: Some(read),
     details: Some(details),
     frames: Some(open_frames),
+    topology: Some(read_atoms),
+    ..Format::NOTHING
 };
 
 /// The [`super::OpenFrames`] of mmCIF: one frame per `pdbx_PDB_model_num`, in order of first
@@ -31,7 +34,7 @@ pub const FORMAT: Format = Format {
 /// grouped by model: fine for NMR ensembles; MD trajectories belong in DCD or XTC.
 pub fn open_frames(
     spec: &IncludeSpec,
-    source: super::frame_source::ByteSource,
+    source: super::file::ByteSource,
 ) -> Result<Box<dyn super::frame_source::FrameSource>> {
     let bytes = source.read_all("the file")?;
     let (atoms, warnings) = read_atoms(source.path(), &bytes)?;
@@ -372,19 +375,7 @@ pub fn read_atoms(path: &Path, bytes: &[u8]) -> Result<(Vec<Atom>, Vec<String>)>
                     format!("expected a number for {what}, found '.' or '?'"),
                 )
             })?;
-            match s.parse::<f64>() {
-                Ok(x) if x.is_finite() => Ok(x),
-                Ok(_) => Err(PgtError::at_line(
-                    path,
-                    l,
-                    format!("{what} is not finite: '{s}'"),
-                )),
-                Err(_) => Err(PgtError::at_line(
-                    path,
-                    l,
-                    format!("expected a number for {what}, found '{s}'"),
-                )),
-            }
+            finite_number(&s, what).map_err(|m| PgtError::at_line(path, l, m))
         };
         let position = DVec3::new(
             number(cx, "_atom_site.Cartn_x")?,

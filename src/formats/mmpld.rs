@@ -26,7 +26,7 @@
 //!
 //! Every count is checked against the bytes that remain before anything is allocated.
 
-use super::frame_source::ByteSource;
+use super::file::{ByteSource, Endian, Reader};
 use super::{Format, IncludeSpec, LoadedParticles, ParticleRecord};
 use crate::color::srgb_to_linear;
 use crate::error::{Location, PgtError, Result};
@@ -39,126 +39,14 @@ pub const FORMAT: Format = Format {
     extensions: &["mmpld"],
     description: "MegaMol MMPLD 1.0–1.3",
     particles: "particles in the frame",
-    read,
+    read: Some(read),
     details: Some(details),
     frames: Some(open_frames),
+    ..Format::NOTHING
 };
 
 const MAGIC: &[u8; 6] = b"MMPLD\0";
 const HEADER_BYTES: u64 = 60;
-
-/// A little-endian reader over a byte range that reports file offsets in errors. `bytes` is a
-/// window of the file that starts at file offset `base` (the whole file, or one frame's bytes).
-struct Cursor<'a> {
-    bytes: &'a [u8],
-    /// File offset of `bytes[0]`.
-    base: usize,
-    /// Length of the whole file.
-    file_len: usize,
-    pos: usize,
-    /// Reads may not go past this offset of the window (the frame's end).
-    end: usize,
-    path: &'a Path,
-}
-
-impl<'a> Cursor<'a> {
-    /// A cursor over a whole file.
-    fn whole(bytes: &'a [u8], path: &'a Path) -> Cursor<'a> {
-        Cursor {
-            bytes,
-            base: 0,
-            file_len: bytes.len(),
-            pos: 0,
-            end: bytes.len(),
-            path,
-        }
-    }
-    fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8]> {
-        let stop = self.pos.checked_add(n).filter(|&s| s <= self.end);
-        match stop.and_then(|s| self.bytes.get(self.pos..s)) {
-            Some(b) => {
-                self.pos += n;
-                Ok(b)
-            }
-            None => Err(PgtError::at_byte(
-                self.path,
-                (self.base + self.pos) as u64,
-                format!(
-                    "expected {what} ({n} bytes), but the {} ends at byte {}",
-                    self.region(),
-                    self.base + self.end
-                ),
-            )),
-        }
-    }
-    fn region(&self) -> &'static str {
-        if self.base + self.end == self.file_len {
-            "file"
-        } else {
-            "frame"
-        }
-    }
-    fn arr<const N: usize>(&mut self, what: &str) -> Result<[u8; N]> {
-        let b = self.take(N, what)?;
-        let mut a = [0u8; N];
-        a.copy_from_slice(b);
-        Ok(a)
-    }
-    fn u8(&mut self, what: &str) -> Result<u8> {
-        Ok(self.arr::<1>(what)?[0])
-    }
-    fn u16(&mut self, what: &str) -> Result<u16> {
-        Ok(u16::from_le_bytes(self.arr(what)?))
-    }
-    fn u32(&mut self, what: &str) -> Result<u32> {
-        Ok(u32::from_le_bytes(self.arr(what)?))
-    }
-    fn i32(&mut self, what: &str) -> Result<i32> {
-        Ok(i32::from_le_bytes(self.arr(what)?))
-    }
-    fn u64(&mut self, what: &str) -> Result<u64> {
-        Ok(u64::from_le_bytes(self.arr(what)?))
-    }
-    fn f32(&mut self, what: &str) -> Result<f32> {
-        Ok(f32::from_le_bytes(self.arr(what)?))
-    }
-    /// An error at window offset `at`.
-    fn err(&self, at: usize, msg: impl Into<String>) -> PgtError {
-        PgtError::at_byte(self.path, (self.base + at) as u64, msg)
-    }
-}
-
-fn le_f32(b: &[u8], at: usize) -> f64 {
-    let mut a = [0u8; 4];
-    if let Some(s) = b.get(at..at + 4) {
-        a.copy_from_slice(s);
-    }
-    f64::from(f32::from_le_bytes(a))
-}
-fn le_f64(b: &[u8], at: usize) -> f64 {
-    let mut a = [0u8; 8];
-    if let Some(s) = b.get(at..at + 8) {
-        a.copy_from_slice(s);
-    }
-    f64::from_le_bytes(a)
-}
-fn le_i16(b: &[u8], at: usize) -> f64 {
-    let mut a = [0u8; 2];
-    if let Some(s) = b.get(at..at + 2) {
-        a.copy_from_slice(s);
-    }
-    f64::from(i16::from_le_bytes(a))
-}
-fn le_u16(b: &[u8], at: usize) -> f64 {
-    let mut a = [0u8; 2];
-    if let Some(s) = b.get(at..at + 2) {
-        a.copy_from_slice(s);
-    }
-    f64::from(u16::from_le_bytes(a))
-}
-fn byte(b: &[u8], at: usize) -> f64 {
-    f64::from(b.get(at).copied().unwrap_or(0))
-}
 
 /// sRGB display value (any range) to linear, negatives clamped to 0.
 fn display_to_linear(c: DVec3) -> DVec3 {
@@ -198,22 +86,22 @@ fn header_and_table(path: &Path, bytes: &[u8]) -> Result<(Header, Vec<u64>)> {
 /// [`header_and_table`] from the file's first bytes `bytes` (at least the header and the seek
 /// table, where the file has them) and the file's length.
 fn header_and_table_of(path: &Path, bytes: &[u8], file_len: u64) -> Result<(Header, Vec<u64>)> {
-    let mut c = Cursor::whole(bytes, path);
-    let magic = c.arr::<6>("the magic \"MMPLD\\0\"")?;
+    let mut c = Reader::whole(path, bytes, Endian::Little);
+    let magic = c.array::<6>("the magic \"MMPLD\\0\"")?;
     if &magic != MAGIC {
         return Err(c.err(
             0,
             format!("not an MMPLD file: expected the magic \"MMPLD\\0\", found {magic:?}"),
         ));
     }
-    let version = c.u16("the version")?;
+    let version = c.number::<u16>("the version")?;
     if !(100..=103).contains(&version) {
         return Err(c.err(
             6,
             format!("unsupported MMPLD version {version} (expected 100–103, i.e. 1.0–1.3)"),
         ));
     }
-    let frames = c.u32("the frame count")?;
+    let frames = c.number::<u32>("the frame count")?;
     c.take(48, "the bounding and clip boxes")?;
     let room = file_len.saturating_sub(HEADER_BYTES) / 8;
     if u64::from(frames) >= room {
@@ -229,7 +117,7 @@ fn header_and_table_of(path: &Path, bytes: &[u8], file_len: u64) -> Result<(Head
     let n = frames as usize + 1;
     let mut table = Vec::with_capacity(n);
     for _ in 0..n {
-        table.push(c.u64("a seek-table offset")?);
+        table.push(c.number::<u64>("a seek-table offset")?);
     }
     // A table of only `frames` entries (the mmpld library): then the first offset points
     // at the (frames+1)-th entry's bytes, and the data end is the file end.
@@ -341,14 +229,14 @@ fn frame_records(
     warnings: &mut Vec<String>,
 ) -> Result<Vec<ParticleRecord>> {
     let parse = |timestamp: bool| {
-        let mut c = Cursor {
-            bytes: window,
-            base,
-            file_len,
-            pos: 0,
-            end: window.len(),
+        let mut c = Reader::window(
             path,
-        };
+            window,
+            base as u64,
+            file_len as u64,
+            "frame",
+            Endian::Little,
+        );
         parse_frame_lists(&mut c, version, timestamp)
     };
     match parse(version >= 102) {
@@ -375,9 +263,8 @@ pub fn open_frames(
 ) -> Result<Box<dyn super::frame_source::FrameSource>> {
     let path = source.path().to_path_buf();
     let head = source.read_at(0, source.len().min(HEADER_BYTES), "the header")?;
-    let frames = head
-        .get(8..12)
-        .map_or(0, |b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]));
+    // A header cut short is refused by `header_and_table_of`, which reads it again.
+    let frames = Endian::Little.read::<u32>(&head, 8).unwrap_or(0);
     let table_len = 8 * (u64::from(frames) + 1);
     let prefix = source.read_at(
         0,
@@ -486,10 +373,10 @@ impl ListHeader {
 }
 
 /// Reads a list header up to and including the list box of version 1.3.
-fn list_header(c: &mut Cursor<'_>, version: u16) -> Result<ListHeader> {
-    let vt_at = c.pos;
-    let vertex_type = c.u8("a vertex type")?;
-    let colour_type = c.u8("a colour type")?;
+fn list_header(c: &mut Reader<'_>, version: u16) -> Result<ListHeader> {
+    let vt_at = c.pos();
+    let vertex_type = c.number::<u8>("a vertex type")?;
+    let colour_type = c.number::<u8>("a colour type")?;
     let vertex_bytes = match vertex_type {
         0 => 0usize,
         1 => 12,
@@ -513,12 +400,12 @@ fn list_header(c: &mut Cursor<'_>, version: u16) -> Result<ListHeader> {
         }
     };
     let global_radius = if matches!(vertex_type, 1 | 3 | 4) {
-        f64::from(c.f32("the global radius")?)
+        f64::from(c.number::<f32>("the global radius")?)
     } else {
         1.0
     };
     let global_color = if colour_type == 0 {
-        let rgba = c.arr::<4>("the global RGBA colour")?;
+        let rgba = c.array::<4>("the global RGBA colour")?;
         display_to_linear(
             DVec3::new(f64::from(rgba[0]), f64::from(rgba[1]), f64::from(rgba[2])) / 255.0,
         )
@@ -527,14 +414,14 @@ fn list_header(c: &mut Cursor<'_>, version: u16) -> Result<ListHeader> {
     };
     let intensity_range = if matches!(colour_type, 3 | 7) {
         (
-            f64::from(c.f32("the intensity minimum")?),
-            f64::from(c.f32("the intensity maximum")?),
+            f64::from(c.number::<f32>("the intensity minimum")?),
+            f64::from(c.number::<f32>("the intensity maximum")?),
         )
     } else {
         (0.0, 1.0)
     };
-    let count_at = c.pos;
-    let count = c.u64("the particle count")?;
+    let count_at = c.pos();
+    let count = c.number::<u64>("the particle count")?;
     if version == 103 {
         c.take(24, "the list bounding box")?;
     }
@@ -551,53 +438,57 @@ fn list_header(c: &mut Cursor<'_>, version: u16) -> Result<ListHeader> {
     })
 }
 
-/// Centre and radius of one particle's bytes `p` (vertex types 1–4).
-fn particle_position(p: &[u8], h: &ListHeader) -> (DVec3, f64) {
-    match h.vertex_type {
+/// Centre and radius of the particle at offset `p` of the list's data `d` (vertex types 1–4).
+fn particle_position(d: &Reader<'_>, p: usize, h: &ListHeader) -> Result<(DVec3, f64)> {
+    let f32_at =
+        |o: usize| Ok::<_, PgtError>(f64::from(d.number_at::<f32>(p + o, "a coordinate")?));
+    let i16_at =
+        |o: usize| Ok::<_, PgtError>(f64::from(d.number_at::<i16>(p + o, "a coordinate")?));
+    let f64_at = |o: usize| d.number_at::<f64>(p + o, "a coordinate");
+    Ok(match h.vertex_type {
         1 => (
-            DVec3::new(le_f32(p, 0), le_f32(p, 4), le_f32(p, 8)),
+            DVec3::new(f32_at(0)?, f32_at(4)?, f32_at(8)?),
             h.global_radius,
         ),
-        2 => (
-            DVec3::new(le_f32(p, 0), le_f32(p, 4), le_f32(p, 8)),
-            le_f32(p, 12),
-        ),
+        2 => (DVec3::new(f32_at(0)?, f32_at(4)?, f32_at(8)?), f32_at(12)?),
         3 => (
-            DVec3::new(le_i16(p, 0), le_i16(p, 2), le_i16(p, 4)),
+            DVec3::new(i16_at(0)?, i16_at(2)?, i16_at(4)?),
             h.global_radius,
         ),
         _ => (
-            DVec3::new(le_f64(p, 0), le_f64(p, 8), le_f64(p, 16)),
+            DVec3::new(f64_at(0)?, f64_at(8)?, f64_at(16)?),
             h.global_radius,
         ),
-    }
+    })
 }
 
-/// Linear colour of one particle's bytes `p` (the colour follows the position).
-fn particle_color(p: &[u8], h: &ListHeader) -> DVec3 {
-    let o = h.vertex_bytes;
+/// Linear colour of the particle at offset `p` of the list's data `d` (the colour follows the
+/// position).
+fn particle_color(d: &Reader<'_>, p: usize, h: &ListHeader) -> Result<DVec3> {
+    let o = p + h.vertex_bytes;
     let (imin, imax) = h.intensity_range;
-    match h.colour_type {
+    let u8_at = |k: usize| Ok::<_, PgtError>(f64::from(d.number_at::<u8>(o + k, "a colour")?));
+    let u16_at = |k: usize| Ok::<_, PgtError>(f64::from(d.number_at::<u16>(o + k, "a colour")?));
+    let f32_at = |k: usize| Ok::<_, PgtError>(f64::from(d.number_at::<f32>(o + k, "a colour")?));
+    Ok(match h.colour_type {
         0 => h.global_color,
-        1 | 2 => display_to_linear(DVec3::new(byte(p, o), byte(p, o + 1), byte(p, o + 2)) / 255.0),
-        3 => intensity_color(le_f32(p, o), imin, imax),
-        4 | 5 => display_to_linear(DVec3::new(le_f32(p, o), le_f32(p, o + 4), le_f32(p, o + 8))),
-        6 => display_to_linear(
-            DVec3::new(le_u16(p, o), le_u16(p, o + 2), le_u16(p, o + 4)) / 65535.0,
-        ),
-        _ => intensity_color(le_f64(p, o), imin, imax),
-    }
+        1 | 2 => display_to_linear(DVec3::new(u8_at(0)?, u8_at(1)?, u8_at(2)?) / 255.0),
+        3 => intensity_color(f32_at(0)?, imin, imax),
+        4 | 5 => display_to_linear(DVec3::new(f32_at(0)?, f32_at(4)?, f32_at(8)?)),
+        6 => display_to_linear(DVec3::new(u16_at(0)?, u16_at(2)?, u16_at(4)?) / 65535.0),
+        _ => intensity_color(d.number_at::<f64>(o, "a colour")?, imin, imax),
+    })
 }
 
 /// Reads the particles of a list whose header is `h`, after checking that the announced count
 /// fits in the bytes left in the frame (before anything is allocated).
 fn read_list_particles(
-    c: &mut Cursor<'_>,
+    c: &mut Reader<'_>,
     h: &ListHeader,
     out: &mut Vec<ParticleRecord>,
 ) -> Result<()> {
     let stride = h.stride();
-    let left = c.end.saturating_sub(c.pos);
+    let left = c.left();
     let Some(data_bytes) = (stride as u64)
         .checked_mul(h.count)
         .filter(|&n| n <= left as u64)
@@ -610,16 +501,16 @@ fn read_list_particles(
             ),
         ));
     };
-    let data_at = c.pos;
-    let data = c.take(data_bytes as usize, "the particle data")?;
+    let data_at = c.pos();
+    c.take(data_bytes as usize, "the particle data")?;
     if h.vertex_type == 0 {
         return Ok(());
     }
     out.reserve(h.count as usize);
-    for (k, p) in data.chunks_exact(stride).enumerate() {
-        let (center, radius) = particle_position(p, h);
-        let color = particle_color(p, h);
+    for k in 0..h.count as usize {
         let at = data_at + k * stride;
+        let (center, radius) = particle_position(c, at, h)?;
+        let color = particle_color(c, at, h)?;
         if !center.is_finite() || !color.is_finite() {
             return Err(c.err(
                 at,
@@ -633,20 +524,20 @@ fn read_list_particles(
             color: Some(color),
             opacity: None,
             sigma: None,
-            location: Location::Byte((c.base + at) as u64),
+            location: Location::Byte(c.file_offset(at)),
         });
     }
     Ok(())
 }
 
 /// Skips the cluster info that follows each list in version 1.1.
-fn skip_cluster_info(c: &mut Cursor<'_>) -> Result<()> {
-    c.u32("the cluster count")?;
-    let size_at = c.pos;
-    let size = c.u64("the cluster data size")?;
+fn skip_cluster_info(c: &mut Reader<'_>) -> Result<()> {
+    c.number::<u32>("the cluster count")?;
+    let size_at = c.pos();
+    let size = c.number::<u64>("the cluster data size")?;
     let size = usize::try_from(size)
         .ok()
-        .filter(|&s| s <= c.end.saturating_sub(c.pos))
+        .filter(|&s| s <= c.left())
         .ok_or_else(|| {
             c.err(
                 size_at,
@@ -657,19 +548,19 @@ fn skip_cluster_info(c: &mut Cursor<'_>) -> Result<()> {
     Ok(())
 }
 
-/// Parses the frame under the cursor (from `c.pos` to `c.end`): its lists, which must end
-/// exactly at `c.end`.
+/// Parses the frame under the cursor (from its position to the end of its window): its lists,
+/// which must end exactly there.
 fn parse_frame_lists(
-    c: &mut Cursor<'_>,
+    c: &mut Reader<'_>,
     version: u16,
     timestamp: bool,
 ) -> Result<Vec<ParticleRecord>> {
-    let end = c.end;
+    let end = c.pos() + c.left();
     if timestamp {
-        c.f32("the frame timestamp")?;
+        c.number::<f32>("the frame timestamp")?;
     }
-    let lists_at = c.pos;
-    let lists = c.i32("the list count")?;
+    let lists_at = c.pos();
+    let lists = c.number::<i32>("the list count")?;
     if lists < 0 {
         return Err(c.err(lists_at, format!("negative list count {lists}")));
     }
@@ -681,13 +572,13 @@ fn parse_frame_lists(
             skip_cluster_info(c)?;
         }
     }
-    if c.pos != end {
+    if c.left() != 0 {
         return Err(c.err(
-            c.pos,
+            c.pos(),
             format!(
                 "the frame's lists end at byte {} but the seek table says the frame ends at byte {}",
-                c.base + c.pos,
-                c.base + end
+                c.file_offset(c.pos()),
+                c.file_offset(end)
             ),
         ));
     }

@@ -1,13 +1,23 @@
-//! Particle file formats (docs/design.md §6). Each format turns a file's bytes into
-//! [`ParticleRecord`]s with the line (or byte offset) each came from, so that validation can
-//! point at it.
+//! File formats (docs/design.md §6, §10). Each format turns a file's bytes into what pgt needs
+//! of it: [`ParticleRecord`]s with the line (or byte offset) each came from, so that validation
+//! can point at it; the atoms of a topology; the frames of a trajectory.
 //!
-//! **The table of formats.** Every format is one [`Format`] value, declared in its own module
-//! (`pdb::FORMAT`, …) and listed once in [`FORMATS`]. Extension detection ([`Format::from_path`]),
-//! the `format = "…"` of an `[[include]]` ([`Format::named`]), the "unsupported file type" message
-//! and `pgt info` (name and details) all read that table; nobody matches on a format.
-//! A new format is a new module with a `pub const FORMAT: Format` (its reader has the signature
-//! [`Reader`]), its `mod` line here and its line in [`FORMATS`].
+//! **One table of formats.** Every format is one [`Format`] value, declared in its own module
+//! (`pdb::FORMAT`, …) and listed once in [`FORMATS`]. A format says what it reads: particles
+//! ([`Format::read`], with [`Format::details`] for `pgt info` and [`Format::frames`] where a
+//! file holds several), the atoms of a topology ([`Format::topology`]), the frames of an MD
+//! trajectory ([`Format::trajectory`]), or several of these (a PDB file is particles and a
+//! topology). Extension detection ([`Format::from_path`], [`Format::trajectory_of`],
+//! [`Format::topology_of`]), the `format = "…"` of an `[[include]]` ([`Format::named`]), the
+//! "unsupported file type" messages and `pgt info` (name and details) all read that table;
+//! nobody matches on a format. A new format is a new module with a `pub const FORMAT: Format`
+//! (its readers have the signatures [`Reader`], [`ReadAtoms`], [`OpenTrajectory`]), its `mod`
+//! line here and its line in [`FORMATS`].
+//!
+//! **One byte layer.** The readers take their bytes through [`file`]: numbers in either byte
+//! order and a cursor whose every read is checked against the bytes present, Fortran records,
+//! numbered lines and columns. A reader never sizes an allocation from a header value before
+//! that layer has checked it against the file.
 //!
 //! **One loading path.** [`load_particles`] (a file) and [`load_bytes`] (bytes already read) run
 //! the reader and then, for every format alike: `radius_scale`, `color_by = "uniform"`, the
@@ -17,6 +27,7 @@ pub mod atoms;
 pub mod dcd;
 pub mod elements;
 pub mod export;
+pub mod file;
 pub mod frame_source;
 pub mod frames;
 pub mod gro;
@@ -49,10 +60,10 @@ pub struct LoadedParticles {
     pub warnings: Vec<String>,
 }
 
-/// The one signature of every reader: the include (its `path` names the file in messages; its
-/// selections apply where the format has them) and the file's bytes. `radius_scale`,
-/// `color_by = "uniform"`, the empty-file refusal and the record checks are left to
-/// [`load_bytes`].
+/// The one signature of every particle reader: the include (its `path` names the file in
+/// messages; its selections apply where the format has them) and the file's bytes.
+/// `radius_scale`, `color_by = "uniform"`, the empty-file refusal and the record checks are
+/// left to [`load_bytes`].
 pub type Reader = fn(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles>;
 
 /// Format-specific facts for `pgt info` (`models`, `chains`, `version`, `frames`, …).
@@ -64,7 +75,14 @@ pub type Details =
 pub type OpenFrames =
     fn(spec: &IncludeSpec, bytes: frames::ByteSource) -> Result<Box<dyn frames::FrameSource>>;
 
-/// One particle file format: an entry of [`FORMATS`].
+/// The atoms of a topology file (every model; `path` names the file in messages), with the
+/// reader's remarks.
+pub type ReadAtoms = fn(path: &Path, bytes: &[u8]) -> Result<(Vec<atoms::Atom>, Vec<String>)>;
+
+/// Opens a trajectory from its bytes (header read, frames found).
+pub type OpenTrajectory = fn(source: file::ByteSource) -> Result<Box<dyn frame_source::Trajectory>>;
+
+/// One file format: an entry of [`FORMATS`], with what it reads.
 #[derive(Debug)]
 pub struct Format {
     /// The name of `[[include]] format = "…"` and of `pgt info` (`"pdb"`).
@@ -74,17 +92,37 @@ pub struct Format {
     /// One line for people (`"PDB (wwPDB 3.3, fixed columns)"`).
     pub description: &'static str,
     /// What a particle is in this format, for the "holds no particles" error
-    /// (`"ATOM or HETATM records"`).
+    /// (`"ATOM or HETATM records"`); empty where the format holds no particles.
     pub particles: &'static str,
-    /// The reader.
-    pub read: Reader,
+    /// The particle reader, where a file of this format is a particle file of its own.
+    pub read: Option<Reader>,
     /// Extra facts for `pgt info`, where the format has any.
     pub details: Option<Details>,
-    /// Its frames, one at a time, where a file of this format may hold several.
+    /// Its frames, one at a time, where a particle file of this format may hold several.
     pub frames: Option<OpenFrames>,
+    /// The atoms a trajectory moves, where a file of this format can be a topology.
+    pub topology: Option<ReadAtoms>,
+    /// The trajectory reader, where a file of this format is an MD trajectory.
+    pub trajectory: Option<OpenTrajectory>,
 }
 
-/// Every format pgt reads, in the order messages list them.
+impl Format {
+    /// A format that reads nothing: what a table entry leaves out (`..Format::NOTHING`).
+    pub const NOTHING: Format = Format {
+        name: "",
+        extensions: &[],
+        description: "",
+        particles: "",
+        read: None,
+        details: None,
+        frames: None,
+        topology: None,
+        trajectory: None,
+    };
+}
+
+/// Every format pgt reads: the particle formats in the order messages list them, then the
+/// topologies and trajectories that are nothing else.
 pub static FORMATS: &[&Format] = &[
     &pdb::FORMAT,
     &mmcif::FORMAT,
@@ -94,6 +132,9 @@ pub static FORMATS: &[&Format] = &[
     &xyz_csv::CSV,
     &gro::FORMAT,
     &ply::FORMAT,
+    &psf::FORMAT,
+    &dcd::FORMAT,
+    &xtc::FORMAT,
 ];
 
 impl PartialEq for Format {
@@ -103,37 +144,56 @@ impl PartialEq for Format {
 }
 
 impl Format {
-    /// The format of this name (`"pdb"`), as `[[include]] format = "…"` writes it.
+    /// The particle format of this name (`"pdb"`), as `[[include]] format = "…"` writes it.
     pub fn named(name: &str) -> Option<&'static Format> {
-        FORMATS.iter().copied().find(|f| f.name == name)
+        particle_formats().find(|f| f.name == name)
     }
 
-    /// The format a file name's extension stands for (case-insensitive).
+    /// The particle format a file name's extension stands for (case-insensitive).
     pub fn from_path(path: &Path) -> Option<&'static Format> {
+        Format::with_extension(path, |f| f.read.is_some())
+    }
+
+    /// The trajectory format a file name's extension stands for (case-insensitive).
+    pub fn trajectory_of(path: &Path) -> Option<&'static Format> {
+        Format::with_extension(path, |f| f.trajectory.is_some())
+    }
+
+    /// The topology format a file name's extension stands for (case-insensitive).
+    pub fn topology_of(path: &Path) -> Option<&'static Format> {
+        Format::with_extension(path, |f| f.topology.is_some())
+    }
+
+    /// The first format of [`FORMATS`] for which `reads` holds that has the extension of `path`.
+    fn with_extension(path: &Path, reads: impl Fn(&Format) -> bool) -> Option<&'static Format> {
         let ext = path.extension()?.to_str()?.to_ascii_lowercase();
         FORMATS
             .iter()
             .copied()
-            .find(|f| f.extensions.contains(&ext.as_str()))
+            .find(|f| reads(f) && f.extensions.contains(&ext.as_str()))
     }
 }
 
-/// Every extension of [`FORMATS`] as a list for messages: `.pdb, .ent, …, .csv`.
+/// The formats of [`FORMATS`] that read particle files, in table order.
+pub fn particle_formats() -> impl Iterator<Item = &'static Format> {
+    FORMATS.iter().copied().filter(|f| f.read.is_some())
+}
+
+/// Every extension of the particle formats as a list for messages: `.pdb, .ent, …, .ply`.
 pub fn known_extensions() -> String {
-    let all: Vec<String> = FORMATS
-        .iter()
+    let all: Vec<String> = particle_formats()
         .flat_map(|f| f.extensions.iter().map(|e| format!(".{e}")))
         .collect();
     all.join(", ")
 }
 
-/// Every name of [`FORMATS`] as a list for messages: `pdb, mmcif, …`.
+/// Every name of the particle formats as a list for messages: `pdb, mmcif, …`.
 pub fn known_names() -> String {
-    let all: Vec<&str> = FORMATS.iter().map(|f| f.name).collect();
+    let all: Vec<&str> = particle_formats().map(|f| f.name).collect();
     all.join(", ")
 }
 
-/// serde for `[[include]] format = "…"`: a name of [`FORMATS`]; another name is an error that
+/// serde for `[[include]] format = "…"`: a particle format's name; another name is an error that
 /// lists them (toml adds the line).
 pub(crate) fn deserialize_format<'de, D>(
     d: D,
@@ -215,7 +275,16 @@ pub fn load_particles(spec: &IncludeSpec) -> Result<LoadedParticles> {
 /// no particles (docs/design.md §1: an error naming the file), and [`check_records`]. `spec.path`
 /// names the file in messages.
 pub fn load_bytes(spec: &IncludeSpec, format: &Format, bytes: &[u8]) -> Result<LoadedParticles> {
-    let mut loaded = (format.read)(spec, bytes)?;
+    let Some(read) = format.read else {
+        return Err(PgtError::in_file(
+            &spec.path,
+            format!(
+                "a {} file holds no particles of its own ({})",
+                format.name, format.description
+            ),
+        ));
+    };
+    let mut loaded = read(spec, bytes)?;
     if loaded.records.is_empty() {
         return Err(no_particles(spec, format, bytes.len(), &loaded.warnings));
     }

@@ -11,9 +11,8 @@
 
 use super::atoms::{atoms_to_particles, infer_element, Atom};
 use super::elements::Element;
-use super::frame_source::{
-    finish_frame, scan_lines, ByteSource, Frame, FrameInfo, FrameSource, TextFrames,
-};
+use super::file::{columns, lines, scan_lines, ByteSource};
+use super::frame_source::{finish_frame, Frame, FrameInfo, FrameSource, TextFrames};
 use super::{Format, IncludeSpec, LoadedParticles};
 use crate::error::{PgtError, Result};
 use glam::DVec3;
@@ -25,9 +24,11 @@ pub const FORMAT: Format = Format {
     extensions: &["pdb", "ent"],
     description: "PDB (wwPDB format 3.3, fixed columns)",
     particles: "ATOM or HETATM records",
-    read,
+    read: Some(read),
     details: Some(details),
     frames: Some(open_frames),
+    topology: Some(read_atoms),
+    ..Format::NOTHING
 };
 
 /// The [`super::Reader`] of PDB: every atom record, then the include's selections
@@ -56,10 +57,8 @@ fn read_atoms_from(
     let mut atoms = Vec::new();
     let warnings = Vec::new();
     let mut model = 1i64;
-    for (i, raw) in bytes.split(|&b| b == b'\n').enumerate() {
-        let line_no = i + first_line;
-        let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
-        let record = field(raw, 1, 6);
+    for (line_no, raw) in lines(bytes, first_line) {
+        let record = columns(raw, 1, 6);
         match record.trim_end() {
             "ATOM" | "HETATM" => atoms.push(atom(
                 path,
@@ -97,7 +96,6 @@ fn read_atoms_from(
 pub fn open_frames(spec: &IncludeSpec, source: ByteSource) -> Result<Box<dyn FrameSource>> {
     let mut text = TextFrames::default();
     scan_lines(&source, |line, at, raw| {
-        let raw = raw.strip_suffix(b"\r").unwrap_or(raw);
         if raw.starts_with(b"MODEL") && (raw.len() == 5 || raw.get(5) == Some(&b' ')) {
             if text.starts.is_empty() {
                 text.starts.push(0);
@@ -151,13 +149,6 @@ impl FrameSource for PdbFrames {
     }
 }
 
-/// Columns `from..=to` (1-based) of a line, as text; short lines give what is there.
-fn field(line: &[u8], from: usize, to: usize) -> std::borrow::Cow<'_, str> {
-    let start = from.saturating_sub(1).min(line.len());
-    let end = to.min(line.len());
-    String::from_utf8_lossy(line.get(start..end).unwrap_or_default())
-}
-
 fn coordinate(
     path: &Path,
     line: &[u8],
@@ -166,7 +157,7 @@ fn coordinate(
     from: usize,
     to: usize,
 ) -> Result<f64> {
-    let text = field(line, from, to);
+    let text = columns(line, from, to);
     let v: f64 = text.trim().parse().map_err(|_| {
         PgtError::at_line(
             path,
@@ -194,7 +185,7 @@ fn atom(path: &Path, raw: &[u8], line_no: usize, model: i64, hetatm: bool) -> Re
     let x = coordinate(path, raw, line_no, "x", 31, 38)?;
     let y = coordinate(path, raw, line_no, "y", 39, 46)?;
     let z = coordinate(path, raw, line_no, "z", 47, 54)?;
-    let occ_text = field(raw, 55, 60);
+    let occ_text = columns(raw, 55, 60);
     let occupancy = if occ_text.trim().is_empty() {
         1.0
     } else {
@@ -212,8 +203,8 @@ fn atom(path: &Path, raw: &[u8], line_no: usize, model: i64, hetatm: bool) -> Re
             }
         }
     };
-    let name_field = field(raw, 13, 16);
-    let element_field = field(raw, 77, 78);
+    let name_field = columns(raw, 13, 16);
+    let element_field = columns(raw, 77, 78);
     let element = if element_field
         .trim()
         .chars()
@@ -224,7 +215,7 @@ fn atom(path: &Path, raw: &[u8], line_no: usize, model: i64, hetatm: bool) -> Re
     } else {
         infer_element(&name_field, hetatm)
     };
-    let alt = field(raw, 17, 17);
+    let alt = columns(raw, 17, 17);
     let alt = alt.trim();
     Ok(Atom {
         position: DVec3::new(x, y, z),
@@ -232,9 +223,9 @@ fn atom(path: &Path, raw: &[u8], line_no: usize, model: i64, hetatm: bool) -> Re
         name: name_field.trim().to_string(),
         alt_loc: (!alt.is_empty()).then(|| alt.to_string()),
         occupancy,
-        residue_name: field(raw, 18, 20).trim().to_string(),
-        chain: field(raw, 22, 22).trim().to_string(),
-        residue: field(raw, 23, 27).into_owned(),
+        residue_name: columns(raw, 18, 20).trim().to_string(),
+        chain: columns(raw, 22, 22).trim().to_string(),
+        residue: columns(raw, 23, 27).into_owned(),
         model,
         line: line_no,
     })

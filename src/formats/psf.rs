@@ -12,9 +12,20 @@
 
 use super::atoms::{md_element, Atom};
 use super::elements::Element;
+use super::file::text_lines;
+use super::Format;
 use crate::error::{PgtError, Result};
 use glam::DVec3;
 use std::path::Path;
+
+/// PSF in the table of formats ([`super::FORMATS`]): a topology only.
+pub const FORMAT: Format = Format {
+    name: "psf",
+    extensions: &["psf"],
+    description: "CHARMM/X-PLOR PSF (the !NATOM section)",
+    topology: Some(read_atoms),
+    ..Format::NOTHING
+};
 
 /// How far (in u) an atom's mass may be from an element's standard atomic mass to be taken as
 /// that element.
@@ -67,11 +78,7 @@ pub fn element_of_mass(mass: f64) -> Option<Element> {
 
 /// Reads the atoms of a PSF file's `!NATOM` section (positions 0: a PSF has none).
 pub fn read_atoms(path: &Path, bytes: &[u8]) -> Result<(Vec<Atom>, Vec<String>)> {
-    let mut lines = bytes
-        .split(|&b| b == b'\n')
-        .map(|l| String::from_utf8_lossy(l.strip_suffix(b"\r").unwrap_or(l)).into_owned())
-        .enumerate()
-        .map(|(i, l)| (i + 1, l));
+    let mut lines = text_lines(bytes, 1);
     let (natom_line, n) = loop {
         let Some((no, line)) = lines.next() else {
             return Err(PgtError::in_file(

@@ -156,8 +156,9 @@ pub struct IncludeSpec {
     /// never read from the file.
     #[serde(skip)]
     pub view_from: Option<glam::DVec3>,
-    /// Forces a file format whatever the extension: a name of [`super::FORMATS`] (`"pdb"`,
-    /// `"mmcif"`, `"vrml"`, `"mmpld"`, `"xyz"`, `"csv"`, `"gro"`, `"ply"`).
+    /// Forces a file format whatever the extension: the name of a particle format of
+    /// [`super::FORMATS`] (`"pdb"`, `"mmcif"`, `"vrml"`, `"mmpld"`, `"xyz"`, `"csv"`, `"gro"`,
+    /// `"ply"`).
     #[serde(default, deserialize_with = "super::deserialize_format")]
     pub format: Option<&'static super::Format>,
 }

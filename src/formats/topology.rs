@@ -3,40 +3,30 @@
 //! der Waals radius, CPK colour), chain and residue, so `color_by`, `chains`, `skip_water` and
 //! `skip_hydrogen` work as for a PDB file; the trajectory gives the positions of every frame.
 //!
-//! **The table of trajectory formats.** A trajectory format is a [`TrajectoryFormat`] in
-//! [`TRAJECTORY_FORMATS`], read through the [`Trajectory`] trait: atom count, frame count, time
-//! step, and the positions of one frame in Å (GRO and XTC are in nm and are converted, so that
-//! radii by element agree). A new format is a module with a `pub const FORMAT` and its line in
-//! the table.
+//! **Formats.** Trajectories and topologies are entries of the one table of formats
+//! ([`super::FORMATS`]): a trajectory format has a [`Format::trajectory`] reader, read through
+//! the [`Trajectory`] trait (atom count, frame count, time step, and the positions of one frame
+//! in Å: GRO and XTC are in nm and are converted, so that radii by element agree); a topology
+//! format has a [`Format::topology`] reader that gives the atoms.
 //!
 //! **Atom counts must agree.** The topology's atoms (of its first model) are the trajectory's
 //! atoms in order; a topology with another count is refused, naming both files and both counts.
 
 use super::atoms::{select_atom_indices, Atom};
-use super::frame_source::{finish_frame, past_the_end, ByteSource, Frame, FrameInfo, FrameSource};
-pub use super::frame_source::{OpenTrajectory, Trajectory, TrajectoryFormat};
-use super::{IncludeSpec, LoadedParticles, ParticleRecord};
+use super::file::ByteSource;
+pub use super::frame_source::Trajectory;
+use super::frame_source::{finish_frame, past_the_end, Frame, FrameInfo, FrameSource};
+use super::{Format, IncludeSpec, LoadedParticles, ParticleRecord, FORMATS};
 use crate::error::{PgtError, Result};
 use glam::DVec3;
 use std::path::Path;
 
-/// Every trajectory format pgt reads.
-pub static TRAJECTORY_FORMATS: &[&TrajectoryFormat] = &[&super::dcd::FORMAT, &super::xtc::FORMAT];
-
-/// The trajectory format of a file name's extension (case-insensitive).
-pub fn trajectory_format_of(path: &Path) -> Option<&'static TrajectoryFormat> {
-    let ext = path.extension()?.to_str()?.to_ascii_lowercase();
-    TRAJECTORY_FORMATS
-        .iter()
-        .copied()
-        .find(|f| f.extensions.contains(&ext.as_str()))
-}
-
 /// Opens a trajectory file by its extension; another extension is an error listing the known.
 pub fn open_trajectory_file(path: &Path) -> Result<Box<dyn Trajectory>> {
-    let Some(format) = trajectory_format_of(path) else {
-        let known: Vec<String> = TRAJECTORY_FORMATS
+    let Some(open) = Format::trajectory_of(path).and_then(|f| f.trajectory) else {
+        let known: Vec<String> = FORMATS
             .iter()
+            .filter(|f| f.trajectory.is_some())
             .flat_map(|f| f.extensions.iter().map(|e| format!(".{e}")))
             .collect();
         return Err(PgtError::in_file(
@@ -47,31 +37,17 @@ pub fn open_trajectory_file(path: &Path) -> Result<Box<dyn Trajectory>> {
             ),
         ));
     };
-    (format.open)(ByteSource::open(path)?)
+    open(ByteSource::open(path)?)
 }
 
-/// The atoms of a topology file's first model, by its extension: PDB, mmCIF, GRO or PSF.
+/// The atoms of a topology file's first model, read as its extension says (PDB, mmCIF, GRO or
+/// PSF).
 pub fn topology_atoms(path: &Path) -> Result<(Vec<Atom>, Vec<String>)> {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or_default()
-        .to_ascii_lowercase();
     let bytes = super::read_input(path)?;
-    let (atoms, warnings) = match ext.as_str() {
-        "pdb" | "ent" => super::pdb::read_atoms(path, &bytes)?,
-        "cif" | "mmcif" => super::mmcif::read_atoms(path, &bytes)?,
-        "gro" => super::gro::read_atoms(path, &bytes)?,
-        "psf" => super::psf::read_atoms(path, &bytes)?,
-        _ => {
-            return Err(PgtError::in_file(
-                path,
-                format!(
-                    "unsupported topology file type '.{ext}': a trajectory's `path` is its topology, a .pdb, .cif, .gro or .psf file"
-                ),
-            ))
-        }
+    let Some(read_atoms) = Format::topology_of(path).and_then(|f| f.topology) else {
+        return Err(not_a_topology(path));
     };
+    let (atoms, warnings) = read_atoms(path, &bytes)?;
     let first = atoms.first().map(|a| a.model);
     let atoms: Vec<Atom> = atoms
         .into_iter()
@@ -81,6 +57,31 @@ pub fn topology_atoms(path: &Path) -> Result<(Vec<Atom>, Vec<String>)> {
         return Err(PgtError::in_file(path, "the topology holds no atoms"));
     }
     Ok((atoms, warnings))
+}
+
+/// The error for a topology of another extension, naming each topology format by its first
+/// extension (`a .pdb, .cif, .gro or .psf file`).
+fn not_a_topology(path: &Path) -> PgtError {
+    let ext = path
+        .extension()
+        .and_then(|e| e.to_str())
+        .unwrap_or_default()
+        .to_ascii_lowercase();
+    let first: Vec<String> = FORMATS
+        .iter()
+        .filter(|f| f.topology.is_some())
+        .filter_map(|f| f.extensions.first().map(|e| format!(".{e}")))
+        .collect();
+    let known = match first.split_last() {
+        Some((last, rest)) if !rest.is_empty() => format!("{} or {last}", rest.join(", ")),
+        _ => first.concat(),
+    };
+    PgtError::in_file(
+        path,
+        format!(
+            "unsupported topology file type '.{ext}': a trajectory's `path` is its topology, a {known} file"
+        ),
+    )
 }
 
 /// A trajectory with its topology as a [`FrameSource`]: the topology's records (radius, colour)

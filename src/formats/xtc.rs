@@ -34,19 +34,22 @@
 //! a last frame cut short counts, and reading it is the error. The time step is the time of frame
 //! 1 minus that of frame 0.
 
-use super::frame_source::ByteSource;
-use super::frame_source::{Trajectory, TrajectoryFormat};
+use super::file::binary::Number;
+use super::file::{ByteSource, Endian, Reader};
+use super::frame_source::Trajectory;
 use super::gro::ANGSTROM_PER_NM;
+use super::Format;
 use crate::error::{PgtError, Result};
 use glam::DVec3;
 use std::path::Path;
 
-/// XTC in the table of trajectory formats ([`super::topology::TRAJECTORY_FORMATS`]).
-pub const FORMAT: TrajectoryFormat = TrajectoryFormat {
+/// XTC in the table of formats ([`super::FORMATS`]): a trajectory.
+pub const FORMAT: Format = Format {
     name: "xtc",
     extensions: &["xtc"],
     description: "GROMACS XTC (compressed, nm, converted to Å)",
-    open,
+    trajectory: Some(open),
+    ..Format::NOTHING
 };
 
 /// The magic number of classic XTC frames.
@@ -73,24 +76,12 @@ const MAGICINTS: [u32; 73] = [
 /// The smallest valid small-integer index (`MAGICINTS[FIRSTIDX − 1]` is 0).
 const FIRSTIDX: usize = 9;
 
-fn be_i32(b: &[u8], at: usize) -> i32 {
-    let mut a = [0u8; 4];
-    if let Some(s) = b.get(at..at + 4) {
-        a.copy_from_slice(s);
-    }
-    i32::from_be_bytes(a)
-}
-
-fn be_f32(b: &[u8], at: usize) -> f32 {
-    f32::from_bits(be_i32(b, at) as u32)
-}
-
-fn be_u64(b: &[u8], at: usize) -> u64 {
-    let mut a = [0u8; 8];
-    if let Some(s) = b.get(at..at + 8) {
-        a.copy_from_slice(s);
-    }
-    u64::from_be_bytes(a)
+/// The XDR (big-endian) number at byte `at` of a frame's bytes; bytes that end before it are a
+/// corrupt frame.
+fn xdr<T: Number>(bytes: &[u8], at: usize) -> std::result::Result<T, Corrupt> {
+    Endian::Big
+        .read(bytes, at)
+        .ok_or_else(|| (at as u64, "the frame ends inside its header".to_string()))
 }
 
 /// Where one frame is.
@@ -111,7 +102,7 @@ struct Xtc {
     warnings: Vec<String>,
 }
 
-/// The [`super::frame_source::OpenTrajectory`] of XTC: one scan of the frame headers.
+/// The [`super::OpenTrajectory`] of XTC: one scan of the frame headers.
 pub fn open(source: ByteSource) -> Result<Box<dyn Trajectory>> {
     let path = source.path().to_path_buf();
     let len = source.len();
@@ -133,7 +124,9 @@ pub fn open(source: ByteSource) -> Result<Box<dyn Trajectory>> {
             });
             break;
         }
-        let magic = be_i32(&head, 0);
+        // A frame's header as XDR numbers, errors naming their file offset.
+        let header = Reader::window(&path, &head, at, len, "frame header", Endian::Big);
+        let magic = header.number_at::<i32>(0, "the magic number")?;
         if magic != MAGIC_1995 && magic != MAGIC_2023 {
             return Err(PgtError::at_byte(
                 &path,
@@ -141,8 +134,8 @@ pub fn open(source: ByteSource) -> Result<Box<dyn Trajectory>> {
                 format!("frame {k}: expected the XTC magic number 1995 or 2023, found {magic} (not an XTC file, or a corrupt frame)"),
             ));
         }
-        let n = be_i32(&head, 4);
-        let n2 = be_i32(&head, 52);
+        let n = header.number_at::<i32>(4, "the atom count")?;
+        let n2 = header.number_at::<i32>(52, "the atom count")?;
         if n < 1 || n != n2 {
             return Err(PgtError::at_byte(
                 &path,
@@ -169,9 +162,9 @@ pub fn open(source: ByteSource) -> Result<Box<dyn Trajectory>> {
                 HEADER_BYTES + PRELUDE_BYTES + count_bytes
             } else {
                 let block = if magic == MAGIC_2023 {
-                    be_u64(&head, count_at)
+                    header.number_at::<u64>(count_at, "the block's byte count")?
                 } else {
-                    u64::from(be_i32(&head, count_at) as u32)
+                    u64::from(header.number_at::<u32>(count_at, "the block's byte count")?)
                 };
                 let padded = block.checked_add(3).map(|b| b / 4 * 4).unwrap_or(u64::MAX);
                 (HEADER_BYTES + PRELUDE_BYTES + count_bytes).saturating_add(padded)
@@ -180,7 +173,7 @@ pub fn open(source: ByteSource) -> Result<Box<dyn Trajectory>> {
         frames.push(FrameAt {
             offset: at,
             size,
-            time: be_f32(&head, 12),
+            time: header.number_at::<f32>(12, "the time")?,
             magic,
         });
         match at.checked_add(size).filter(|&e| e <= len) {
@@ -276,7 +269,10 @@ fn decode_frame(
     let to_angstrom = |v: f32| f64::from(v) * ANGSTROM_PER_NM;
     if atoms <= MAX_UNCOMPRESSED {
         for k in 0..atoms {
-            let p: [f32; 3] = std::array::from_fn(|c| be_f32(bytes, at + 12 * k + 4 * c));
+            let mut p = [0f32; 3];
+            for (c, v) in p.iter_mut().enumerate() {
+                *v = xdr(bytes, at + 12 * k + 4 * c)?;
+            }
             if !p.iter().all(|v| v.is_finite()) {
                 return Err((
                     (at + 12 * k) as u64,
@@ -291,21 +287,24 @@ fn decode_frame(
         }
         return Ok(());
     }
-    let precision = be_f32(bytes, at);
+    let precision: f32 = xdr(bytes, at)?;
     if !(precision.is_finite() && precision > 0.0) {
         return Err((
             at as u64,
             format!("the precision {precision} is not a finite number > 0"),
         ));
     }
-    let minint: [i32; 3] = std::array::from_fn(|c| be_i32(bytes, at + 4 + 4 * c));
-    let maxint: [i32; 3] = std::array::from_fn(|c| be_i32(bytes, at + 16 + 4 * c));
-    let smallidx = be_i32(bytes, at + 28);
+    let (mut minint, mut maxint) = ([0i32; 3], [0i32; 3]);
+    for c in 0..3 {
+        minint[c] = xdr(bytes, at + 4 + 4 * c)?;
+        maxint[c] = xdr(bytes, at + 16 + 4 * c)?;
+    }
+    let smallidx: i32 = xdr(bytes, at + 28)?;
     let count_at = at + PRELUDE_BYTES as usize;
     let (count, block_at) = if magic == MAGIC_2023 {
-        (be_u64(bytes, count_at), count_at + 8)
+        (xdr::<u64>(bytes, count_at)?, count_at + 8)
     } else {
-        (u64::from(be_i32(bytes, count_at) as u32), count_at + 4)
+        (u64::from(xdr::<u32>(bytes, count_at)?), count_at + 4)
     };
     // The stream ends at the block's byte count: the padding to 4 bytes is no part of it.
     let block_end = usize::try_from(count)

@@ -27,9 +27,9 @@
 //! disagree is refused, naming its line (one of the two was edited without the other).
 
 use super::elements::{element_color, element_radius, Element};
-use super::frame_source::{
-    finish_frame, scan_lines, ByteSource, Frame, FrameInfo, FrameSource, TextFrames,
-};
+use super::file::text::finite_number;
+use super::file::{scan_lines, text_lines, ByteSource};
+use super::frame_source::{finish_frame, Frame, FrameInfo, FrameSource, TextFrames};
 use super::{EllipsoidRecord, Format, IncludeSpec, LoadedParticles, ParticleRecord};
 use crate::error::{Location, PgtError, Result};
 use glam::DVec3;
@@ -41,9 +41,9 @@ pub const XYZ: Format = Format {
     extensions: &["xyz"],
     description: "XYZ (lines of element x y z)",
     particles: "atoms in the frame",
-    read: read_xyz,
-    details: None,
+    read: Some(read_xyz),
     frames: Some(open_xyz_frames),
+    ..Format::NOTHING
 };
 
 /// CSV in the table of formats ([`super::FORMATS`]).
@@ -52,37 +52,13 @@ pub const CSV: Format = Format {
     extensions: &["csv"],
     description: "CSV with a header row",
     particles: "data rows after the header",
-    read: read_csv,
-    details: None,
-    frames: None,
+    read: Some(read_csv),
+    ..Format::NOTHING
 };
 
-fn lines(bytes: &[u8]) -> impl Iterator<Item = (usize, String)> + '_ {
-    lines_from(bytes, 1)
-}
-
-/// The lines of a piece of a file whose first line is line `first` of the file.
-fn lines_from(bytes: &[u8], first: usize) -> impl Iterator<Item = (usize, String)> + '_ {
-    bytes.split(|&b| b == b'\n').enumerate().map(move |(i, l)| {
-        let l = l.strip_suffix(b"\r").unwrap_or(l);
-        (i + first, String::from_utf8_lossy(l).into_owned())
-    })
-}
-
+/// A field that must be a finite number (blanks around it trimmed); the error names the line.
 fn number(path: &Path, line: usize, what: &str, s: &str) -> Result<f64> {
-    match s.trim().parse::<f64>() {
-        Ok(v) if v.is_finite() => Ok(v),
-        Ok(_) => Err(PgtError::at_line(
-            path,
-            line,
-            format!("{what} is not finite: '{}'", s.trim()),
-        )),
-        Err(_) => Err(PgtError::at_line(
-            path,
-            line,
-            format!("expected a number for {what}, found '{}'", s.trim()),
-        )),
-    }
+    finite_number(s.trim(), what).map_err(|m| PgtError::at_line(path, line, m))
 }
 
 /// The [`super::Reader`] of XYZ: frame `spec.frame` (0-based, default 0).
@@ -94,7 +70,7 @@ pub fn read_xyz(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
 fn read_xyz_from(spec: &IncludeSpec, bytes: &[u8], first_line: usize) -> Result<LoadedParticles> {
     let path = spec.path.as_path();
     let frame = spec.frame.unwrap_or(0);
-    let mut it = lines_from(bytes, first_line).peekable();
+    let mut it = text_lines(bytes, first_line).peekable();
     let mut records = Vec::new();
     let mut warnings = Vec::new();
     let mut unknown = 0usize;
@@ -499,7 +475,7 @@ pub fn read_csv(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
     let mut cols: Option<Columns> = None;
     let mut width = 0usize;
     let mut records = Vec::new();
-    for (line, text) in lines(bytes) {
+    for (line, text) in text_lines(bytes, 1) {
         let t = text.trim();
         if t.is_empty() || t.starts_with('#') {
             continue;

@@ -5,7 +5,7 @@
 
 use crate::formats::frames::open_frames;
 use crate::formats::summary::{summarize, Info};
-use crate::formats::topology::{trajectory_format_of, trajectory_summary};
+use crate::formats::topology::trajectory_summary;
 use crate::formats::{format_of, load_bytes, read_input, Format, IncludeSpec};
 use crate::scene::{SceneFrames, SceneLoadOptions};
 
@@ -34,7 +34,7 @@ pub fn info_of(path: &std::path::Path, format: Option<&'static Format>) -> crate
         info.frames = frames.frame_info();
         return Ok(info);
     }
-    if let Some(format) = trajectory_format_of(path) {
+    if let Some(format) = Format::trajectory_of(path) {
         let (frames, first, warnings) = trajectory_summary(path)?;
         let mut info = summarize(
             name,

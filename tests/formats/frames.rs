@@ -665,8 +665,9 @@ fn opening_and_reading_a_frame_reads_that_frame_not_the_trajectory() {
             read: read.clone(),
         };
         let source = pgt::formats::frames::ByteSource::from_reader(&path, len, Box::new(reader));
-        let format = pgt::formats::topology::trajectory_format_of(&path).expect("a trajectory");
-        let t = (format.open)(source).expect("opens");
+        let format = pgt::formats::Format::trajectory_of(&path).expect("a trajectory");
+        let open = format.trajectory.expect("a trajectory reader");
+        let t = open(source).expect("opens");
         let at_open = read.load(Ordering::Relaxed);
         let frames = t.frames() as u64;
         // Opening reads headers: at most 100 bytes a frame (XTC's scan) or the DCD header.

@@ -15,9 +15,8 @@ pub const FORMAT: Format = Format {
     extensions: &["wrl", "vrml"],
     description: "VRML97",
     particles: "Sphere shapes",
-    read,
-    details: None,
-    frames: None,
+    read: Some(read),
+    ..Format::NOTHING
 };
 
 /// The [`super::Reader`] of VRML97: the spheres of the file. The file must start with
