@@ -20,7 +20,7 @@ use crate::optics::Profile;
 use std::path::Path;
 
 /// The standard deviations by which a bare file of Gaussians is framed: a splatting
-/// rasteriser's footprint is 3σ (docs/design.md §12).
+/// rasteriser's footprint is 3σ (docs/design.md §1, "A splatting file is Gaussians").
 const FRAMING_SIGMAS: f64 = 3.0;
 
 /// Whether `path`, read as `options.format` or by its extension, is a PLY of 3D Gaussian
