@@ -162,7 +162,7 @@ gpu_struct! {
 }
 
 gpu_struct! {
-    /// WGSL `struct Frame` (the uniform buffer), 144 bytes: camera, background, render settings
+    /// WGSL `struct Frame` (the uniform buffer), 160 bytes: camera, background, render settings
     /// and the method's parameters.
     plain "Frame" pub struct GpuFrame {
         /// Camera frame f, r, u of docs/design.md §1 (the camera is at the origin).
@@ -201,10 +201,18 @@ gpu_struct! {
         /// `dispatch::bands`); the camera ray still uses the whole image's size.
         pub row_begin: u32,
         pub row_count: u32,
-        pub _pad0: u32,
+        /// 1 when the camera has intrinsics (docs/design.md §1 "Intrinsics": the camera ray
+        /// uses `fx`, `fy`, `cx`, `cy`), 0 for a fov_y camera (`tan_half_fov`).
+        pub pinhole: u32,
         /// The method's parameters, slot k at `params[k / 4][k % 4]` (the prelude's
         /// `method_param(slot)`; slots are named by generated `PARAM_<NAME>` constants).
         pub params: [[u32; 4]; 2],
+        /// Pinhole intrinsics in pixels (with `pinhole` = 1; else the fov_y camera's own,
+        /// [`crate::geometry::Camera::pinhole`]).
+        pub fx: f32,
+        pub fy: f32,
+        pub cx: f32,
+        pub cy: f32,
     }
 }
 
@@ -452,6 +460,7 @@ impl GpuFrame {
     /// method's parameter values by slot (at most [`PARAM_SLOTS`]; the caller validates).
     pub fn new(scene: &Scene, params: &[u32]) -> GpuFrame {
         let cam = &scene.camera;
+        let k = cam.pinhole();
         let mut slots = [[0u32; 4]; 2];
         for (k, v) in params.iter().take(PARAM_SLOTS).enumerate() {
             slots[k / 4][k % 4] = *v;
@@ -478,6 +487,11 @@ impl GpuFrame {
             row_begin: 0,
             row_count: cam.height,
             params: slots,
+            pinhole: cam.intrinsics.is_some() as u32,
+            fx: k.fx as f32,
+            fy: k.fy as f32,
+            cx: k.cx as f32,
+            cy: k.cy as f32,
             ..GpuFrame::default()
         }
     }

@@ -87,6 +87,46 @@ fn covariance(buffers: &SceneBuffers, i: usize) -> Mat3 {
     }
 }
 
+/// Focal lengths, principal point (pixels) and the Jacobian's clamp of x/z and y/z as
+/// (−low, high) limits. A fov_y camera's are 3DGS's (`fov2focal`: focal = pixels/(2·tan(fov/2)),
+/// fx = fy; centre W/2, H/2; limits ±1.3·tan(fov/2)); a camera with intrinsics (docs/design.md §1
+/// "Intrinsics") uses fx, fy, cx, cy and gsplat's asymmetric limits (`proj_ewa`:
+/// cx/fx + 0.3·tan_fovx below, (W − cx)/fx + 0.3·tan_fovx above, tan_fovx = (W/2)/fx), which
+/// are 3DGS's for a centred principal point.
+#[allow(clippy::type_complexity)]
+fn lens(frame: &GpuFrame) -> (f32, f32, [f32; 2], ((f32, f32), (f32, f32))) {
+    let (w, h) = (frame.width as f32, frame.height as f32);
+    if frame.pinhole == 0 {
+        let tan_fovy = frame.tan_half_fov;
+        let tan_fovx = tan_fovy * w / h;
+        let (lim_x, lim_y) = (JACOBIAN_CLAMP * tan_fovx, JACOBIAN_CLAMP * tan_fovy);
+        return (
+            w / (2.0 * tan_fovx),
+            h / (2.0 * tan_fovy),
+            [0.5 * w, 0.5 * h],
+            ((lim_x, lim_x), (lim_y, lim_y)),
+        );
+    }
+    let (fx, fy, cx, cy) = (frame.fx, frame.fy, frame.cx, frame.cy);
+    let margin = JACOBIAN_CLAMP - 1.0;
+    let (tan_fovx, tan_fovy) = (0.5 * w / fx, 0.5 * h / fy);
+    (
+        fx,
+        fy,
+        [cx, cy],
+        (
+            (
+                cx / fx + margin * tan_fovx,
+                (w - cx) / fx + margin * tan_fovx,
+            ),
+            (
+                cy / fy + margin * tan_fovy,
+                (h - cy) / fy + margin * tan_fovy,
+            ),
+        ),
+    )
+}
+
 /// Projects particle `i` as 3DGS's `preprocessCUDA` does; `None` where 3DGS drops it (near
 /// culling, a singular covariance, a footprint that touches no tile).
 pub fn project(buffers: &SceneBuffers, frame: &GpuFrame, i: usize) -> Option<Projected> {
@@ -102,17 +142,10 @@ pub fn project(buffers: &SceneBuffers, frame: &GpuFrame, i: usize) -> Option<Pro
     if t.z <= NEAR_CULL {
         return None;
     }
-    let (w, h) = (frame.width as f32, frame.height as f32);
-    let tan_fovy = frame.tan_half_fov;
-    let tan_fovx = tan_fovy * w / h;
-    // 3DGS `fov2focal`: focal = pixels / (2·tan(fov/2)); fx = fy for square pixels.
-    let focal_x = w / (2.0 * tan_fovx);
-    let focal_y = h / (2.0 * tan_fovy);
+    let (focal_x, focal_y, principal, (lim_x, lim_y)) = lens(frame);
     // The Jacobian of the perspective projection at the (clamped) centre.
-    let lim_x = JACOBIAN_CLAMP * tan_fovx;
-    let lim_y = JACOBIAN_CLAMP * tan_fovy;
-    let tx = (t.x / t.z).clamp(-lim_x, lim_x) * t.z;
-    let ty = (t.y / t.z).clamp(-lim_y, lim_y) * t.z;
+    let tx = (t.x / t.z).clamp(-lim_x.0, lim_x.1) * t.z;
+    let ty = (t.y / t.z).clamp(-lim_y.0, lim_y.1) * t.z;
     let j0 = Vec3::new(focal_x / t.z, 0.0, -(focal_x * tx) / (t.z * t.z));
     let j1 = Vec3::new(0.0, focal_y / t.z, -(focal_y * ty) / (t.z * t.z));
     // Rows of T = J·W in scene axes (Wᵀ·j: W's rows are r, −u, f); Σ₂D = T·Σ·Tᵀ.
@@ -133,7 +166,10 @@ pub fn project(buffers: &SceneBuffers, frame: &GpuFrame, i: usize) -> Option<Pro
     let root = (mid * mid - det).max(EIGEN_FLOOR).sqrt();
     let radius = (FOOTPRINT_SIGMAS * (mid + root).max(mid - root).sqrt()).ceil();
     // The mean, pixel centres at +0.5 (docs/design.md §1).
-    let mean = [focal_x * t.x / t.z + 0.5 * w, focal_y * t.y / t.z + 0.5 * h];
+    let mean = [
+        focal_x * t.x / t.z + principal[0],
+        focal_y * t.y / t.z + principal[1],
+    ];
     // 3DGS `getRect` on its pixel coordinates (centres at integers: x − 0.5), truncating.
     let (cols, rows) = tile_grid(frame.width, frame.height);
     let side = TILE_SIDE as f32;

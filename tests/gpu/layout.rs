@@ -133,7 +133,12 @@ fn rust_and_wgsl_struct_layouts_agree() {
             ("pair_end", offset_of!(GpuFrame, pair_end)),
             ("row_begin", offset_of!(GpuFrame, row_begin)),
             ("row_count", offset_of!(GpuFrame, row_count)),
+            ("pinhole", offset_of!(GpuFrame, pinhole)),
             ("params", offset_of!(GpuFrame, params)),
+            ("fx", offset_of!(GpuFrame, fx)),
+            ("fy", offset_of!(GpuFrame, fy)),
+            ("cx", offset_of!(GpuFrame, cx)),
+            ("cy", offset_of!(GpuFrame, cy)),
         ],
     );
     check(
