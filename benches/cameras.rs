@@ -16,7 +16,11 @@ fn colmap(dir: &Path) {
     let bin = dir.join("bin");
     std::fs::create_dir_all(&text).unwrap();
     std::fs::create_dir_all(&bin).unwrap();
-    std::fs::write(text.join("cameras.txt"), "1 PINHOLE 1920 1080 1500 1490 960.5 540.25\n").unwrap();
+    std::fs::write(
+        text.join("cameras.txt"),
+        "1 PINHOLE 1920 1080 1500 1490 960.5 540.25\n",
+    )
+    .unwrap();
     let mut c = 1u64.to_le_bytes().to_vec();
     c.extend(1u32.to_le_bytes());
     c.extend(1u32.to_le_bytes());
@@ -32,7 +36,18 @@ fn colmap(dir: &Path) {
         let a = i as f64 * 0.01;
         let q = [(a / 2.0).cos(), 0.0, (a / 2.0).sin(), 0.0];
         let tv = [0.1 * i as f64, -0.5, 4.0];
-        let _ = writeln!(t, "{} {} {} {} {} {} {} {} 1 img_{i:05}.jpg", i + 1, q[0], q[1], q[2], q[3], tv[0], tv[1], tv[2]);
+        let _ = writeln!(
+            t,
+            "{} {} {} {} {} {} {} {} 1 img_{i:05}.jpg",
+            i + 1,
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+            tv[0],
+            tv[1],
+            tv[2]
+        );
         for p in 0..POINTS {
             let _ = write!(t, "{}.5 {}.25 -1 ", p, p % 1080);
         }
@@ -54,9 +69,9 @@ fn transforms(dir: &Path) {
     let mut t = String::from("{\"fl_x\": 1500, \"fl_y\": 1490, \"cx\": 960.5, \"cy\": 540.25, \"w\": 1920, \"h\": 1080, \"frames\": [\n");
     for i in 0..IMAGES {
         let (s, c) = (i as f64 * 0.01).sin_cos();
-        let _ = write!(
+        let _ = writeln!(
             t,
-            "{}{{\"file_path\": \"images/frame_{i:05}.png\", \"transform_matrix\": [[{c}, 0.0, {s}, {}], [0.0, 1.0, 0.0, 0.5], [{}, 0.0, {c}, 4.0], [0.0, 0.0, 0.0, 1.0]]}}\n",
+            "{}{{\"file_path\": \"images/frame_{i:05}.png\", \"transform_matrix\": [[{c}, 0.0, {s}, {}], [0.0, 1.0, 0.0, 0.5], [{}, 0.0, {c}, 4.0], [0.0, 0.0, 0.0, 1.0]]}}",
             if i == 0 { "" } else { "," },
             0.1 * i as f64,
             -s
@@ -68,7 +83,10 @@ fn transforms(dir: &Path) {
 
 fn time(what: &str, path: &Path) {
     let bytes: u64 = if path.is_dir() {
-        std::fs::read_dir(path).unwrap().map(|e| e.unwrap().metadata().unwrap().len()).sum()
+        std::fs::read_dir(path)
+            .unwrap()
+            .map(|e| e.unwrap().metadata().unwrap().len())
+            .sum()
     } else {
         std::fs::metadata(path).unwrap().len()
     };
@@ -76,7 +94,11 @@ fn time(what: &str, path: &Path) {
     let cams = cameras::read(path).unwrap();
     let s = start.elapsed().as_secs_f64();
     assert_eq!(cams.len(), IMAGES);
-    println!("{what:<28} {IMAGES} images  {:>8.1} MB  {:>8.1} ms", bytes as f64 / 1e6, s * 1e3);
+    println!(
+        "{what:<28} {IMAGES} images  {:>8.1} MB  {:>8.1} ms",
+        bytes as f64 / 1e6,
+        s * 1e3
+    );
 }
 
 fn main() {

@@ -492,7 +492,6 @@ impl GpuFrame {
             fy: k.fy as f32,
             cx: k.cx as f32,
             cy: k.cy as f32,
-            ..GpuFrame::default()
         }
     }
 }

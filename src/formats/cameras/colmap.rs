@@ -305,7 +305,7 @@ pub fn parse_binary(
             .to_string();
         b.at += end + 1;
         let points = b.u64(&format!("image {name:?}'s point count"))?;
-        let bytes = points.checked_mul(POINT2D_BYTES).unwrap_or(u64::MAX);
+        let bytes = points.saturating_mul(POINT2D_BYTES);
         b.take(bytes, &format!("image {name:?}'s {points} 2D points"))?;
         list.push(ModelImage {
             name,
