@@ -5,11 +5,15 @@
 
 use super::super::file::CameraTable;
 use super::super::SceneLoadOptions;
-use super::camera::check_size;
 use crate::error::{At, PgtError, Result, SourceText};
 use crate::formats::cameras;
 use crate::geometry::{Camera, CameraPath};
 use std::path::Path;
+
+/// An image size, checked against the limits (`scene::check_image_size`).
+fn check_size(at: &At, w: i64, h: i64) -> Result<(u32, u32)> {
+    super::super::check_image_size(w, h).map_err(|e| at.err(e))
+}
 
 /// The camera path of a `[camera]` table with `from`.
 pub(super) fn path(
