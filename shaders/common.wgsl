@@ -52,8 +52,14 @@ fn ray_at(ray: Ray, t: f32) -> vec3<f32> {
 }
 
 // docs/design.md §1: pixel (px, py), py down, through its centre:
-// a = (2(px+0.5)/W − 1)·(W/H)·tan(fov_y/2), b = (1 − 2(py+0.5)/H)·tan(fov_y/2).
+// a = (2(px+0.5)/W − 1)·(W/H)·tan(fov_y/2), b = (1 − 2(py+0.5)/H)·tan(fov_y/2); with intrinsics
+// ("Intrinsics") a = (px + 0.5 − cx)/fx, b = (cy − (py + 0.5))/fy.
 fn camera_ray(pixel: vec2<u32>) -> Ray {
+    if (frame.pinhole != 0u) {
+        let a = (f32(pixel.x) + 0.5 - frame.cx) / frame.fx;
+        let b = (frame.cy - (f32(pixel.y) + 0.5)) / frame.fy;
+        return Ray(vec3<f32>(0.0), normalize(frame.forward + a * frame.right + b * frame.up));
+    }
     let w = f32(frame.width);
     let h = f32(frame.height);
     let a = (2.0 * (f32(pixel.x) + 0.5) / w - 1.0) * (w / h) * frame.tan_half_fov;

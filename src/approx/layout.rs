@@ -162,7 +162,7 @@ gpu_struct! {
 }
 
 gpu_struct! {
-    /// WGSL `struct Frame` (the uniform buffer), 160 bytes: camera, background, render settings
+    /// WGSL `struct Frame` (the uniform buffer), 176 bytes: camera, background, render settings
     /// and the method's parameters.
     plain "Frame" pub struct GpuFrame {
         /// Camera frame f, r, u of docs/design.md §1 (the camera is at the origin).
@@ -201,7 +201,9 @@ gpu_struct! {
         /// `dispatch::bands`); the camera ray still uses the whole image's size.
         pub row_begin: u32,
         pub row_count: u32,
-        pub _pad0: u32,
+        /// 1 when the camera has intrinsics (docs/design.md §1 "Intrinsics": the camera ray
+        /// uses `fx`, `fy`, `cx`, `cy`), 0 for a fov_y camera (`tan_half_fov`).
+        pub pinhole: u32,
         /// The splatting methods' per-pixel constants (docs/design.md §4 `splat`, set from the
         /// method's parameters by `splat_tiles::SplatConstants::apply_to`; 3DGS's otherwise):
         /// the α cap, the α below which a splat is skipped, the transmittance below which a
@@ -213,6 +215,12 @@ gpu_struct! {
         /// The method's parameters, slot k at `params[k / 4][k % 4]` (the prelude's
         /// `method_param(slot)`; slots are named by generated `PARAM_<NAME>` constants).
         pub params: [[u32; 4]; 2],
+        /// Pinhole intrinsics in pixels (with `pinhole` = 1; else the fov_y camera's own,
+        /// [`crate::geometry::Camera::pinhole`]).
+        pub fx: f32,
+        pub fy: f32,
+        pub cx: f32,
+        pub cy: f32,
     }
 }
 
@@ -460,6 +468,7 @@ impl GpuFrame {
     /// method's parameter values by slot (at most [`PARAM_SLOTS`]; the caller validates).
     pub fn new(scene: &Scene, params: &[u32]) -> GpuFrame {
         let cam = &scene.camera;
+        let k = cam.pinhole();
         let mut slots = [[0u32; 4]; 2];
         for (k, v) in params.iter().take(PARAM_SLOTS).enumerate() {
             slots[k / 4][k % 4] = *v;
@@ -486,11 +495,15 @@ impl GpuFrame {
             row_begin: 0,
             row_count: cam.height,
             params: slots,
+            pinhole: cam.intrinsics.is_some() as u32,
+            fx: k.fx as f32,
+            fy: k.fy as f32,
+            cx: k.cx as f32,
+            cy: k.cy as f32,
             splat_alpha_cap: super::contract::SPLAT_ALPHA_MAX,
             splat_alpha_skip: super::contract::SPLAT_ALPHA_MIN,
             splat_stop_below: super::contract::SPLAT_T_MIN,
             splat_stop_inclusive: 0,
-            ..GpuFrame::default()
         }
     }
 }

@@ -164,6 +164,47 @@ fn covariance(buffers: &SceneBuffers, i: usize) -> Mat3 {
     }
 }
 
+/// Focal lengths, principal point (pixels) and the Jacobian's clamp of x/z and y/z as
+/// (−low, high) limits, for the clamp factor `clamp` (1.3 in both presets). A fov_y camera's
+/// are 3DGS's (`fov2focal`: focal = pixels/(2·tan(fov/2)), fx = fy; centre W/2, H/2; limits
+/// ±clamp·tan(fov/2)); a camera with intrinsics (docs/design.md §1 "Intrinsics") uses fx, fy,
+/// cx, cy and gsplat's asymmetric limits (`proj_ewa`: cx/fx + (clamp − 1)·tan_fovx below,
+/// (W − cx)/fx + (clamp − 1)·tan_fovx above, tan_fovx = (W/2)/fx), which are 3DGS's for a
+/// centred principal point.
+#[allow(clippy::type_complexity)]
+fn lens(frame: &GpuFrame, clamp: f32) -> (f32, f32, [f32; 2], ((f32, f32), (f32, f32))) {
+    let (w, h) = (frame.width as f32, frame.height as f32);
+    if frame.pinhole == 0 {
+        let tan_fovy = frame.tan_half_fov;
+        let tan_fovx = tan_fovy * w / h;
+        let (lim_x, lim_y) = (clamp * tan_fovx, clamp * tan_fovy);
+        return (
+            w / (2.0 * tan_fovx),
+            h / (2.0 * tan_fovy),
+            [0.5 * w, 0.5 * h],
+            ((lim_x, lim_x), (lim_y, lim_y)),
+        );
+    }
+    let (fx, fy, cx, cy) = (frame.fx, frame.fy, frame.cx, frame.cy);
+    let margin = clamp - 1.0;
+    let (tan_fovx, tan_fovy) = (0.5 * w / fx, 0.5 * h / fy);
+    (
+        fx,
+        fy,
+        [cx, cy],
+        (
+            (
+                cx / fx + margin * tan_fovx,
+                (w - cx) / fx + margin * tan_fovx,
+            ),
+            (
+                cy / fy + margin * tan_fovy,
+                (h - cy) / fy + margin * tan_fovy,
+            ),
+        ),
+    )
+}
+
 /// Projects particle `i` as 3DGS's `preprocessCUDA` (or gsplat's projection) does with the
 /// constants `k`; `None` where the rasteriser drops it (near culling, a singular covariance,
 /// a footprint that touches no tile).
@@ -185,17 +226,10 @@ pub fn project(
     if t.z <= k.near {
         return None;
     }
-    let (w, h) = (frame.width as f32, frame.height as f32);
-    let tan_fovy = frame.tan_half_fov;
-    let tan_fovx = tan_fovy * w / h;
-    // 3DGS `fov2focal`: focal = pixels / (2·tan(fov/2)); fx = fy for square pixels.
-    let focal_x = w / (2.0 * tan_fovx);
-    let focal_y = h / (2.0 * tan_fovy);
+    let (focal_x, focal_y, principal, (lim_x, lim_y)) = lens(frame, k.jacobian_clamp);
     // The Jacobian of the perspective projection at the (clamped) centre.
-    let lim_x = k.jacobian_clamp * tan_fovx;
-    let lim_y = k.jacobian_clamp * tan_fovy;
-    let tx = (t.x / t.z).clamp(-lim_x, lim_x) * t.z;
-    let ty = (t.y / t.z).clamp(-lim_y, lim_y) * t.z;
+    let tx = (t.x / t.z).clamp(-lim_x.0, lim_x.1) * t.z;
+    let ty = (t.y / t.z).clamp(-lim_y.0, lim_y.1) * t.z;
     let j0 = Vec3::new(focal_x / t.z, 0.0, -(focal_x * tx) / (t.z * t.z));
     let j1 = Vec3::new(0.0, focal_y / t.z, -(focal_y * ty) / (t.z * t.z));
     // Rows of T = J·W in scene axes (Wᵀ·j: W's rows are r, −u, f); Σ₂D = T·Σ·Tᵀ.
@@ -214,7 +248,10 @@ pub fn project(
     let det_inv = 1.0 / det;
     let conic = [cc * det_inv, -b * det_inv, a * det_inv];
     // The mean, pixel centres at +0.5 (docs/design.md §1).
-    let mean = [focal_x * t.x / t.z + 0.5 * w, focal_y * t.y / t.z + 0.5 * h];
+    let mean = [
+        focal_x * t.x / t.z + principal[0],
+        focal_y * t.y / t.z + principal[1],
+    ];
     let (radius, tiles_x, tiles_y) = footprint_tiles(k.footprint, mean, [a, b, cc], det, frame);
     if (tiles_x.1 - tiles_x.0) * (tiles_y.1 - tiles_y.0) == 0 {
         return None;

@@ -24,6 +24,7 @@
 //! refusal of a file that yields no particles (docs/design.md §1), and the check of every record.
 
 pub mod atoms;
+pub mod cameras;
 pub mod dcd;
 pub mod elements;
 pub mod export;

@@ -31,7 +31,7 @@
 //! The interpolated u is normalised by the camera (r = normalize(f × u)); a frame where l = p or
 //! u is parallel to the viewing direction is an error naming the frame.
 
-use super::Camera;
+use super::{Camera, Intrinsics};
 use glam::DVec3;
 
 /// How keyframe values are interpolated between keyframes (fov_y is always linear).
@@ -72,6 +72,8 @@ pub enum CameraPath {
         degrees_per_frame: f64,
         width: u32,
         height: u32,
+        /// The frame-0 camera's intrinsics, kept in every frame (`None`: fov_y).
+        intrinsics: Option<Intrinsics>,
     },
     /// Interpolated keyframes (at least two, frames strictly increasing).
     Keyframes {
@@ -80,6 +82,9 @@ pub enum CameraPath {
         width: u32,
         height: u32,
     },
+    /// One camera per frame, as a dataset lists them (docs/design.md §1 "Cameras of datasets");
+    /// the scene has as many frames as cameras.
+    Sequence(Vec<Camera>),
 }
 
 /// Rodrigues' rotation of `v` by `angle` radians about the unit `axis`.
@@ -115,21 +120,34 @@ fn tangent(values: &[DVec3], frames: &[f64], k: usize) -> DVec3 {
 impl CameraPath {
     /// The camera of scene frame `frame`, or a message when it is degenerate there.
     pub fn camera_at(&self, frame: usize) -> Result<Camera, String> {
+        let mut intrinsics = None;
         let (p, l, u, fov, w, h) = match self {
             CameraPath::Fixed(camera) => return Ok(*camera),
+            CameraPath::Sequence(cameras) => {
+                return cameras.get(frame).copied().ok_or_else(|| {
+                    format!(
+                    "frame {frame} requested, but the camera sequence has {} camera(s) (0-based)",
+                    cameras.len()
+                )
+                })
+            }
             CameraPath::Orbit {
                 start,
                 width,
                 height,
+                intrinsics: k,
                 ..
-            } if frame == 0 => (
-                start.position,
-                start.look_at,
-                start.up,
-                start.fov_y,
-                *width,
-                *height,
-            ),
+            } if frame == 0 => {
+                intrinsics = *k;
+                (
+                    start.position,
+                    start.look_at,
+                    start.up,
+                    start.fov_y,
+                    *width,
+                    *height,
+                )
+            }
             CameraPath::Orbit {
                 start,
                 center,
@@ -137,7 +155,9 @@ impl CameraPath {
                 degrees_per_frame,
                 width,
                 height,
+                intrinsics: k,
             } => {
+                intrinsics = *k;
                 let angle = (frame as f64 * degrees_per_frame).to_radians();
                 (
                     *center + rotate(start.position - *center, *axis, angle),
@@ -177,7 +197,20 @@ impl CameraPath {
                 "fov_y is {fov}° at frame {frame}, outside (0, 180)"
             ));
         }
-        Ok(Camera::new(p, l, u, fov, w, h))
+        let camera = Camera::new(p, l, u, fov, w, h);
+        Ok(match intrinsics {
+            Some(k) => camera.with_intrinsics(k),
+            None => camera,
+        })
+    }
+
+    /// The number of frames the path itself has: a sequence's camera count; `None` for the
+    /// others, which give a camera for every frame.
+    pub fn frame_count(&self) -> Option<usize> {
+        match self {
+            CameraPath::Sequence(cameras) => Some(cameras.len()),
+            _ => None,
+        }
     }
 }
 
@@ -277,6 +310,7 @@ mod tests {
             degrees_per_frame: 90.0,
             width: 8,
             height: 8,
+            intrinsics: None,
         };
         let c1 = path.camera_at(1).expect("ok");
         // −z side turned by +90° about +y goes to the −x side.

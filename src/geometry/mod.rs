@@ -10,7 +10,7 @@ pub mod ray;
 pub mod sphere;
 
 pub use bvh::{Bvh, BvhNode, Hit, Leaf};
-pub use camera::Camera;
+pub use camera::{check_rotation, Camera, Intrinsics, Lens};
 pub use camera_path::{CameraPath, Interpolation, Keyframe};
 pub use ellipsoid::{Ellipsoid, Shape};
 pub use ray::Ray;

@@ -15,7 +15,7 @@
 //! b = (1 − 2y_pix/H)·tan(fov_y/2).
 
 use super::Camera;
-use glam::{DMat4, DVec3, DVec4};
+use glam::{DMat3, DMat4, DQuat, DVec3, DVec4};
 
 /// A graphics API's clip-space conventions.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -144,15 +144,36 @@ pub fn view_matrix(camera: &Camera) -> DMat4 {
     )
 }
 
-/// The perspective projection of `api` for the camera's fov_y and W/H, mapping view depth
-/// −z = near to the API's near depth and −z = far to its far depth. Built from tan(fov_y/2)
-/// itself (not from fov_y through tan ∘ atan) so that pixels land where the reference's rays go
-/// to the last bit: ndc.x = x / (−z · aspect · tan(fov_y/2)), ndc.y = ±y / (−z · tan(fov_y/2)).
+/// The perspective projection of `api` for the camera's lens and W/H, mapping view depth
+/// −z = near to the API's near depth and −z = far to its far depth. A fov_y camera's is built
+/// from tan(fov_y/2) itself (not from fov_y through tan ∘ atan) so that pixels land where the
+/// reference's rays go to the last bit: ndc.x = x / (−z · aspect · tan(fov_y/2)),
+/// ndc.y = ±y / (−z · tan(fov_y/2)). With intrinsics, x_pix = cx + fx·x/(−z) and
+/// y_pix = cy − fy·y/(−z) give ndc.x = 2x_pix/W − 1 = (2fx/W)·x/(−z) + (2cx/W − 1) and
+/// ndc.y = 1 − 2y_pix/H = (2fy/H)·y/(−z) + (1 − 2cy/H): the offsets sit in the z column.
 pub fn projection_matrix(camera: &Camera, api: GraphicsApi, near: f64, far: f64) -> DMat4 {
-    let aspect = camera.width as f64 / camera.height as f64;
-    let sy = 1.0 / camera.tan_half_fov;
-    let sx = sy / aspect;
-    let sy = if api == GraphicsApi::Vulkan { -sy } else { sy };
+    let (sx, sy, ox, oy) = match &camera.intrinsics {
+        None => {
+            let aspect = camera.width as f64 / camera.height as f64;
+            let sy = 1.0 / camera.tan_half_fov;
+            (sy / aspect, sy, 0.0, 0.0)
+        }
+        Some(k) => {
+            let (w, h) = (camera.width as f64, camera.height as f64);
+            (
+                2.0 * k.fx / w,
+                2.0 * k.fy / h,
+                1.0 - 2.0 * k.cx / w,
+                2.0 * k.cy / h - 1.0,
+            )
+        }
+    };
+    // Vulkan's ndc y points down. 0 − oy keeps a centred camera's entry +0, not −0.
+    let (sy, oy) = if api == GraphicsApi::Vulkan {
+        (-sy, 0.0 - oy)
+    } else {
+        (sy, oy)
+    };
     // Depth: ndc z = (A·z + B) / (−z) with z = −near ↦ z_lo and z = −far ↦ z_hi.
     let (a, b) = match api {
         GraphicsApi::OpenGl => ((far + near) / (near - far), 2.0 * far * near / (near - far)),
@@ -161,7 +182,7 @@ pub fn projection_matrix(camera: &Camera, api: GraphicsApi, near: f64, far: f64)
     DMat4::from_cols(
         DVec4::new(sx, 0.0, 0.0, 0.0),
         DVec4::new(0.0, sy, 0.0, 0.0),
-        DVec4::new(0.0, 0.0, a, -1.0),
+        DVec4::new(ox, oy, a, -1.0),
         DVec4::new(0.0, 0.0, b, 0.0),
     )
 }
@@ -263,6 +284,28 @@ pub struct CameraJson {
     pub projection: std::collections::BTreeMap<String, ProjectionJson>,
     /// The scene's background radiance L_bg (linear RGB): what an engine clears to.
     pub background: [f64; 3],
+    /// Focal lengths and principal point, pixels (docs/design.md §1 "Intrinsics"); a fov_y
+    /// camera's are fx = fy = (H/2)/tan(fov_y/2), cx = W/2, cy = H/2.
+    pub fx: f64,
+    pub fy: f64,
+    pub cx: f64,
+    pub cy: f64,
+    /// The intrinsic matrix [[fx, 0, cx], [0, fy, cy], [0, 0, 1]], row by row.
+    #[serde(rename = "K")]
+    pub k: [[f64; 3]; 3],
+    /// The OpenCV world-to-camera rotation (camera x right, y down, z forward), row by row: its
+    /// rows are r, −u, f. A scene's `[camera] R` with `position = eye` is this camera again.
+    #[serde(rename = "R")]
+    pub r: [[f64; 3]; 3],
+    /// The OpenCV world-to-camera translation t = −R·eye (x_cam = R·x_world + t).
+    pub t: [f64; 3],
+    /// COLMAP's `images.txt` pose: the unit quaternion (w, x, y, z) of R, w ≥ 0.
+    pub colmap_qvec: [f64; 4],
+    /// COLMAP's tvec: t.
+    pub colmap_tvec: [f64; 3],
+    /// The camera-to-world matrix of NeRF's and nerfstudio's `transforms.json` (OpenGL camera
+    /// axes: x right, y up, z back), row by row: columns r, u, −f and the eye.
+    pub nerfstudio_camera_to_world: [[f64; 4]; 4],
 }
 
 /// docs/design.md §1's pixel-centre convention, in words.
@@ -300,14 +343,28 @@ impl CameraJson {
                 )
             })
             .collect();
+        let k = camera.pinhole();
+        let rotation = camera.world_to_camera_rotation();
+        let t = -(rotation * camera.position);
+        let (r, u, f, e) = (camera.right, camera.up, camera.forward, camera.position);
+        let (fov_y_deg, fov_x_deg) = match camera.intrinsics {
+            None => (
+                2.0 * camera.tan_half_fov.atan().to_degrees(),
+                2.0 * (aspect * camera.tan_half_fov).atan().to_degrees(),
+            ),
+            Some(k) => (
+                span_deg(k.cy, camera.height, k.fy),
+                span_deg(k.cx, camera.width, k.fx),
+            ),
+        };
         CameraJson {
             eye: camera.position.to_array(),
             eye_plus_forward: (camera.position + camera.forward).to_array(),
             forward: camera.forward.to_array(),
             right: camera.right.to_array(),
             up: camera.up.to_array(),
-            fov_y_deg: 2.0 * camera.tan_half_fov.atan().to_degrees(),
-            fov_x_deg: 2.0 * (aspect * camera.tan_half_fov).atan().to_degrees(),
+            fov_y_deg,
+            fov_x_deg,
             tan_half_fov_y: camera.tan_half_fov,
             width: camera.width,
             height: camera.height,
@@ -319,8 +376,36 @@ impl CameraJson {
             view: MatrixJson::of(&view_matrix(camera)),
             projection,
             background: background.to_array(),
+            fx: k.fx,
+            fy: k.fy,
+            cx: k.cx,
+            cy: k.cy,
+            k: [[k.fx, 0.0, k.cx], [0.0, k.fy, k.cy], [0.0, 0.0, 1.0]],
+            r: [rotation.row(0), rotation.row(1), rotation.row(2)].map(|v| v.to_array()),
+            t: t.to_array(),
+            colmap_qvec: colmap_qvec(rotation),
+            colmap_tvec: t.to_array(),
+            nerfstudio_camera_to_world: [
+                [r.x, u.x, -f.x, e.x],
+                [r.y, u.y, -f.y, e.y],
+                [r.z, u.z, -f.z, e.z],
+                [0.0, 0.0, 0.0, 1.0],
+            ],
         }
     }
+}
+
+/// The full angle (degrees) that the pixels [0, size] span about the principal point c with
+/// focal length f: atan(c/f) + atan((size − c)/f).
+fn span_deg(c: f64, size: u32, f: f64) -> f64 {
+    ((c / f).atan() + ((size as f64 - c) / f).atan()).to_degrees()
+}
+
+/// COLMAP's qvec (w, x, y, z) of the rotation R, with w ≥ 0.
+pub fn colmap_qvec(rotation: DMat3) -> [f64; 4] {
+    let q = DQuat::from_mat3(&rotation).normalize();
+    let q = if q.w < 0.0 { -q } else { q };
+    [q.w, q.x, q.y, q.z]
 }
 
 #[cfg(test)]

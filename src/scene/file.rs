@@ -30,6 +30,21 @@ pub(super) struct CameraTable {
     pub up: Option<[f64; 3]>,
     pub fov_y: Option<f64>,
     pub focal_length: Option<f64>,
+    /// Pinhole intrinsics in pixels, instead of fov_y (docs/design.md §1 "Intrinsics").
+    pub fx: Option<f64>,
+    pub fy: Option<f64>,
+    pub cx: Option<f64>,
+    pub cy: Option<f64>,
+    /// The OpenCV world-to-camera rotation, row by row, instead of look_at and up.
+    #[serde(rename = "R")]
+    pub r: Option<[[f64; 3]; 3]>,
+    /// The OpenCV world-to-camera translation, with `R`, instead of position.
+    pub t: Option<[f64; 3]>,
+    /// A dataset's cameras (docs/design.md §1 "Cameras of datasets"): a COLMAP model folder, a
+    /// NeRF `transforms.json` or a 3DGS `cameras.json`, relative to the scene file.
+    pub from: Option<String>,
+    /// With `from`: the one image whose camera this is; without it every image is a frame.
+    pub image: Option<String>,
     pub width: Option<i64>,
     pub height: Option<i64>,
     /// `[camera.orbit]`: the camera turns about an axis (docs/design.md §10).

@@ -99,7 +99,19 @@ impl SceneFrames {
                 playing.push(p);
             }
         }
-        let frame_count = playing.first().map(|p| p.selection.len());
+        let mut frame_count = playing.first().map(|p| p.selection.len());
+        if let Some(n) = camera_path.frame_count() {
+            if frame_count.is_some_and(|m| m != n) {
+                return Err(PgtError::in_file(
+                    &scene.source,
+                    format!(
+                        "the camera sequence has {n} cameras, but the includes play {} frames: the two must agree",
+                        frame_count.unwrap_or_default()
+                    ),
+                ));
+            }
+            frame_count = Some(n);
+        }
         Ok(SceneFrames {
             first: scene,
             camera_path,
@@ -109,8 +121,8 @@ impl SceneFrames {
         })
     }
 
-    /// The number of frames; `None` when no include plays (any frame count: only the camera
-    /// moves).
+    /// The number of frames: the playing includes' or the camera sequence's; `None` when neither
+    /// sets it (any frame count: only the camera moves).
     pub fn frame_count(&self) -> Option<usize> {
         self.frame_count
     }

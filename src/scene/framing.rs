@@ -3,6 +3,7 @@
 use crate::geometry::Camera;
 use crate::optics::light::Light;
 use crate::optics::particle::Particle;
+use crate::optics::Profile;
 use glam::DVec3;
 
 /// Vertical field of view of the default camera, degrees.
@@ -28,8 +29,22 @@ pub fn default_camera(particles: &[Particle], width: u32, height: u32) -> Camera
     )
 }
 
+/// Standard deviations of a Gaussian particle that framing and the near plane hold (docs/design.md
+/// §1 "Default framing"): the footprint splatting rasterisers draw.
+pub const GAUSSIAN_EXTENT_SIGMAS: f64 = 3.0;
+
+/// The radius of the sphere about a particle's centre that framing and the near/far planes hold:
+/// its bounding radius, or [`GAUSSIAN_EXTENT_SIGMAS`] times it for a Gaussian (whose radius is a
+/// standard deviation).
+pub fn extent_radius(p: &Particle) -> f64 {
+    match p.profile {
+        Profile::Gaussian => GAUSSIAN_EXTENT_SIGMAS * p.radius,
+        _ => p.radius,
+    }
+}
+
 /// The centre of the particles' bounding box and the radius of the sphere around it that holds
-/// every particle whole. An empty set gives the unit sphere at the origin.
+/// every particle whole ([`extent_radius`]). An empty set gives the unit sphere at the origin.
 pub fn bounding_sphere(particles: &[Particle]) -> (DVec3, f64) {
     if particles.is_empty() {
         return (DVec3::ZERO, 1.0);
@@ -37,13 +52,13 @@ pub fn bounding_sphere(particles: &[Particle]) -> (DVec3, f64) {
     let mut lo = DVec3::splat(f64::INFINITY);
     let mut hi = DVec3::splat(f64::NEG_INFINITY);
     for p in particles {
-        lo = lo.min(p.center - DVec3::splat(p.radius));
-        hi = hi.max(p.center + DVec3::splat(p.radius));
+        lo = lo.min(p.center - DVec3::splat(extent_radius(p)));
+        hi = hi.max(p.center + DVec3::splat(extent_radius(p)));
     }
     let center = 0.5 * (lo + hi);
     let radius = particles
         .iter()
-        .map(|p| (p.center - center).length() + p.radius)
+        .map(|p| (p.center - center).length() + extent_radius(p))
         .fold(0.0, f64::max);
     (center, radius)
 }

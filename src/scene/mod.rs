@@ -235,7 +235,9 @@ impl Scene {
     pub fn camera_json(&self) -> crate::geometry::projection::CameraJson {
         crate::geometry::projection::CameraJson::new(
             &self.camera,
-            self.particles.iter().map(|p| (p.center, p.radius)),
+            self.particles
+                .iter()
+                .map(|p| (p.center, framing::extent_radius(p))),
             self.render.background,
         )
     }

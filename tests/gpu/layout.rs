@@ -133,6 +133,7 @@ fn rust_and_wgsl_struct_layouts_agree() {
             ("pair_end", offset_of!(GpuFrame, pair_end)),
             ("row_begin", offset_of!(GpuFrame, row_begin)),
             ("row_count", offset_of!(GpuFrame, row_count)),
+            ("pinhole", offset_of!(GpuFrame, pinhole)),
             ("splat_alpha_cap", offset_of!(GpuFrame, splat_alpha_cap)),
             ("splat_alpha_skip", offset_of!(GpuFrame, splat_alpha_skip)),
             ("splat_stop_below", offset_of!(GpuFrame, splat_stop_below)),
@@ -141,6 +142,10 @@ fn rust_and_wgsl_struct_layouts_agree() {
                 offset_of!(GpuFrame, splat_stop_inclusive),
             ),
             ("params", offset_of!(GpuFrame, params)),
+            ("fx", offset_of!(GpuFrame, fx)),
+            ("fy", offset_of!(GpuFrame, fy)),
+            ("cx", offset_of!(GpuFrame, cx)),
+            ("cy", offset_of!(GpuFrame, cy)),
         ],
     );
     check(

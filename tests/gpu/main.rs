@@ -12,6 +12,7 @@ mod cli;
 mod contract;
 mod ellipsoids;
 mod gaussians;
+mod intrinsics;
 mod layout;
 mod methods;
 mod raster;

@@ -174,6 +174,65 @@ radius = 1.0
     );
     check_scene(&framed, None);
     check_scene(&framed, Some((64, 200)));
+    // Intrinsics (docs/design.md §1): fx ≠ fy, an off-centre principal point, the pose as R
+    // and t; and the same scaled by --size.
+    let intrinsics = write_scene(
+        dir.path(),
+        "intrinsics.toml",
+        r#"
+[camera]
+fx = 70.0
+fy = 52.5
+cx = 19.25
+cy = 27.75
+R = [[0.0, 0.0, -1.0], [0.0, -1.0, 0.0], [-1.0, 0.0, 0.0]]
+t = [0.5, -0.25, 9.0]
+width = 48
+height = 40
+[[particles]]
+center = [0.0, 0.0, 0.0]
+radius = 1.0
+"#,
+    );
+    check_scene(&intrinsics, None);
+    check_scene(&intrinsics, Some((96, 30)));
+}
+
+#[test]
+fn the_json_gives_k_the_opencv_pose_colmaps_qvec_and_nerfstudios_camera_to_world() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let scene = root.join("examples/shadows.toml");
+    let json = pgt_camera(&scene, None);
+    let cam = reference_camera(&scene, None).camera;
+    // A fov_y camera: fx = fy = (H/2)/tan(fov_y/2), the principal point at the centre.
+    let f = 0.5 * cam.height as f64 / cam.tan_half_fov;
+    assert_eq!((json.fx, json.fy), (f, f));
+    assert_eq!(
+        (json.cx, json.cy),
+        (0.5 * cam.width as f64, 0.5 * cam.height as f64)
+    );
+    assert_eq!(
+        json.k,
+        [[f, 0.0, json.cx], [0.0, f, json.cy], [0.0, 0.0, 1.0]]
+    );
+    // R's rows are r, −u, f; t = −R·eye; qvec turns into R; the camera-to-world's columns are
+    // r, u, −f and the eye.
+    let r = glam::DMat3::from_cols_array_2d(&json.r).transpose();
+    assert_eq!(r.row(0), cam.right);
+    assert_eq!(r.row(1), -cam.up);
+    assert_eq!(r.row(2), cam.forward);
+    let t = DVec3::from(json.t);
+    assert!((r * cam.position + t).length() < 1e-12);
+    assert_eq!(json.colmap_tvec, json.t);
+    let [w, x, y, z] = json.colmap_qvec;
+    assert!(w >= 0.0);
+    let q = glam::DMat3::from_quat(glam::DQuat::from_xyzw(x, y, z, w));
+    assert!(q.abs_diff_eq(r, 1e-12), "{q} vs {r}");
+    let c2w = glam::DMat4::from_cols_array_2d(&json.nerfstudio_camera_to_world).transpose();
+    assert_eq!(c2w.x_axis.truncate(), cam.right);
+    assert_eq!(c2w.y_axis.truncate(), cam.up);
+    assert_eq!(c2w.z_axis.truncate(), -cam.forward);
+    assert_eq!(c2w.w_axis, cam.position.extend(1.0));
 }
 
 #[test]

@@ -8,6 +8,7 @@
 mod support;
 
 mod camera_projection;
+mod dataset_cameras;
 mod ellipsoids;
 mod error;
 mod exact;

@@ -8,13 +8,13 @@ use super::super::framing::{default_camera, DEFAULT_FOV_Y, DEFAULT_SIZE};
 use super::super::SceneLoadOptions;
 use super::{keyframes, orbit};
 use crate::error::{At, Result, SourceText};
-use crate::geometry::{Camera, CameraPath, Keyframe};
+use crate::geometry::{check_rotation, Camera, CameraPath, Intrinsics, Keyframe, Lens};
 use crate::optics::particle::Particle;
-use glam::DVec3;
+use glam::{DMat3, DVec3};
 use toml::Spanned;
 
 /// The camera of every frame: the framed default camera without a `[camera]` table, else the
-/// table's fixed camera, orbit or keyframes.
+/// table's dataset cameras, fixed camera, orbit or keyframes.
 pub(super) fn path(
     source: &SourceText,
     table: &Option<Spanned<CameraTable>>,
@@ -28,40 +28,30 @@ pub(super) fn path(
     };
     let t = table.get_ref();
     let table_at = source.at(table.span());
+    if t.from.is_some() {
+        return super::dataset_camera::path(source, &table_at, t, options);
+    }
+    if t.image.is_some() {
+        return Err(table_at.err("camera.image names an image of camera.from, which is not set"));
+    }
+    let table_size = check_size(
+        &table_at,
+        t.width.unwrap_or(DEFAULT_SIZE.0 as i64),
+        t.height.unwrap_or(DEFAULT_SIZE.1 as i64),
+    )?;
     let (w, h) = match options.size {
         Some((w, h)) => check_size(&source.whole(), w as i64, h as i64)?,
-        None => check_size(
-            &table_at,
-            t.width.unwrap_or(DEFAULT_SIZE.0 as i64),
-            t.height.unwrap_or(DEFAULT_SIZE.1 as i64),
-        )?,
+        None => table_size,
     };
-    let fov_y = fov(&table_at, t)?;
+    let lens = lens(&table_at, t, table_size, (w, h))?;
     if t.interpolation.is_some() && t.keyframes.is_empty() {
         return Err(table_at
             .err("camera.interpolation applies to [[camera.keyframes]], and there are none"));
     }
     if !t.keyframes.is_empty() {
-        if t.orbit.is_some() {
-            return Err(
-                table_at.err("camera: set [camera.orbit] or [[camera.keyframes]], not both")
-            );
-        }
-        if let Some(key) = [
-            ("position", t.position.is_some()),
-            ("look_at", t.look_at.is_some()),
-        ]
-        .iter()
-        .find(|(_, set)| *set)
-        {
-            return Err(table_at.err(format!(
-                "camera.{}: the keyframes set the camera's position and look_at; remove one or the other",
-                key.0
-            )));
-        }
-        return keyframes::path(source, &table_at, t, fov_y, (w, h));
+        return keyframed(source, &table_at, t, lens, (w, h));
     }
-    let (camera, look_at) = fixed(&table_at, t, particles, fov_y, (w, h))?;
+    let (camera, look_at) = fixed(&table_at, t, particles, lens, (w, h))?;
     match &t.orbit {
         None => Ok(CameraPath::Fixed(camera)),
         Some(o) => {
@@ -69,14 +59,58 @@ pub(super) fn path(
                 frame: 0,
                 position: camera.position,
                 look_at,
-                up: table_at.direction("camera.up", t.up.unwrap_or([0.0, 1.0, 0.0]))?,
-                fov_y,
+                up: camera.up,
+                fov_y: match lens {
+                    Lens::FovY(f) => f,
+                    Lens::Pinhole(_) => DEFAULT_FOV_Y,
+                },
             };
-            orbit::path(&source.at(o.span()), o.get_ref(), start, (w, h), particles)
+            let intrinsics = camera.intrinsics;
+            orbit::path(
+                &source.at(o.span()),
+                o.get_ref(),
+                start,
+                (w, h),
+                intrinsics,
+                particles,
+            )
         }
     }
 }
 
+/// `[[camera.keyframes]]`, which interpolate position, look_at, up and fov_y: the table may not
+/// set a position, look_at, R or intrinsics of its own.
+fn keyframed(
+    source: &SourceText,
+    table_at: &At,
+    t: &CameraTable,
+    lens: Lens,
+    size: (u32, u32),
+) -> Result<CameraPath> {
+    if t.orbit.is_some() {
+        return Err(table_at.err("camera: set [camera.orbit] or [[camera.keyframes]], not both"));
+    }
+    if let Some(key) = [
+        ("position", t.position.is_some()),
+        ("look_at", t.look_at.is_some()),
+        ("R", t.r.is_some()),
+        ("t", t.t.is_some()),
+    ]
+    .iter()
+    .find(|(_, set)| *set)
+    {
+        return Err(table_at.err(format!(
+            "camera.{}: the keyframes set the camera's position and look_at; remove one or the other",
+            key.0
+        )));
+    }
+    let Lens::FovY(fov_y) = lens else {
+        return Err(table_at.err(
+            "camera: keyframes interpolate fov_y; intrinsics (fx, fy, cx, cy) do not apply to [[camera.keyframes]]",
+        ));
+    };
+    keyframes::path(source, table_at, t, fov_y, size)
+}
 /// The camera of frame 0, with a degenerate one named at the camera table's line.
 pub(super) fn first(
     source: &SourceText,
@@ -94,6 +128,42 @@ pub(super) fn first(
 /// An image size, checked against the limits (`scene::check_image_size`).
 pub(super) fn check_size(at: &At, w: i64, h: i64) -> Result<(u32, u32)> {
     super::super::check_image_size(w, h).map_err(|e| at.err(e))
+}
+
+/// The table's lens: `fx, fy, cx, cy` (all four, for the table's own size, scaled to the image
+/// size when `--size` differs: [`Intrinsics::scaled`]) or fov_y ([`fov`]).
+fn lens(at: &At, t: &CameraTable, table_size: (u32, u32), size: (u32, u32)) -> Result<Lens> {
+    let given = [("fx", t.fx), ("fy", t.fy), ("cx", t.cx), ("cy", t.cy)];
+    if given.iter().all(|(_, v)| v.is_none()) {
+        return Ok(Lens::FovY(fov(at, t)?));
+    }
+    if t.fov_y.is_some() || t.focal_length.is_some() {
+        return Err(at.err("camera: set fov_y (or focal_length) or fx, fy, cx, cy, not both"));
+    }
+    let missing: Vec<&str> = given
+        .iter()
+        .filter(|(_, v)| v.is_none())
+        .map(|(k, _)| *k)
+        .collect();
+    if !missing.is_empty() {
+        return Err(at.err(format!(
+            "camera: intrinsics need fx, fy, cx and cy; {} missing",
+            missing.join(", ")
+        )));
+    }
+    let value = |k: &str, v: Option<f64>| at.finite(&format!("camera.{k}"), v.unwrap_or(0.0));
+    let k = Intrinsics {
+        fx: value("fx", t.fx)?,
+        fy: value("fy", t.fy)?,
+        cx: value("cx", t.cx)?,
+        cy: value("cy", t.cy)?,
+    };
+    for (name, f) in [("fx", k.fx), ("fy", k.fy)] {
+        if f <= 0.0 {
+            return Err(at.err(format!("camera.{name} must be > 0 pixels, got {f}")));
+        }
+    }
+    Ok(Lens::Pinhole(k.scaled(table_size, size)))
 }
 
 /// `camera.fov_y` or `camera.focal_length` (degrees), [`DEFAULT_FOV_Y`] by default.
@@ -118,15 +188,22 @@ fn fov(at: &At, t: &CameraTable) -> Result<f64> {
     })
 }
 
-/// The `[camera]` table's own camera (framing the particles where position and look_at are
-/// absent) and its look_at point.
+/// The `[camera]` table's own camera (framing the particles where no position is set) and a
+/// point on its view axis (its look_at).
 fn fixed(
     at: &At,
     t: &CameraTable,
     particles: &[Particle],
-    fov_y: f64,
+    lens: Lens,
     (w, h): (u32, u32),
 ) -> Result<(Camera, DVec3)> {
+    if let Some(rows) = t.r {
+        let camera = posed(at, t, rows, lens, (w, h))?;
+        return Ok((camera, camera.position + camera.forward));
+    }
+    if t.t.is_some() {
+        return Err(at.err("camera.t is the translation of camera.R, which is not set"));
+    }
     let (position, look_at) = match (t.position, t.look_at) {
         (Some(p), Some(l)) => (
             at.vec3("camera.position", p)?,
@@ -149,7 +226,35 @@ fn fixed(
     if forward.normalize().cross(up).length() < 1e-9 {
         return Err(at.err("camera.up must not be parallel to the viewing direction"));
     }
-    Ok((Camera::new(position, look_at, up, fov_y, w, h), look_at))
+    let camera = match lens {
+        Lens::FovY(fov_y) => Camera::new(position, look_at, up, fov_y, w, h),
+        Lens::Pinhole(k) => {
+            Camera::new(position, look_at, up, DEFAULT_FOV_Y, w, h).with_intrinsics(k)
+        }
+    };
+    Ok((camera, look_at))
+}
+
+/// The camera of `R` (the OpenCV world-to-camera rotation, rows) with `position` or `t`
+/// (docs/design.md §1 "Intrinsics"); R is used as written, checked by [`check_rotation`].
+fn posed(
+    at: &At,
+    t: &CameraTable,
+    rows: [[f64; 3]; 3],
+    lens: Lens,
+    (w, h): (u32, u32),
+) -> Result<Camera> {
+    if t.look_at.is_some() || t.up.is_some() {
+        return Err(at.err("camera.R sets the viewing direction and up: remove look_at and up"));
+    }
+    let rotation = DMat3::from_cols_array_2d(&rows).transpose();
+    check_rotation(rotation).map_err(|m| at.err(format!("camera.R {m}")))?;
+    let position = match (t.position, t.t) {
+        (Some(p), None) => at.vec3("camera.position", p)?,
+        (None, Some(tv)) => Camera::eye_of(rotation, at.vec3("camera.t", tv)?),
+        _ => return Err(at.err("camera.R needs camera.position or camera.t (one of them)")),
+    };
+    Ok(Camera::from_rotation(position, rotation, lens, w, h))
 }
 
 #[cfg(test)]

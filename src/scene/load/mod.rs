@@ -16,6 +16,7 @@
 
 mod bare;
 mod camera;
+mod dataset_camera;
 mod defaults;
 mod includes;
 mod keyframes;

@@ -4,7 +4,7 @@
 use super::super::file::OrbitTable;
 use super::super::framing::bounding_sphere;
 use crate::error::{At, Result};
-use crate::geometry::{CameraPath, Keyframe};
+use crate::geometry::{CameraPath, Intrinsics, Keyframe};
 use crate::optics::particle::Particle;
 
 /// The orbit of `orbit`, starting at `start` (the `[camera]` table's camera), about `axis`
@@ -15,6 +15,7 @@ pub(super) fn path(
     orbit: &OrbitTable,
     start: Keyframe,
     (width, height): (u32, u32),
+    intrinsics: Option<Intrinsics>,
     particles: &[Particle],
 ) -> Result<CameraPath> {
     let axis = at.direction("camera.orbit.axis", orbit.axis)?;
@@ -30,6 +31,7 @@ pub(super) fn path(
         degrees_per_frame,
         width,
         height,
+        intrinsics,
     })
 }
 
