@@ -1,12 +1,16 @@
 //! `pgt gen random --count N --seed S [--box …] [--radius a..b] -o FILE` (docs/design.md §7): the
-//! synthetic random set of [`pgt::formats::random`], written as CSV, atomically.
+//! synthetic random set of [`pgt::formats::random`], written as CSV, atomically; `pgt gen
+//! gaussians --count N --seed S -o FILE.ply`: Gaussians with trained-scene statistics
+//! ([`pgt::formats::trained`]) as a 3DGS PLY.
 
 use super::output::{check_outputs, Output, OutputKind};
 use super::Outcome;
 use clap::{Args, Subcommand};
 use glam::DVec3;
 use pgt::formats::random::{particles, write_csv, RandomSpec, THESIS_COUNT};
+use pgt::formats::trained;
 use pgt::image_io::write_atomically;
+use std::io::Write as _;
 use std::path::PathBuf;
 
 /// Most particles `pgt gen random` writes (about 7.5 GB of CSV); a typo beyond it is refused
@@ -27,6 +31,24 @@ pub enum GenKind {
     /// Uniformly random spheres in a box (the thesis's random set: 73,642 particles).
     /// The random set of [`pgt::formats::random`].
     Random(RandomArgs),
+    /// Gaussians with the statistics of trained 3D Gaussian splatting scenes (clustered centres,
+    /// log-normal scales, flat shapes, sigmoid opacities), as a 3DGS PLY: read it with
+    /// `density = "gaussian"`.
+    Gaussians(GaussiansArgs),
+}
+
+/// Options of `pgt gen gaussians`.
+#[derive(Debug, Args)]
+pub struct GaussiansArgs {
+    /// Number of Gaussians.
+    #[arg(long, default_value_t = 100_000)]
+    pub count: usize,
+    /// Seed of the SplitMix64 generator (the same seed always gives the same file).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Output PLY file (.ply).
+    #[arg(short, long)]
+    pub output: PathBuf,
 }
 
 /// Options of `pgt gen random`.
@@ -111,6 +133,24 @@ pub fn run(args: GenArgs) -> anyhow::Result<Outcome> {
             write_atomically(&a.output, |w| write_csv(w, particles(&spec)))?;
             eprintln!(
                 "wrote {} random particles to {}",
+                a.count,
+                a.output.display()
+            );
+            Ok(Outcome::Success)
+        }
+        GenKind::Gaussians(a) => {
+            check_outputs(&[Output::new(
+                "--output",
+                &a.output,
+                OutputKind::File(&["ply"]),
+            )])?;
+            if a.count > MAX_COUNT {
+                anyhow::bail!("--count: at most {MAX_COUNT} Gaussians, got {}", a.count);
+            }
+            let bytes = trained::to_ply(&trained::generate(a.count, a.seed));
+            write_atomically(&a.output, |w| w.write_all(&bytes))?;
+            eprintln!(
+                "wrote {} Gaussians with trained-scene statistics to {}",
                 a.count,
                 a.output.display()
             );

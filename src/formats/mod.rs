@@ -42,6 +42,7 @@ pub mod random;
 pub mod record;
 pub mod summary;
 pub mod topology;
+pub mod trained;
 pub mod vrml;
 pub mod xtc;
 pub mod xyz_csv;

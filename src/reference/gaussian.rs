@@ -13,9 +13,12 @@
 //!   ∫_a^b T(0,t)·Σ_A σᵢCᵢ dt = T(0,a)·[C_ref·(1 − e^{−τ(a,b)}) + ∫_a^b e^{−τ(a,t)}·Σ_A σᵢ(Cᵢ − C_ref) dt]
 //!
 //! because ∫ e^{−τ(a,t)}σ(t) dt = 1 − e^{−τ(a,b)} exactly. C_ref is the colour of the Gaussian
-//! with the most depth on the segment, so a segment where all have one colour is closed form
-//! and the rest is a small, smooth integrand for adaptive Gauss–Kronrod (`quadrature`), with
-//! tol/2 of the pixel's budget.
+//! with the most depth on the segment, so a segment where all have one colour is closed form.
+//! Where no light scatters, the rest is bounded in closed form where the bound is tight
+//! ([`deviation_bounds`]: one Gaussian dominates, or the piece is thin) while the bounds fit
+//! their share; otherwise it is a small, smooth integrand for adaptive Gauss–Kronrod
+//! (`quadrature`), with its share of the pixel's budget (`reference::budget::gaussian` names
+//! every share of tol; the parts of err are [`ErrorParts`]).
 //!
 //! **What is left out, and bounded into err.** The rendered medium is the true one less some
 //! density δσ ≥ 0: (1) every Gaussian whose k-σ ellipsoid the ray does not meet in front of
@@ -31,9 +34,9 @@
 //! (3) are summed exactly in closed form; for (1) each Gaussian i missed adds at most
 //! σᵢ·s_max,i·√(2π)·e^{−k²/2} (its line depth at Mahalanobis distance ≥ k, or the tail beyond
 //! its chord when the chord lies behind the eye), summed over the scene once. k defaults to
-//! the smallest value ≥ 3 that puts that sum's share below tol/8. A ray whose transmittance has
-//! fallen to T with T·M ≤ tol/8 stops: what lies beyond is in [0, T·M], taken as its midpoint
-//! with half of it in err.
+//! the smallest value ≥ 3 that puts M times that sum within its share of tol. A ray whose
+//! transmittance has fallen to T with T·M ≤ twice the ray-stop share of tol stops: what lies
+//! beyond is in [0, T·M], taken as its midpoint with half of it in err.
 //!
 //! **Single-scatter.** The source is Q = a·E + α·(1/4π)·Σ_l E_l·T_l (docs/design.md §2), so
 //! σ·Q = a·Σσᵢ(t)Cᵢ + (1/4π)·Σᵢσᵢ(t)αᵢ·Σ_l E_l(x_t)·T_l(x_t): the first term is the emission
@@ -48,10 +51,12 @@
 //! reported as not converged); and each shadow ray leaves out at most the same missed depth
 //! Δ_far as a camera ray, so the rendered T_l is at most e^{Δ_far} times the true one and the
 //! scattered radiance is high by at most (L + err)·(1 − e^{−Δ_far}). A shadow ray stops once
-//! its depth reaches D with e^{−D}·Σ_l q̂_l ≤ tol/16 (q̂_l the bound of light l's part on this
-//! ray): its T_l is then high by at most e^{−D}, the pixel by at most e^{−D}·Σ_l q̂_l, which goes
-//! into err where a shadow ray stopped; that tol/16 comes out of the quadrature's tol/2.
+//! its depth reaches D with e^{−D}·Σ_l q̂_l within the shadow-stop share of tol (q̂_l the bound
+//! of light l's part on this ray): its T_l is then high by at most e^{−D}, the pixel by at most
+//! e^{−D}·Σ_l q̂_l, which goes into err where a shadow ray stopped; where no shadow ray can stop,
+//! that share is the quadrature's.
 
+use super::budget::gaussian as share;
 use super::quadrature::{integrate_adaptive, Piece};
 use super::volume::MAX_SEGMENTS;
 use super::{Integrator, RadianceEstimator, Sample};
@@ -147,6 +152,39 @@ struct Deviation {
     reference: DVec3,
     first: usize,
     count: usize,
+}
+
+/// The parts of one pixel's err per channel (docs/design.md §3, §9), each paid from its share
+/// of `tol` (`reference::budget::gaussian`); `Sample::error` is their [`ErrorParts::total`].
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct ErrorParts {
+    /// Half the bound of what lies behind a ray stopped behind nearly opaque gas
+    /// ([`share::RAY_STOP`]).
+    pub ray_stop: DVec3,
+    /// The half-widths of the colour deviations bounded in closed form instead of integrated
+    /// ([`share::BOUNDED`]).
+    pub bounded: DVec3,
+    /// The quadrature's error estimate ([`share::QUADRATURE`]).
+    pub quadrature: DVec3,
+    /// Shadow rays stopped at depth D: e^{−D}·Σ_l q̂_l ([`share::SHADOW_STOP`]).
+    pub shadow_stop: DVec3,
+    /// The shadow rays' missed depth, (L + err)·(1 − e^{−Δ_far}): unbudgeted.
+    pub shadow_missed: DVec3,
+    /// M·(1 − e^{−Δ}) for the depth Δ left out of the camera ray: faint Gaussians, tails and the
+    /// Gaussians not met within k σ ([`share::FAINT`] + [`share::TAILS`] + [`share::FAR`]).
+    pub left_out: DVec3,
+}
+
+impl ErrorParts {
+    /// err: the parts summed in a fixed order.
+    pub fn total(&self) -> DVec3 {
+        self.ray_stop
+            + self.bounded
+            + self.quadrature
+            + self.shadow_stop
+            + self.shadow_missed
+            + self.left_out
+    }
 }
 
 #[derive(Default)]
@@ -320,55 +358,66 @@ impl GaussianRenderer {
         self.model.light_source(&self.params, &bounds, &sample)
     }
 
-    fn radiance_with(&self, ray: &Ray, s: &mut Scratch) -> Sample {
+    /// The sample of `ray` and the parts of its err, which sum to `Sample::error` in the
+    /// order [`ErrorParts::total`] adds them.
+    fn radiance_with(&self, ray: &Ray, s: &mut Scratch) -> (Sample, ErrorParts) {
         let (bound, scattered) = self.source_bound(ray);
         let m_max = bound.max_element();
         if m_max == 0.0 {
             // Every colour, light and the background are black: L = 0 whatever the densities.
-            return Sample::default();
+            return (Sample::default(), ErrorParts::default());
         }
-        // Budgets of optical depth left out: tol/4 of radiance in all (M·Δ ≤ tol/4), half for
-        // the small Gaussians left out whole and half for the tails outside the windows. A ray
-        // through a point light has no finite M; its windows are those of the scene's M.
+        // Optical depth left out, as radiance M·Δ: the faint Gaussians and the tails outside
+        // the windows, each within its share of tol. A ray through a point light has no finite
+        // M; its windows are those of the scene's M.
         let m_budget = if m_max.is_finite() {
             m_max
         } else {
             self.typical_bound().max_element().max(f64::MIN_POSITIVE)
         };
-        let budget = self.tol / (4.0 * m_budget);
-        let delta = self.far_depth + self.gather(ray, s, budget);
+        let delta = self.far_depth + self.gather(ray, s, self.tol / m_budget);
         cut_pieces(s, &self.lights, ray);
-        let (mut radiance, mut error) = self.sweep(s, bound);
+        let mut parts = ErrorParts::default();
+        let mut radiance = self.sweep(s, bound, &mut parts);
         let q = scattered.max_element();
         let stop_depth = if q > 0.0 && q.is_finite() {
-            (16.0 * q / self.tol).ln().max(0.0)
+            (q / (share::SHADOW_STOP * self.tol)).ln().max(0.0)
         } else {
             f64::INFINITY
         };
         let (converged, shadow_rays, stopped) =
-            self.deviations(ray, s, stop_depth, &mut radiance, &mut error);
+            self.deviations(ray, s, stop_depth, &mut radiance, &mut parts.quadrature);
         if stopped {
-            error += scattered * (-stop_depth).exp();
+            parts.shadow_stop = scattered * (-stop_depth).exp();
         }
-
         if !self.lights.is_empty() {
             // The scattered part is at most the whole radiance; the shadow rays' missed depth
             // makes it high by at most that part's 1 − e^{−Δ_far}.
-            error += (radiance + error) * -(-self.far_depth).exp_m1();
+            let so_far = parts.ray_stop + parts.bounded + parts.quadrature + parts.shadow_stop;
+            parts.shadow_missed = (radiance + so_far) * -(-self.far_depth).exp_m1();
         }
-        error += bound * -(-delta).exp_m1();
-        Sample {
+        parts.left_out = bound * -(-delta).exp_m1();
+        let error = parts.total();
+        let sample = Sample {
             radiance,
             error,
             shadow_rays,
             unconverged: !converged || !error.is_finite(),
-        }
+        };
+        (sample, parts)
+    }
+
+    /// The sample of `ray` and the parts of its err (docs/design.md §3 "What err guarantees"),
+    /// each spent from its share of `tol` (`reference::budget::gaussian`).
+    pub fn radiance_and_parts(&self, ray: &Ray) -> (Sample, ErrorParts) {
+        SCRATCH.with(|s| self.radiance_with(ray, &mut s.borrow_mut()))
     }
 
     /// Fills `s.windows` with the Gaussians the ray keeps (sorted by window start) and
-    /// returns the optical depth left out of them: the faint ones left out whole, within half
-    /// of `budget`, and the tails outside the windows.
-    fn gather(&self, ray: &Ray, s: &mut Scratch, budget: f64) -> f64 {
+    /// returns the optical depth left out of them: the faint ones left out whole, within
+    /// [`share::FAINT`] of `depth_per_tol` (the depth whose M·Δ is tol), and the tails outside
+    /// the windows, within [`share::TAILS`] of it.
+    fn gather(&self, ray: &Ray, s: &mut Scratch, depth_per_tol: f64) -> f64 {
         let mut delta = 0.0;
         self.bvh.all_hits(ray, 0.0, f64::INFINITY, &mut s.hits);
         s.candidates.clear();
@@ -394,7 +443,7 @@ impl GaussianRenderer {
         let mut left_out = 0.0;
         let mut first_kept = s.candidates.len();
         for (k, c) in s.candidates.iter().enumerate() {
-            if left_out + c.front > 0.5 * budget {
+            if left_out + c.front > share::FAINT * depth_per_tol {
                 first_kept = k;
                 break;
             }
@@ -402,7 +451,7 @@ impl GaussianRenderer {
         }
         delta += left_out;
         let kept = &s.candidates[first_kept..];
-        let tail_budget = 0.5 * budget / kept.len().max(1) as f64;
+        let tail_budget = share::TAILS * depth_per_tol / kept.len().max(1) as f64;
         s.windows.clear();
         for c in kept {
             let total = c.profile.total_depth();
@@ -432,14 +481,16 @@ impl GaussianRenderer {
         delta
     }
 
-    /// The closed-form part of every piece, front to back: T(a)·C_ref·(1 − e^{−τ(a,b)}) and
-    /// the pieces whose colours differ, or every piece where lights scatter, queued for
-    /// quadrature (`s.pieces`), then L_bg·T(0,∞), or the bounded rest of a ray stopped at
-    /// T·max M ≤ tol/8 (`bound` is M). Returns the radiance and its error so far.
-    fn sweep(&self, s: &mut Scratch, bound: DVec3) -> (DVec3, DVec3) {
+    /// The closed-form part of every piece, front to back: T(a)·C_ref·(1 − e^{−τ(a,b)}); the
+    /// pieces whose colours differ bounded in closed form ([`deviation_bounds`], half-widths
+    /// into `parts.bounded`) while that fits [`share::BOUNDED`] and no light scatters, else
+    /// queued for quadrature (`s.pieces`), as is every piece where lights scatter; then
+    /// L_bg·T(0,∞), or the bounded rest of a ray stopped at T·max M ≤ 2·[`share::RAY_STOP`]·tol
+    /// (`bound` is M), half of which goes into `parts.ray_stop`. Returns the radiance so far.
+    fn sweep(&self, s: &mut Scratch, bound: DVec3, parts: &mut ErrorParts) -> DVec3 {
         let m_max = bound.max_element();
+        let bounded_budget = share::BOUNDED * self.tol;
         let mut radiance = DVec3::ZERO;
-        let mut error = DVec3::ZERO;
         let mut transmittance = 1.0;
         let mut stopped = false;
         s.members.clear();
@@ -476,10 +527,10 @@ impl GaussianRenderer {
             if count == 0 {
                 continue;
             }
-            if transmittance * m_max <= self.tol / 8.0 {
+            if transmittance * m_max <= 2.0 * share::RAY_STOP * self.tol {
                 let rest = 0.5 * transmittance * bound;
                 radiance += rest;
-                error += rest;
+                parts.ray_stop += rest;
                 stopped = true;
                 s.members.truncate(first);
                 break;
@@ -491,11 +542,21 @@ impl GaussianRenderer {
                 .fold(&members[0], |h, m| if m.depth > h.depth { m } else { h });
             let reference = self.color_of(&s.windows[heaviest.window]);
             radiance += transmittance * reference * -(-tau).exp_m1();
-            if !self.lights.is_empty()
-                || members
-                    .iter()
-                    .any(|m| self.color_of(&s.windows[m.window]) != reference)
-            {
+            let deviates = members
+                .iter()
+                .any(|m| self.color_of(&s.windows[m.window]) != reference);
+            // Where no light scatters, a deviation that fits what is left of its share is
+            // bounded in closed form instead of integrated.
+            let closed = (deviates && self.lights.is_empty())
+                .then(|| deviation_bounds(members, &s.windows, self, reference, tau))
+                .filter(|&(_, half)| {
+                    (parts.bounded + transmittance * half).max_element() <= bounded_budget
+                });
+            if let Some((middle, half)) = closed {
+                radiance += transmittance * middle;
+                parts.bounded += transmittance * half;
+                s.members.truncate(first);
+            } else if !self.lights.is_empty() || deviates {
                 s.pieces.push(Piece {
                     lo: a,
                     hi: b,
@@ -515,13 +576,14 @@ impl GaussianRenderer {
         if !stopped {
             radiance += transmittance * self.background;
         }
-        (radiance, error)
+        radiance
     }
 
     /// The colour deviations of the queued pieces, and the lights' part where they scatter, by
-    /// adaptive Gauss–Kronrod with tol/2 (7·tol/16 where a shadow ray may stop), added to
-    /// `radiance` and their estimate to `error`; whether the quadrature converged, the number of
-    /// shadow rays traced and whether one stopped at `stop_depth`.
+    /// adaptive Gauss–Kronrod with [`share::QUADRATURE`] of tol (and [`share::SHADOW_STOP`] where
+    /// no shadow ray may stop, [`share::BOUNDED`] where lights scatter), added to `radiance` and
+    /// their estimate to `error`; whether the quadrature converged, the number of shadow rays
+    /// traced and whether one stopped at `stop_depth`.
     fn deviations(
         &self,
         ray: &Ray,
@@ -587,12 +649,16 @@ impl GaussianRenderer {
                 }
                 (-tau).exp() * sum
             };
-            // A shadow ray that may stop takes its tol/16 from the quadrature's half.
-            let quadrature_tol = if stop_depth.is_finite() {
-                7.0 / 16.0 * self.tol
-            } else {
-                0.5 * self.tol
-            };
+            // The shares no part of this ray can spend are the quadrature's: the shadow stop's
+            // where no shadow ray can stop, the bounded deviations' where lights scatter.
+            let mut quadrature = share::QUADRATURE;
+            if !stop_depth.is_finite() {
+                quadrature += share::SHADOW_STOP;
+            }
+            if scatters {
+                quadrature += share::BOUNDED;
+            }
+            let quadrature_tol = quadrature * self.tol;
             let result = integrate_adaptive(
                 &s.pieces,
                 quadrature_tol,
@@ -602,7 +668,7 @@ impl GaussianRenderer {
                 |_, _, _| true,
             );
             *radiance += result.value;
-            *error += result.error;
+            *error = result.error;
             converged = result.converged;
         }
         (converged, shadow_rays, stopped)
@@ -643,7 +709,7 @@ impl GaussianRenderer {
 
 impl RadianceEstimator for GaussianRenderer {
     fn radiance(&self, ray: &Ray) -> Sample {
-        SCRATCH.with(|s| self.radiance_with(ray, &mut s.borrow_mut()))
+        self.radiance_and_parts(ray).0
     }
 
     fn estimates_error(&self) -> bool {
@@ -697,6 +763,32 @@ fn check(scene: &Scene, integrator: Integrator) -> Result<()> {
     Ok(())
 }
 
+/// The deviation ∫_a^b e^{−τ(a,t)}·Σ σᵢ(Cᵢ − C_ref) dt of one piece in closed form, as a
+/// middle and a half-width per channel: with dᵢ window i's depth on the piece and τ all of
+/// theirs, τᵢ(a,t) ≤ τ(a,t) ≤ τᵢ(a,t) + τ − dᵢ, so ∫ e^{−τ(a,t)}σᵢ dt lies in
+/// [e^{−(τ − dᵢ)}·(1 − e^{−dᵢ}), 1 − e^{−dᵢ}] (∫ e^{−τᵢ(a,t)}σᵢ dt = 1 − e^{−dᵢ} exactly). The
+/// half-width is O(dᵢ·(τ − dᵢ)): small where one Gaussian dominates or the piece is thin.
+fn deviation_bounds(
+    members: &[Member],
+    windows: &[Window],
+    renderer: &GaussianRenderer,
+    reference: DVec3,
+    tau: f64,
+) -> (DVec3, DVec3) {
+    let (mut middle, mut half) = (DVec3::ZERO, DVec3::ZERO);
+    for m in members {
+        let delta = renderer.color_of(&windows[m.window]) - reference;
+        if delta == DVec3::ZERO {
+            continue;
+        }
+        let own = -(-m.depth).exp_m1();
+        let others = (-(tau - m.depth).max(0.0)).exp();
+        middle += delta * (0.5 * own * (1.0 + others));
+        half += delta.abs() * (0.5 * own * (1.0 - others));
+    }
+    (middle, half)
+}
+
 /// Cuts the ray into `s.points`: the windows' ends and centres, thinned so that neighbouring
 /// cuts are at least [`PIECE_WIDTH`] mean standard deviations apart (the quadrature splits where
 /// a piece needs it; an evaluation costs the windows that hold the node, not the piece's), and
@@ -748,9 +840,9 @@ fn cut_pieces(s: &mut Scratch, lights: &[Light], ray: &Ray) {
     }
 }
 
-/// The smallest k ≥ 3 with M·Σᵢ σᵢ·s_max,i·√(2π)·e^{−k²/2} ≤ tol/8.
+/// The smallest k ≥ 3 with M·Σᵢ σᵢ·s_max,i·√(2π)·e^{−k²/2} ≤ [`share::FAR`]·tol.
 fn auto_cutoff(line_depth: f64, m_max: f64, tol: f64) -> f64 {
-    let ratio = 8.0 * m_max * line_depth / tol;
+    let ratio = m_max * line_depth / (share::FAR * tol);
     if ratio > 1.0 {
         (2.0 * ratio.ln()).sqrt().max(MIN_AUTO_CUTOFF)
     } else {

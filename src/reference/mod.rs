@@ -1,6 +1,7 @@
 //! The exact reference renderer (docs/design.md §3): f64 throughout, parallel over blocks of pixels with
 //! rayon, bit-identical for any thread count (each pixel is a pure function of the scene).
 
+pub mod budget;
 pub mod gaussian;
 pub mod opaque;
 pub mod quadrature;

@@ -713,3 +713,116 @@ fn a_ray_through_a_point_light_in_gaussian_gas_is_reported() {
         "{beside:?}"
     );
 }
+
+#[test]
+fn each_pixels_err_is_the_sum_of_its_parts_each_within_its_share() {
+    use pgt::reference::budget::gaussian as share;
+    // Emission over dense overlapping Gaussians (faint ones, tails and stopped rays all occur),
+    // then single-scatter with a sun and a point light (shadow rays that stop).
+    let mut rng = Rng::new(47);
+    let particles = overlapping(&mut rng, 40, 1.5);
+    let tol = 1e-5;
+    let emission = scene(particles.clone(), 12, tol, None);
+    let lit = single_scatter_scene(particles, two_lights(DVec3::new(0.3, 1.1, 0.2)), 12, tol);
+    let (mut stopped, mut left_out, mut shadow_stopped, mut bounded) = (0, 0, 0, 0);
+    for s in [&emission, &lit] {
+        let r = renderer(s);
+        for y in 0..12 {
+            for x in 0..12 {
+                let ray = s.camera.ray_at(x as f64 + 0.5, y as f64 + 0.5);
+                let (sample, parts) = r.radiance_and_parts(&ray);
+                assert_eq!(sample.error, parts.total(), "({x}, {y})");
+                assert_eq!(sample, r.radiance(&ray));
+                if sample.unconverged {
+                    continue;
+                }
+                let within = |part: DVec3, fraction: f64, what: &str| {
+                    assert!(
+                        part.max_element() <= fraction * tol * (1.0 + 1e-9),
+                        "({x}, {y}), {} lights, {what}: {part} over its share {fraction} of tol",
+                        s.lights.len()
+                    );
+                };
+                within(parts.ray_stop, share::RAY_STOP, "ray stop");
+                within(parts.bounded, share::BOUNDED, "bounded deviations");
+                within(parts.shadow_stop, share::SHADOW_STOP, "shadow stop");
+                within(
+                    parts.quadrature,
+                    share::QUADRATURE + share::SHADOW_STOP + share::BOUNDED,
+                    "quadrature",
+                );
+                if s.lights.is_empty() {
+                    // Where lights scatter, a ray's M may exceed the scene's M that chose k
+                    // (a point light near the ray), and the far part its share (§9).
+                    within(
+                        parts.left_out,
+                        share::FAINT + share::TAILS + share::FAR,
+                        "left out",
+                    );
+                    within(
+                        parts.quadrature,
+                        share::QUADRATURE + share::SHADOW_STOP,
+                        "quadrature",
+                    );
+                    assert_eq!(parts.shadow_missed, DVec3::ZERO);
+                    assert!(sample.error.max_element() <= tol);
+                } else if parts.shadow_stop != DVec3::ZERO {
+                    within(
+                        parts.quadrature,
+                        share::QUADRATURE + share::BOUNDED,
+                        "quadrature",
+                    );
+                    assert_eq!(parts.bounded, DVec3::ZERO);
+                    shadow_stopped += 1;
+                }
+                stopped += usize::from(parts.ray_stop != DVec3::ZERO);
+                bounded += usize::from(parts.bounded != DVec3::ZERO);
+                left_out += usize::from(parts.left_out != DVec3::ZERO);
+            }
+        }
+    }
+    assert!(
+        stopped > 0 && left_out > 0 && shadow_stopped > 0 && bounded > 0,
+        "a part never occurs: {stopped} stopped rays, {left_out} with depth left out, {shadow_stopped} with stopped shadow rays, {bounded} with bounded deviations"
+    );
+}
+
+/// Flat splats (one axis 10⁻³ of the others) crossing round Gaussians of other colours, as the
+/// donut's hair crosses itself: err at tol 1e-5 covers a render at tol/100 at ≥ 99.9 % of
+/// pixel channels, whichever parts (quadrature, bounded deviations, left-out depth) it holds.
+#[test]
+fn err_covers_a_hundred_times_tighter_render_of_flat_and_round_gaussians() {
+    let mut rng = Rng::new(4747);
+    let mut particles = overlapping(&mut rng, 60, 1.2);
+    for p in particles.iter_mut().step_by(2) {
+        let e = p
+            .ellipsoid
+            .unwrap_or_else(|| Ellipsoid::new(DVec3::splat(p.radius), DQuat::IDENTITY));
+        let axes = e.semi_axes();
+        *p = gaussian(
+            p.center,
+            DVec3::new(axes.x, axes.y, 1e-3 * axes.z),
+            e.rotation(),
+            p.color,
+            p.sigma * 20.0,
+        );
+    }
+    let options = RenderOptions::default();
+    let coarse = render(&scene(particles.clone(), 24, 1e-5, None), &options).unwrap();
+    let tight = render(&scene(particles, 24, 1e-7, None), &options).unwrap();
+    let (ce, te) = (coarse.error.unwrap(), tight.error.unwrap());
+    let (mut covered, mut total, mut off) = (0usize, 0usize, 0.0f32);
+    for i in 0..coarse.image.pixels.len() {
+        for c in 0..3 {
+            let diff = (coarse.image.pixels[i][c] - tight.image.pixels[i][c]).abs();
+            total += 1;
+            covered += usize::from(diff <= ce.pixels[i][c] + te.pixels[i][c]);
+            off = off.max(diff);
+        }
+    }
+    assert!(
+        covered as f64 >= 0.999 * total as f64,
+        "err covers {covered} of {total} channels"
+    );
+    assert!(off > 1e-8, "the renders agree exactly: nothing is tested");
+}

@@ -9,6 +9,8 @@
 //! | [`SHADOW_STOP_SHARE`] | 1e-3 | shadow rays that stop where their transmittance has fallen to ε ([`VolumeRenderer::shadow_cut`]) |
 //! | the rest ([`quadrature_tol`]) | 1 − 0.5e-3 − 1e-3 | the adaptive quadrature's error estimate |
 //!
+//! The shares are named in `reference::budget`, beside the Gaussian renderer's.
+//!
 //! Both bounded parts rest on a bound Qb of the light's source q_l along the rest of the ray
 //! ([`VolumeRenderer::source_bound`]): every model's q_l is non-decreasing in the colour,
 //! albedo, irradiance and shadow-ray radiance and transmittance (`OpticalModel::light_source`).
@@ -29,15 +31,13 @@ use crate::reference::quadrature::Piece;
 use crate::scene::Scene;
 use glam::DVec3;
 
-/// Part of each light's share of `tol` that the far end of a camera ray may take as a bound
-/// instead of being integrated ([`VolumeRenderer::tail_cut`]).
-pub(super) const RAY_TAIL_SHARE: f64 = 1e-3;
-
-/// Part of each light's share of `tol` that the quadrature's shadow rays may spend by stopping
-/// where their transmittance has fallen to ε ([`VolumeRenderer::shadow_cut`]): ε is this part
-/// of the share over twice the bound of q_l. Dense sets (many overlapping spheres) lose most
-/// of the length of their shadow rays behind that point; molecules rarely get that dark.
-pub(super) const SHADOW_STOP_SHARE: f64 = 1e-3;
+/// The far end of a camera ray, of each light's share of `tol` (`reference::budget`).
+pub(super) use crate::reference::budget::volume::RAY_TAIL as RAY_TAIL_SHARE;
+/// Shadow rays that stop where their transmittance has fallen to ε, of each light's share of
+/// `tol` (`reference::budget`): ε is this part of the share over twice the bound of q_l. Dense
+/// sets (many overlapping spheres) lose most of the length of their shadow rays behind that
+/// point; molecules rarely get that dark.
+pub(super) use crate::reference::budget::volume::SHADOW_STOP as SHADOW_STOP_SHARE;
 
 /// A segment of a piece whose whole contribution to a light's integral is bounded by at most
 /// this many times the light's share of tol (w·Δu·Qb, with Qb of
@@ -48,14 +48,10 @@ pub(super) const SHADOW_STOP_SHARE: f64 = 1e-3;
 /// limits trade little speed for a weaker bound (docs/performance.md, "The R5 start").
 pub(super) const R5_START_LIMIT: f64 = 10.0;
 
-/// The part of a light's share of `tol` that its quadrature may spend: what the bounded parts
-/// leave (half the ray's tail bound is err, the other half moves the value).
-pub(super) const QUADRATURE_SHARE: f64 = 1.0 - 0.5 * RAY_TAIL_SHARE - SHADOW_STOP_SHARE;
-
 /// The tolerance of one light's quadrature, given the light's `share` of `tol`.
 #[inline]
 pub(super) fn quadrature_tol(share: f64) -> f64 {
-    share * QUADRATURE_SHARE
+    share * crate::reference::budget::volume::QUADRATURE
 }
 
 impl VolumeRenderer<'_> {
