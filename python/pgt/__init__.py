@@ -12,8 +12,9 @@ as the ``pgt`` command line: the values are the CLI's, bit for bit.
     assert cmp.gate({"min_ssim": 0.95})
     cmp.write_report("report/")
 
-Scenes: load_scene, Scene.from_arrays, directional_light, point_light; load_frames -> Frames
-(trajectories, sequences, camera orbits: .frame(t) is a Scene).
+Scenes: load_scene, Scene.from_arrays, Scene.from_gaussians (3D Gaussian splatting's tensors),
+camera_from_K (K and a world-to-camera matrix as a camera), directional_light, point_light;
+load_frames -> Frames (trajectories, sequences, camera orbits: .frame(t) is a Scene).
 Rendering: render (exact, CPU), approx (GPU methods and WGSL files), approx_methods.
 Measuring: compare -> Comparison (.gate, .summary, .write_report) of two images, or
 SequenceComparison (.summary, .verdict, .passed) of two sequences of frames; sweep (an
@@ -35,6 +36,7 @@ from typing import Any, Callable, Dict, Mapping, Optional, Sequence, Tuple, Unio
 
 from . import _pgt
 from ._errors import Error, FileError, GpuError, InputError, NoAdapterError, PgtWarning
+from ._gaussians import camera_from_K
 from ._pgt import (
     ApproxResult,
     Comparison,
@@ -74,6 +76,7 @@ __all__ = [
     "approx",
     "approx_methods",
     "bench",
+    "camera_from_K",
     "compare",
     "directional_light",
     "load_frames",

@@ -42,6 +42,25 @@ class Scene:
         ambient: Optional[float] = None,
         defaults: Optional[Mapping[str, Any]] = None,
     ) -> Scene: ...
+    @staticmethod
+    def from_gaussians(
+        means: npt.ArrayLike,
+        scales: npt.ArrayLike,
+        quats: npt.ArrayLike,
+        opacities: npt.ArrayLike,
+        sh_or_colours: npt.ArrayLike,
+        *,
+        activated: bool = False,
+        sh: str = "view",
+        camera: Optional[Mapping[str, Any]] = None,
+        model: str = "emission",
+        defaults: Optional[Mapping[str, Any]] = None,
+        **scene: Any,
+    ) -> Scene:
+        """3D Gaussian splatting's tensors (log scales, w-x-y-z quaternions, logit opacities,
+        SH (n, K, 3) or colours (n, 3)) as a scene of Gaussians: the particles of a 3DGS PLY of
+        the same values, bit for bit (pgt._gaussians.from_gaussians documents the arguments)."""
+        ...
     def particles(self) -> Dict[str, npt.NDArray[np.float64]]: ...
     def camera_matrices(self, api: str = "opengl") -> Dict[str, Any]: ...
     @property
@@ -287,6 +306,17 @@ class SequenceComparison:
     def report_page(self) -> Optional[pathlib.Path]: ...
     def summary(self) -> Dict[str, Any]: ...
 
+def gaussian_particles(
+    centers: npt.ArrayLike,
+    scales: npt.ArrayLike,
+    quats: npt.ArrayLike,
+    opacities: npt.ArrayLike,
+    *,
+    sh: Optional[npt.ArrayLike] = None,
+    colors: Optional[npt.ArrayLike] = None,
+    activated: bool = False,
+    eye: Optional[Tuple[float, float, float]] = None,
+) -> Dict[str, npt.NDArray[np.float64]]: ...
 def is_sequence(path: _Path) -> bool: ...
 def compare_sequences(
     reference: _Path,

@@ -16,6 +16,7 @@ mod arrays;
 mod compare;
 mod errors;
 mod frames;
+mod gaussians;
 mod images;
 mod render;
 mod scene;
@@ -39,6 +40,7 @@ fn _pgt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("N_EXACT_ALL", pgt::approx::N_EXACT_ALL)?;
     m.add_class::<scene::Scene>()?;
     m.add_function(wrap_pyfunction!(scene::load_scene, m)?)?;
+    m.add_function(wrap_pyfunction!(gaussians::gaussian_particles, m)?)?;
     m.add_class::<frames::Frames>()?;
     m.add_function(wrap_pyfunction!(frames::load_frames, m)?)?;
     m.add_class::<render::RenderResult>()?;

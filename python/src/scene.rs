@@ -11,7 +11,7 @@ use pgt::geometry::projection::GraphicsApi;
 use pgt::scene::Light;
 use pgt::scene::{Model, ParticleInput, RenderMode, SceneLoadOptions};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyDict, PyList, PyTuple};
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -363,6 +363,23 @@ impl Scene {
         Ok(Scene {
             inner: Arc::new(scene),
         })
+    }
+
+    /// A scene of 3D Gaussians from the tensors of 3D Gaussian splatting (means, log scales,
+    /// w-x-y-z quaternions, logit opacities, SH coefficients (n, K, 3) or colours (n, 3)),
+    /// with the particles a 3DGS PLY of the same values gives (`pgt.load_scene`), bit for bit.
+    /// Implemented in Python (`pgt._gaussians.from_gaussians`, whose docstring lists the
+    /// arguments) over `Scene.from_arrays`.
+    #[staticmethod]
+    #[pyo3(signature = (*args, **kwargs))]
+    fn from_gaussians<'py>(
+        py: Python<'py>,
+        args: &Bound<'py, PyTuple>,
+        kwargs: Option<&Bound<'py, PyDict>>,
+    ) -> PyResult<Bound<'py, PyAny>> {
+        py.import("pgt._gaussians")?
+            .getattr("from_gaussians")?
+            .call(args, kwargs)
     }
 
     /// The resolved particles, as `pgt export` writes them: a dict of float64 arrays

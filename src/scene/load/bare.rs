@@ -19,10 +19,6 @@ use crate::geometry::CameraPath;
 use crate::optics::Profile;
 use std::path::Path;
 
-/// The standard deviations by which a bare file of Gaussians is framed: a splatting
-/// rasteriser's footprint is 3σ (docs/design.md §1, "A splatting file is Gaussians").
-const FRAMING_SIGMAS: f64 = 3.0;
-
 /// Whether `path`, read as `options.format` or by its extension, is a PLY of 3D Gaussian
 /// splatting.
 fn is_splatting(path: &Path, options: &SceneLoadOptions) -> bool {
@@ -103,7 +99,8 @@ pub(in crate::scene) fn load_bare(path: &Path, options: &SceneLoadOptions) -> Re
     }
     let (w, h) = options.size.unwrap_or(DEFAULT_SIZE);
     camera::check_size(&whole, w as i64, h as i64)?;
-    let camera = framed_camera(&particles, defaults.density, w, h);
+    // Gaussians are framed by their 3σ extent (`framing::extent_radius`), as in a scene file.
+    let camera = default_camera(&particles, w, h);
     // The view-dependent colour needs the eye, which the framing places: read again from it.
     if splatting && sh == ShColor::View {
         spec.sh = Some(ShColor::View);
@@ -132,26 +129,6 @@ pub(in crate::scene) fn load_bare(path: &Path, options: &SceneLoadOptions) -> Re
             lambda: render.lambda,
         },
     })
-}
-
-/// The default camera framing `particles`; Gaussians by their 3σ extent.
-fn framed_camera(
-    particles: &[crate::scene::Particle],
-    density: Profile,
-    width: u32,
-    height: u32,
-) -> crate::geometry::Camera {
-    if density != Profile::Gaussian {
-        return default_camera(particles, width, height);
-    }
-    let extent: Vec<_> = particles
-        .iter()
-        .map(|p| crate::scene::Particle {
-            radius: p.radius * FRAMING_SIGMAS,
-            ..*p
-        })
-        .collect();
-    default_camera(&extent, width, height)
 }
 
 #[cfg(test)]
@@ -290,8 +267,18 @@ mod tests {
             "{}",
             s.particles[0].color
         );
-        // Framed by the 3σ extent: farther than the 1σ framing.
-        let one_sigma = default_camera(&s.particles, 512, 512);
+        // Framed by the 3σ extent (framing::extent_radius) once, as a scene file of the same
+        // Gaussians is: farther than the framing of the same ellipsoids' 1σ bounds.
+        assert_eq!(s.camera, default_camera(&s.particles, 512, 512));
+        let one_sigma: Vec<_> = s
+            .particles
+            .iter()
+            .map(|p| crate::scene::Particle {
+                profile: Profile::Constant,
+                ..*p
+            })
+            .collect();
+        let one_sigma = default_camera(&one_sigma, 512, 512);
         assert!(
             eye.distance(s.particles[0].center)
                 > one_sigma.position.distance(s.particles[0].center)
