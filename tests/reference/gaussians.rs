@@ -106,6 +106,28 @@ fn renderer(s: &Scene) -> GaussianRenderer {
     GaussianRenderer::new(s, Integrator::Adaptive).expect("a Gaussian scene")
 }
 
+/// How many pixel channels of `coarse` lie within the two renders' err of `tight` (of how many),
+/// and the largest difference between them.
+fn coverage(
+    coarse: &pgt::reference::RenderOutput,
+    tight: &pgt::reference::RenderOutput,
+) -> (usize, usize, f32) {
+    let (ce, te) = (
+        coarse.error.as_ref().unwrap(),
+        tight.error.as_ref().unwrap(),
+    );
+    let (mut covered, mut total, mut off) = (0usize, 0usize, 0.0f32);
+    for i in 0..coarse.image.pixels.len() {
+        for c in 0..3 {
+            let diff = (coarse.image.pixels[i][c] - tight.image.pixels[i][c]).abs();
+            total += 1;
+            covered += usize::from(diff <= ce.pixels[i][c] + te.pixels[i][c]);
+            off = off.max(diff);
+        }
+    }
+    (covered, total, off)
+}
+
 #[test]
 fn one_gaussian_is_its_closed_form() {
     let p = gaussian(
@@ -372,18 +394,7 @@ fn err_covers_the_truth_on_thousands_of_overlapping_gaussians() {
     let options = RenderOptions::default();
     let coarse = render(&scene(particles.clone(), 40, 1e-3, None), &options).unwrap();
     let tight = render(&scene(particles, 40, 1e-8, None), &options).unwrap();
-    let (ce, te) = (coarse.error.unwrap(), tight.error.unwrap());
-    let (mut covered, mut total, mut off) = (0usize, 0usize, 0.0f32);
-    for i in 0..coarse.image.pixels.len() {
-        for c in 0..3 {
-            let diff = (coarse.image.pixels[i][c] - tight.image.pixels[i][c]).abs();
-            total += 1;
-            if diff <= ce.pixels[i][c] + te.pixels[i][c] {
-                covered += 1;
-            }
-            off = off.max(diff);
-        }
-    }
+    let (covered, total, off) = coverage(&coarse, &tight);
     assert!(
         covered as f64 >= 0.999 * total as f64,
         "err covers {covered} of {total} channels"
@@ -670,18 +681,7 @@ fn single_scatter_err_covers_a_much_tighter_render_with_a_light_inside_the_gas()
     let options = RenderOptions::default();
     let coarse = render(&ss(1e-2), &options).unwrap();
     let tight = render(&ss(1e-7), &options).unwrap();
-    let (ce, te) = (coarse.error.unwrap(), tight.error.unwrap());
-    let (mut covered, mut total, mut off) = (0usize, 0usize, 0.0f32);
-    for i in 0..coarse.image.pixels.len() {
-        for c in 0..3 {
-            let diff = (coarse.image.pixels[i][c] - tight.image.pixels[i][c]).abs();
-            total += 1;
-            if diff <= ce.pixels[i][c] + te.pixels[i][c] {
-                covered += 1;
-            }
-            off = off.max(diff);
-        }
-    }
+    let (covered, total, off) = coverage(&coarse, &tight);
     assert!(
         covered as f64 >= 0.999 * total as f64,
         "err covers {covered} of {total} channels"
@@ -810,16 +810,7 @@ fn err_covers_a_hundred_times_tighter_render_of_flat_and_round_gaussians() {
     let options = RenderOptions::default();
     let coarse = render(&scene(particles.clone(), 24, 1e-5, None), &options).unwrap();
     let tight = render(&scene(particles, 24, 1e-7, None), &options).unwrap();
-    let (ce, te) = (coarse.error.unwrap(), tight.error.unwrap());
-    let (mut covered, mut total, mut off) = (0usize, 0usize, 0.0f32);
-    for i in 0..coarse.image.pixels.len() {
-        for c in 0..3 {
-            let diff = (coarse.image.pixels[i][c] - tight.image.pixels[i][c]).abs();
-            total += 1;
-            covered += usize::from(diff <= ce.pixels[i][c] + te.pixels[i][c]);
-            off = off.max(diff);
-        }
-    }
+    let (covered, total, off) = coverage(&coarse, &tight);
     assert!(
         covered as f64 >= 0.999 * total as f64,
         "err covers {covered} of {total} channels"
