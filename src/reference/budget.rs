@@ -19,6 +19,7 @@
 //! |---|---|---|
 //! | [`gaussian::QUADRATURE`] | 5/16 | the quadrature's estimate of the colour deviations and the scattered light |
 //! | [`gaussian::BOUNDED`] | 1/8 | colour deviations of pieces bounded in closed form where no light scatters |
+//! | [`gaussian::SERIES`] | 1/16 | wide windows of a piece summed as polynomials where no light scatters (their remainder's bound) |
 //! | [`gaussian::SHADOW_STOP`] | 1/16 | shadow rays stopped at depth D (the quadrature's where no shadow ray can stop) |
 //! | [`gaussian::FAINT`] | 1/8 | faint Gaussians left out whole |
 //! | [`gaussian::TAILS`] | 1/8 | the tails outside the kept Gaussians' windows |
@@ -53,6 +54,10 @@ pub mod gaussian {
     /// The colour deviations of pieces bounded in closed form instead of integrated (where no
     /// light scatters), taken front to back while their half-widths fit.
     pub const BOUNDED: f64 = 1.0 / 8.0;
+    /// The windows wide on a piece, summed as one Taylor polynomial in the quadrature's
+    /// integrand where no light scatters: the bound on what that changes in the piece's
+    /// integral (`reference::series`).
+    pub const SERIES: f64 = 1.0 / 16.0;
     /// Shadow rays stopped once e^{−D}·Σ_l q̂_l ≤ this share; where no shadow ray can stop, the
     /// quadrature's.
     pub const SHADOW_STOP: f64 = 1.0 / 16.0;
@@ -66,9 +71,10 @@ pub mod gaussian {
     /// Half of the bound T·M of what lies behind a ray stopped where T·M ≤ 2·RAY_STOP·tol.
     pub const RAY_STOP: f64 = 1.0 / 16.0;
     /// Every share as err spends it, with its name.
-    pub const SHARES: [(&str, f64); 7] = [
+    pub const SHARES: [(&str, f64); 8] = [
         ("quadrature", QUADRATURE),
         ("bounded deviations", BOUNDED),
+        ("wide windows as polynomials", SERIES),
         ("shadow stop", SHADOW_STOP),
         ("faint Gaussians", FAINT),
         ("tails", TAILS),

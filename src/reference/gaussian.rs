@@ -58,6 +58,7 @@
 
 use super::budget::gaussian as share;
 use super::quadrature::{integrate_adaptive, Piece};
+use super::series::{WideSum, MAX_HALF_WIDTH};
 use super::volume::MAX_SEGMENTS;
 use super::{Integrator, RadianceEstimator, Sample};
 use crate::error::{PgtError, Result};
@@ -145,13 +146,15 @@ struct Member {
     depth: f64,
 }
 
-/// A piece that needs quadrature: its reference colour and its windows
-/// (`members[first..first + count]`).
+/// A piece that needs quadrature: its reference colour, the windows evaluated one by one
+/// (`members[first..first + count]`) and the wide ones summed as polynomials
+/// (`series[i]`, [`WideSum`]).
 #[derive(Debug, Clone, Copy)]
 struct Deviation {
     reference: DVec3,
     first: usize,
     count: usize,
+    series: Option<usize>,
 }
 
 /// The parts of one pixel's err per channel (docs/design.md §3, §9), each paid from its share
@@ -166,6 +169,9 @@ pub struct ErrorParts {
     pub bounded: DVec3,
     /// The quadrature's error estimate ([`share::QUADRATURE`]).
     pub quadrature: DVec3,
+    /// What summing the wide windows of a piece as polynomials may change in its integral
+    /// ([`share::SERIES`], `reference::series`).
+    pub series: DVec3,
     /// Shadow rays stopped at depth D: e^{−D}·Σ_l q̂_l ([`share::SHADOW_STOP`]).
     pub shadow_stop: DVec3,
     /// The shadow rays' missed depth, (L + err)·(1 − e^{−Δ_far}): unbudgeted.
@@ -181,6 +187,7 @@ impl ErrorParts {
         self.ray_stop
             + self.bounded
             + self.quadrature
+            + self.series
             + self.shadow_stop
             + self.shadow_missed
             + self.left_out
@@ -196,6 +203,7 @@ struct Scratch {
     points: Vec<f64>,
     members: Vec<Member>,
     deviations: Vec<Deviation>,
+    series: Vec<WideSum>,
     pieces: Vec<Piece>,
 }
 
@@ -495,9 +503,10 @@ impl GaussianRenderer {
         let mut stopped = false;
         s.members.clear();
         s.deviations.clear();
+        s.series.clear();
         s.pieces.clear();
-        for seg in s.points.windows(2) {
-            let (a, b) = (seg[0], seg[1]);
+        for i in 1..s.points.len() {
+            let (a, b) = (s.points[i - 1], s.points[i]);
             let first = s.members.len();
             // Windows are sorted by their start: those that start before b and end after a.
             for (k, w) in s.windows.iter_mut().enumerate() {
@@ -563,10 +572,16 @@ impl GaussianRenderer {
                     weight: transmittance,
                     tag: s.deviations.len(),
                 });
+                let series = if self.lights.is_empty() {
+                    self.sum_wide(s, (first, a, b), reference, transmittance, parts)
+                } else {
+                    None
+                };
                 s.deviations.push(Deviation {
                     reference,
                     first,
-                    count,
+                    count: s.members.len() - first,
+                    series,
                 });
             } else {
                 s.members.truncate(first);
@@ -577,6 +592,61 @@ impl GaussianRenderer {
             radiance += transmittance * self.background;
         }
         radiance
+    }
+
+    /// Sums the windows of the piece [a, b] (`s.members[first..]`) that cover it and are wide
+    /// on it (r = h/(2s) ≤ [`MAX_HALF_WIDTH`]) into one [`WideSum`] and takes them out of the
+    /// members, when at least two are and the bound on what the polynomials change, times the
+    /// piece's `weight` (its transmittance), fits what is left of [`share::SERIES`] (the bound
+    /// goes into `parts.series`); returns the sum's index in `s.series`.
+    fn sum_wide(
+        &self,
+        s: &mut Scratch,
+        (first, a, b): (usize, f64, f64),
+        reference: DVec3,
+        weight: f64,
+        parts: &mut ErrorParts,
+    ) -> Option<usize> {
+        let half = 0.5 * (b - a);
+        let wide =
+            |m: &Member, w: &Window| m.x0 == a && m.x1 == b && half <= MAX_HALF_WIDTH * w.profile.s;
+        let members = &s.members[first..];
+        let count = members
+            .iter()
+            .filter(|m| wide(m, &s.windows[m.window]))
+            .count();
+        if count < 2 {
+            return None;
+        }
+        let mut sum = WideSum::new(a, b);
+        let mut deviation_depth = DVec3::ZERO;
+        for m in members {
+            let w = &s.windows[m.window];
+            let deviation = self.color_of(w) - reference;
+            deviation_depth += m.depth * deviation.abs();
+            if wide(m, w) {
+                let p = w.profile;
+                sum.add(p.peak, p.t_star, p.s, deviation);
+            }
+        }
+        let error = weight * sum.integral_error(deviation_depth);
+        let fits = (parts.series + error).max_element() <= share::SERIES * self.tol;
+        if !fits {
+            return None;
+        }
+        parts.series += error;
+        sum.finish();
+        let mut kept = first;
+        for k in first..s.members.len() {
+            let m = s.members[k];
+            if !wide(&m, &s.windows[m.window]) {
+                s.members[kept] = m;
+                kept += 1;
+            }
+        }
+        s.members.truncate(kept);
+        s.series.push(sum);
+        Some(s.series.len() - 1)
     }
 
     /// The colour deviations of the queued pieces, and the lights' part where they scatter, by
@@ -597,11 +667,14 @@ impl GaussianRenderer {
         let mut stopped = false;
         if !s.pieces.is_empty() {
             let (windows, members, deviations) = (&s.windows, &s.members, &s.deviations);
+            let series = &s.series;
             let scatters = !self.lights.is_empty();
             let integrand = |tag: usize, t: f64| {
                 let d = &deviations[tag];
-                let mut tau = 0.0;
-                let mut sum = DVec3::ZERO;
+                let (mut tau, mut sum) = match d.series {
+                    Some(i) => series[i].at(t),
+                    None => (0.0, DVec3::ZERO),
+                };
                 let (mut sigma, mut color, mut albedo) = (0.0, DVec3::ZERO, DVec3::ZERO);
                 for m in &members[d.first..d.first + d.count] {
                     if t <= m.x0 {

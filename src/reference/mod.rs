@@ -7,6 +7,7 @@ pub mod opaque;
 pub mod quadrature;
 pub mod riemann;
 pub mod rows;
+pub mod series;
 pub mod shadow;
 pub mod volume;
 

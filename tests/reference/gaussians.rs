@@ -724,7 +724,7 @@ fn each_pixels_err_is_the_sum_of_its_parts_each_within_its_share() {
     let tol = 1e-5;
     let emission = scene(particles.clone(), 12, tol, None);
     let lit = single_scatter_scene(particles, two_lights(DVec3::new(0.3, 1.1, 0.2)), 12, tol);
-    let (mut stopped, mut left_out, mut shadow_stopped, mut bounded) = (0, 0, 0, 0);
+    let (mut stopped, mut left_out, mut shadow_stopped, mut bounded, mut series) = (0, 0, 0, 0, 0);
     for s in [&emission, &lit] {
         let r = renderer(s);
         for y in 0..12 {
@@ -745,6 +745,7 @@ fn each_pixels_err_is_the_sum_of_its_parts_each_within_its_share() {
                 };
                 within(parts.ray_stop, share::RAY_STOP, "ray stop");
                 within(parts.bounded, share::BOUNDED, "bounded deviations");
+                within(parts.series, share::SERIES, "wide windows as polynomials");
                 within(parts.shadow_stop, share::SHADOW_STOP, "shadow stop");
                 within(
                     parts.quadrature,
@@ -777,13 +778,14 @@ fn each_pixels_err_is_the_sum_of_its_parts_each_within_its_share() {
                 }
                 stopped += usize::from(parts.ray_stop != DVec3::ZERO);
                 bounded += usize::from(parts.bounded != DVec3::ZERO);
+                series += usize::from(parts.series != DVec3::ZERO);
                 left_out += usize::from(parts.left_out != DVec3::ZERO);
             }
         }
     }
     assert!(
-        stopped > 0 && left_out > 0 && shadow_stopped > 0 && bounded > 0,
-        "a part never occurs: {stopped} stopped rays, {left_out} with depth left out, {shadow_stopped} with stopped shadow rays, {bounded} with bounded deviations"
+        stopped > 0 && left_out > 0 && shadow_stopped > 0 && bounded > 0 && series > 0,
+        "a part never occurs: {stopped} stopped rays, {left_out} with depth left out, {shadow_stopped} with stopped shadow rays, {bounded} with bounded deviations, {series} with wide windows as polynomials"
     );
 }
 
