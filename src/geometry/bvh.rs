@@ -296,6 +296,18 @@ impl Bvh {
         self.traverse(ray, t_min, t_max, |index, chord, _| visit(index, chord));
     }
 
+    /// [`Bvh::visit_hits`], where `visit` may lower the far end `limit` (a front-to-back
+    /// search that learns where it can stop): the boxes wholly beyond it are skipped from then on.
+    pub fn visit_hits_narrowing(
+        &self,
+        ray: &Ray,
+        t_min: f64,
+        t_max: f64,
+        visit: impl FnMut(u32, Chord, &mut f64) -> bool,
+    ) {
+        self.traverse(ray, t_min, t_max, visit);
+    }
+
     /// Visits every sphere whose chord overlaps (t_min, limit), nearer boxes first; `visit` may
     /// lower `limit` (nearest-hit search) and returns true to stop.
     fn traverse(

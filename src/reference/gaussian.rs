@@ -62,7 +62,7 @@ use super::series::{WideSum, MAX_HALF_WIDTH};
 use super::volume::MAX_SEGMENTS;
 use super::{Integrator, RadianceEstimator, Sample};
 use crate::error::{PgtError, Result};
-use crate::geometry::{Bvh, Ellipsoid, Hit, Ray};
+use crate::geometry::{Bvh, Ellipsoid, Ray};
 use crate::optics::gaussian::{DepthFrom, GaussianAlongRay};
 use crate::optics::intervals::Interval;
 use crate::optics::light::Light;
@@ -196,7 +196,6 @@ impl ErrorParts {
 
 #[derive(Default)]
 struct Scratch {
-    hits: Vec<Hit>,
     candidates: Vec<Candidate>,
     windows: Vec<Window>,
     cuts: Vec<(f64, bool)>,
@@ -205,6 +204,14 @@ struct Scratch {
     deviations: Vec<Deviation>,
     series: Vec<WideSum>,
     pieces: Vec<Piece>,
+    /// The windows the sweep's current piece may meet, by index in `windows`, in order.
+    open: Vec<usize>,
+    /// The (end, depth) pairs of a front-to-back gather ([`narrow_reach`]).
+    reach: Vec<(f64, f64)>,
+    /// Where the last gather stopped (+∞: it gathered the whole ray).
+    reach_end: f64,
+    /// The last sweep ran out of gathered windows before the ray could stop.
+    incomplete: bool,
 }
 
 thread_local! {
@@ -383,10 +390,27 @@ impl GaussianRenderer {
         } else {
             self.typical_bound().max_element().max(f64::MIN_POSITIVE)
         };
-        let delta = self.far_depth + self.gather(ray, s, self.tol / m_budget);
-        cut_pieces(s, &self.lights, ray);
+        let depth_per_tol = self.tol / m_budget;
+        // The depth after which the sweep surely stops: T·max M ≤ 2·RAY_STOP·tol even with the
+        // faint Gaussians and the tails left out.
+        let reach_depth = if m_max.is_finite() {
+            (m_max / (2.0 * share::RAY_STOP * self.tol)).ln().max(0.0)
+                + (share::FAINT + share::TAILS) * depth_per_tol
+                + 1e-6
+        } else {
+            f64::INFINITY
+        };
         let mut parts = ErrorParts::default();
+        let mut delta = self.far_depth + self.gather(ray, s, depth_per_tol, reach_depth);
+        cut_pieces(s, &self.lights, ray);
         let mut radiance = self.sweep(s, bound, &mut parts);
+        if s.incomplete {
+            // The gathered part of the ray did not stop the sweep: the whole ray instead.
+            parts = ErrorParts::default();
+            delta = self.far_depth + self.gather(ray, s, depth_per_tol, f64::INFINITY);
+            cut_pieces(s, &self.lights, ray);
+            radiance = self.sweep(s, bound, &mut parts);
+        }
         let q = scattered.max_element();
         let stop_depth = if q > 0.0 && q.is_finite() {
             (q / (share::SHADOW_STOP * self.tol)).ln().max(0.0)
@@ -424,27 +448,49 @@ impl GaussianRenderer {
     /// Fills `s.windows` with the Gaussians the ray keeps (sorted by window start) and
     /// returns the optical depth left out of them: the faint ones left out whole, within
     /// [`share::FAINT`] of `depth_per_tol` (the depth whose M·Δ is tol), and the tails outside
-    /// the windows, within [`share::TAILS`] of it.
-    fn gather(&self, ray: &Ray, s: &mut Scratch, depth_per_tol: f64) -> f64 {
+    /// the windows, within [`share::TAILS`] of it. With a finite `reach_depth`, the gather goes
+    /// front to back and stops at a `s.reach_end` by which the Gaussians met so far hold that
+    /// much depth ([`GaussianRenderer::narrow_reach`]); the Gaussians whose k-σ ellipsoid starts
+    /// beyond it are not gathered (their depth before it is in the far depth).
+    fn gather(&self, ray: &Ray, s: &mut Scratch, depth_per_tol: f64, reach_depth: f64) -> f64 {
         let mut delta = 0.0;
-        self.bvh.all_hits(ray, 0.0, f64::INFINITY, &mut s.hits);
         s.candidates.clear();
-        for h in &s.hits {
-            let g = &self.gaussians[h.index as usize];
-            let profile = GaussianAlongRay::new(ray, g.center, &g.shape, g.sigma);
-            // Wholly in front of the eye (beyond 9 s the part behind is below 1e-18 of it) the
-            // depth in front is the whole line's, an upper bound, without an erfc.
-            let front = if profile.t_star >= 9.0 * profile.s {
-                profile.total_depth()
-            } else {
-                profile.optical_depth(0.0, f64::INFINITY)
-            };
-            s.candidates.push(Candidate {
-                index: h.index,
-                profile,
-                front,
+        s.reach.clear();
+        let (mut pending, mut next_check) = (0.0, reach_depth);
+        let mut reach_end = f64::INFINITY;
+        let (candidates, reach) = (&mut s.candidates, &mut s.reach);
+        self.bvh
+            .visit_hits_narrowing(ray, 0.0, f64::INFINITY, |index, _, limit| {
+                let g = &self.gaussians[index as usize];
+                let profile = GaussianAlongRay::new(ray, g.center, &g.shape, g.sigma);
+                // Wholly in front of the eye (beyond 9 s the part behind is below 1e-18 of it)
+                // the depth in front is the whole line's, an upper bound, without an erfc.
+                let front = if profile.t_star >= 9.0 * profile.s {
+                    profile.total_depth()
+                } else {
+                    profile.optical_depth(0.0, f64::INFINITY)
+                };
+                candidates.push(Candidate {
+                    index,
+                    profile,
+                    front,
+                });
+                // A lower bound of its depth over [0, t* + 3s]: what is in front less the
+                // tail beyond 3 s (≤ 0.00135 of the whole) and the 9 s shortcut's excess.
+                let end = profile.t_star + 3.0 * profile.s;
+                let within = front - profile.total_depth() * (TAIL_BEYOND_3S + 1e-15);
+                if reach_depth.is_finite() && end < *limit && end > 0.0 && within > 0.0 {
+                    reach.push((end, within));
+                    pending += within;
+                    if pending >= next_check {
+                        (*limit, pending) = narrow_reach(reach, reach_depth);
+                        reach_end = *limit;
+                        next_check = pending + REACH_RECHECK * reach_depth;
+                    }
+                }
+                false
             });
-        }
+        s.reach_end = reach_end;
         // The smallest first, left out while they fit half the budget.
         s.candidates
             .sort_unstable_by(|a, b| a.front.total_cmp(&b.front).then(a.index.cmp(&b.index)));
@@ -505,33 +551,41 @@ impl GaussianRenderer {
         s.deviations.clear();
         s.series.clear();
         s.pieces.clear();
+        s.open.clear();
+        let mut next = 0;
         for i in 1..s.points.len() {
             let (a, b) = (s.points[i - 1], s.points[i]);
             let first = s.members.len();
-            // Windows are sorted by their start: those that start before b and end after a.
-            for (k, w) in s.windows.iter_mut().enumerate() {
-                if w.lo >= b {
-                    break;
-                }
-                if w.hi > a {
-                    let (x0, x1) = (w.lo.max(a), w.hi.min(b));
-                    // The erfc at x0 is the one the last piece computed at its end, where the
-                    // window goes on.
-                    let from = match w.tail_at {
-                        Some((x, tail)) if x == x0 => w.profile.depth_from_tail(x0, tail),
-                        _ => w.profile.depth_from(x0),
-                    };
-                    let (depth, tail) = from.to_with_tail(x1);
-                    w.tail_at = Some((x1, tail));
-                    s.members.push(Member {
-                        window: k,
-                        x0,
-                        x1,
-                        from,
-                        depth,
-                    });
-                }
+            // Windows are sorted by their start: those that start before b join the open ones,
+            // in their order; an open one that ends by a is done.
+            while next < s.windows.len() && s.windows[next].lo < b {
+                s.open.push(next);
+                next += 1;
             }
+            let (windows, members) = (&mut s.windows, &mut s.members);
+            s.open.retain(|&k| {
+                let w = &mut windows[k];
+                if w.hi <= a {
+                    return false;
+                }
+                let (x0, x1) = (w.lo.max(a), w.hi.min(b));
+                // The erfc at x0 is the one the last piece computed at its end, where the
+                // window goes on.
+                let from = match w.tail_at {
+                    Some((x, tail)) if x == x0 => w.profile.depth_from_tail(x0, tail),
+                    _ => w.profile.depth_from(x0),
+                };
+                let (depth, tail) = from.to_with_tail(x1);
+                w.tail_at = Some((x1, tail));
+                members.push(Member {
+                    window: k,
+                    x0,
+                    x1,
+                    from,
+                    depth,
+                });
+                true
+            });
             let count = s.members.len() - first;
             if count == 0 {
                 continue;
@@ -588,7 +642,18 @@ impl GaussianRenderer {
             }
             transmittance *= (-tau).exp();
         }
-        if !stopped {
+        s.incomplete = false;
+        if !stopped && s.reach_end.is_finite() {
+            // The gather stopped at reach_end: what lies beyond the last window is in
+            // [0, T·M], bounded as a stopped ray's rest where it fits, else gathered whole.
+            if transmittance * m_max <= 2.0 * share::RAY_STOP * self.tol {
+                let rest = 0.5 * transmittance * bound;
+                radiance += rest;
+                parts.ray_stop += rest;
+            } else {
+                s.incomplete = true;
+            }
+        } else if !stopped {
             radiance += transmittance * self.background;
         }
         radiance
@@ -911,6 +976,30 @@ fn cut_pieces(s: &mut Scratch, lights: &[Light], ray: &Ray) {
     if s.points.last().is_some_and(|&last| last < end) {
         s.points.push(end);
     }
+}
+
+/// The depth of a 1D Gaussian beyond 3 standard deviations on one side, rounded up:
+/// erfc(3/√2)/2 = 0.0013499.
+const TAIL_BEYOND_3S: f64 = 0.00135;
+
+/// A front-to-back gather looks for a nearer end again each time the depth it has met grows
+/// by this fraction of the depth it needs (each look sorts what it holds).
+const REACH_RECHECK: f64 = 0.25;
+
+/// The smallest end t of the `(end, depth)` pairs by which the depths of the pairs ending no
+/// later reach `depth`, with their sum; the pairs beyond it are dropped.
+fn narrow_reach(reach: &mut Vec<(f64, f64)>, depth: f64) -> (f64, f64) {
+    reach.sort_unstable_by(|a, b| a.0.total_cmp(&b.0));
+    let mut sum = 0.0;
+    for k in 0..reach.len() {
+        sum += reach[k].1;
+        if sum >= depth {
+            let end = reach[k].0;
+            reach.truncate(k + 1);
+            return (end, sum);
+        }
+    }
+    (f64::INFINITY, sum)
 }
 
 /// The smallest k ≥ 3 with M·Σᵢ σᵢ·s_max,i·√(2π)·e^{−k²/2} ≤ [`share::FAR`]·tol.

@@ -237,6 +237,55 @@ fn overlapping(rng: &mut Rng, n: usize, spread: f64) -> Vec<Particle> {
         .collect()
 }
 
+/// A thick cloud that stops every ray long before its far side: the gather goes front to back
+/// and leaves out what lies behind where the ray stops; the result still matches a brute-force
+/// Riemann sum over every Gaussian within err, and err keeps to tol.
+#[test]
+fn a_ray_stopped_in_a_thick_cloud_matches_a_riemann_sum_over_every_gaussian() {
+    let mut rng = Rng::new(4701);
+    let particles: Vec<Particle> = (0..240)
+        .map(|_| {
+            let c = DVec3::new(
+                rng.range(-1.5, 1.5),
+                rng.range(-1.5, 1.5),
+                rng.range(-2.0, 6.0),
+            );
+            let std = DVec3::new(
+                rng.range(0.2, 0.5),
+                rng.range(0.2, 0.5),
+                rng.range(0.2, 0.5),
+            );
+            gaussian(c, std, turned(rng.range(0.0, 3.0)), rng.vec3(0.0, 1.0), 3.0)
+        })
+        .collect();
+    let tol = 1e-5;
+    let s = scene(particles.clone(), 16, tol, None);
+    let r = renderer(&s);
+    let bg = s.render.background;
+    for (x, y) in [(8.0, 8.0), (6.5, 9.5), (9.2, 7.1)] {
+        let ray = s.camera.ray_at(x, y);
+        let fine = riemann(&particles, bg, &ray, 24.0, 100_000);
+        let coarse = riemann(&particles, bg, &ray, 24.0, 50_000);
+        let riemann_error = (fine - coarse).abs();
+        let (got, parts) = r.radiance_and_parts(&ray);
+        assert!(
+            parts.ray_stop != DVec3::ZERO,
+            "({x}, {y}) did not stop: {got:?}"
+        );
+        assert!(got.error.max_element() <= tol, "({x}, {y}): {got:?}");
+        for c in 0..3 {
+            assert!(
+                (got.radiance[c] - fine[c]).abs() <= got.error[c] + riemann_error[c] + 1e-12,
+                "({x}, {y}) channel {c}: {} against the Riemann sum {} (err {}, Riemann {})",
+                got.radiance[c],
+                fine[c],
+                got.error[c],
+                riemann_error[c]
+            );
+        }
+    }
+}
+
 #[test]
 fn overlapping_gaussians_match_a_riemann_sum_of_1e5_steps() {
     let mut rng = Rng::new(35);
