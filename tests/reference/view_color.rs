@@ -1,0 +1,49 @@
+//! The view-dependent colour follows the camera (docs/design.md §9, "3D Gaussian splatting
+//! PLY"): a Gaussian with a strong degree-1 SH term seen by a sequence of two cameras on opposite
+//! sides renders, in each frame, the colour 3DGS computes for that frame's eye (the closed form
+//! written out in `support::splat`), not the colour of frame 0's eye.
+
+use crate::support::splat::{sh_two_eyes_color, sh_two_eyes_scene};
+use glam::DVec3;
+use pgt::reference::{render, RenderOptions};
+use pgt::scene::{SceneFrames, SceneLoadOptions};
+
+#[test]
+fn each_frame_of_a_camera_sequence_has_the_sh_colour_of_its_own_eye() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = sh_two_eyes_scene(dir.path());
+    let frames = SceneFrames::load(&path, &SceneLoadOptions::default()).unwrap();
+    assert_eq!(frames.frame_count(), Some(2));
+    let mut centre = Vec::new();
+    for (k, eye_z, z_dir) in [(0, -5.0, 1.0), (1, 5.0, -1.0)] {
+        let scene = frames.frame(k).unwrap();
+        assert!((scene.camera.position - DVec3::new(0.0, 0.0, eye_z)).length() < 1e-12);
+        let want_color = sh_two_eyes_color(z_dir);
+        let got_color = scene.particles[0].color;
+        assert!(
+            (got_color - want_color).length() < 1e-12,
+            "frame {k}: colour {got_color} vs {want_color}"
+        );
+        // The centre pixel's ray passes through the centre of the isotropic Gaussian: its
+        // opacity is α = sigmoid(0) = ½, on black the pixel is ½·C.
+        let out = render(&scene, &RenderOptions::default()).unwrap();
+        let err = out.error.unwrap().get(4, 4);
+        let got = out.image.get(4, 4);
+        for c in 0..3 {
+            let want = 0.5 * want_color[c];
+            assert!(
+                (got[c] as f64 - want).abs() <= err[c] as f64 + 1e-6,
+                "frame {k} channel {c}: {} vs {want} (err {})",
+                got[c],
+                err[c]
+            );
+        }
+        centre.push(got);
+    }
+    // The two eyes see different colours: red bright from a.jpg, dim from b.jpg.
+    assert!(centre[0][0] - centre[1][0] > 0.3, "{centre:?}");
+    assert!(centre[1][1] - centre[0][1] > 0.2, "{centre:?}");
+    // Scene::load (a still render) is frame 0.
+    let still = pgt::Scene::load(&path, &SceneLoadOptions::default()).unwrap();
+    assert_eq!(still.particles, frames.frame(0).unwrap().particles);
+}
