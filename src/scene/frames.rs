@@ -172,8 +172,9 @@ impl SceneFrames {
     }
 
     /// The scene of frame `index`: the static particles of frame 0, each playing include's
-    /// particles of its source frame, the camera of the path. A frame past the end, or a frame
-    /// a source cannot read, is an error naming the file and the frame.
+    /// particles of its source frame, the camera of the path, and the particles with SH
+    /// coefficients coloured for that camera's eye. A frame past the end, or a frame a source
+    /// cannot read, is an error naming the file and the frame.
     pub fn frame(&self, index: usize) -> Result<Scene> {
         if let Some(n) = self.frame_count.filter(|&n| index >= n) {
             return Err(PgtError::in_file(
@@ -221,9 +222,7 @@ impl SceneFrames {
             provenance: self.first.provenance.clone(),
         })
     }
-}
 
-impl SceneFrames {
     /// Appends frame 0's particles `run` (between playing includes) to `particles`, those with
     /// SH coefficients coloured for `eye`.
     fn copy_still(&self, particles: &mut Vec<Particle>, run: std::ops::Range<usize>, eye: DVec3) {
