@@ -47,3 +47,29 @@ fn each_frame_of_a_camera_sequence_has_the_sh_colour_of_its_own_eye() {
     let still = pgt::Scene::load(&path, &SceneLoadOptions::default()).unwrap();
     assert_eq!(still.particles, frames.frame(0).unwrap().particles);
 }
+
+/// The render hash that ties parts and skipped frames to one render (`pgt::parts`) sees the SH
+/// coefficients through the colours they give each frame: a file that differs in one degree-1
+/// coefficient hashes differently in the frame whose eye sees it, the same file the same.
+#[test]
+fn the_render_hash_follows_the_sh_coefficients() {
+    let dir = tempfile::tempdir().unwrap();
+    let path = sh_two_eyes_scene(dir.path());
+    let hash = |k: usize| {
+        let frames = SceneFrames::load(&path, &SceneLoadOptions::default()).unwrap();
+        pgt::parts::render_hash(&frames.frame(k).unwrap(), &RenderOptions::default())
+    };
+    let before = [hash(0), hash(1)];
+    assert_eq!(before, [hash(0), hash(1)]);
+    // Red's z coefficient 0.75 → 0.5 (the only 0.75 of the file).
+    let ply = dir.path().join("g.ply");
+    let mut bytes = std::fs::read(&ply).unwrap();
+    let at = bytes
+        .windows(4)
+        .position(|w| w == 0.75f32.to_le_bytes())
+        .unwrap();
+    bytes[at..at + 4].copy_from_slice(&0.5f32.to_le_bytes());
+    std::fs::write(&ply, bytes).unwrap();
+    assert_ne!(hash(0), before[0]);
+    assert_ne!(hash(1), before[1]);
+}
