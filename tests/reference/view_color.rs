@@ -73,3 +73,31 @@ fn the_render_hash_follows_the_sh_coefficients() {
     assert_ne!(hash(0), before[0]);
     assert_ne!(hash(1), before[1]);
 }
+
+/// An include that plays numbered PLY files (`sequence`) keeps the coefficients of every frame
+/// it reads: frame 1's Gaussian has the colour of the eye, not the DC colour its records carry.
+#[test]
+fn a_sequence_of_ply_files_keeps_the_view_colour_in_every_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    sh_two_eyes_scene(dir.path());
+    for k in 0..2 {
+        std::fs::copy(
+            dir.path().join("g.ply"),
+            dir.path().join(format!("g_{k}.ply")),
+        )
+        .unwrap();
+    }
+    let path = dir.path().join("seq.toml");
+    std::fs::write(
+        &path,
+        "[camera]\nposition = [0.0, 0.0, 5.0]\nlook_at = [0.0, 0.0, 0.0]\n[render]\nmodel = \"emission\"\n[[include]]\nsequence = \"g_%d.ply\"\nsh = \"view\"\ndensity = \"gaussian\"\n",
+    )
+    .unwrap();
+    let frames = SceneFrames::load(&path, &SceneLoadOptions::default()).unwrap();
+    assert_eq!(frames.frame_count(), Some(2));
+    let want = sh_two_eyes_color(-1.0);
+    for k in 0..2 {
+        let got = frames.frame(k).unwrap().particles[0].color;
+        assert!((got - want).length() < 1e-12, "frame {k}: {got} vs {want}");
+    }
+}
