@@ -93,3 +93,37 @@ def test_each_frame_renders_as_pgt_render_frames_writes_it(moving, tmp_path, run
         cli = out / f"f_{t}.exr"
         np.testing.assert_array_equal(bits(result.image), bits(pgt.read_image(cli)))
         np.testing.assert_array_equal(bits(result.err), bits(pgt.read_image(cli, layer="err")))
+
+
+def test_sh_colours_follow_each_frames_camera(tmp_path):
+    """A Gaussian whose degree-1 SH has a strong z term, seen by a COLMAP sequence of two
+    cameras on opposite sides: each frame's colour is 3DGS's computeColorFromSH for its own eye,
+    written out here (0.5 + C1·z·coefficient, C1 = ½√(3/π))."""
+    import math
+    import struct
+
+    names = ["x", "y", "z", "nx", "ny", "nz", "f_dc_0", "f_dc_1", "f_dc_2"]
+    names += [f"f_rest_{k}" for k in range(9)]
+    names += ["opacity", "scale_0", "scale_1", "scale_2", "rot_0", "rot_1", "rot_2", "rot_3"]
+    # f_rest channel-major: red 1..3, green 1..3, blue 1..3; index 1 of each is the z term.
+    row = [0.0] * 9 + [0.0, 0.75, 0.0, 0.0, -0.5, 0.0, 0.25, 0.0, 0.0]
+    row += [0.0] + [math.log(0.5)] * 3 + [1.0, 0.0, 0.0, 0.0]
+    head = "ply\nformat binary_little_endian 1.0\nelement vertex 1\n"
+    head += "".join(f"property float {n}\n" for n in names) + "end_header\n"
+    (tmp_path / "g.ply").write_bytes(head.encode() + struct.pack(f"<{len(row)}f", *row))
+    sparse = tmp_path / "sparse"
+    sparse.mkdir()
+    (sparse / "cameras.txt").write_text("1 PINHOLE 9 9 12 12 4.5 4.5\n")
+    # a.jpg at (0, 0, -5) looking along +z; b.jpg (qvec (0, 0, 1, 0)) at (0, 0, 5) along -z.
+    (sparse / "images.txt").write_text("1 1 0 0 0 0 0 5 1 a.jpg\n\n2 0 0 1 0 0 0 5 1 b.jpg\n\n")
+    scene = tmp_path / "s.toml"
+    scene.write_text(
+        '[camera]\nfrom = "sparse"\n[render]\nmodel = "emission"\n'
+        '[[include]]\npath = "g.ply"\nsh = "view"\ndensity = "gaussian"\n'
+    )
+    frames = pgt.load_frames(scene)
+    assert len(frames) == 2
+    c1 = 0.5 * math.sqrt(3.0 / math.pi)
+    for t, z in ((0, 1.0), (1, -1.0)):
+        want = np.maximum(0.5 + c1 * z * np.array([0.75, -0.5, 0.0]), 0.0)
+        np.testing.assert_allclose(frames.frame(t).particles()["color"][0], want, rtol=0, atol=1e-12)

@@ -138,6 +138,7 @@ pub fn atoms_to_particles(
         return Ok(LoadedParticles {
             records: Vec::new(),
             warnings,
+            sh: None,
         });
     }
     let model = select_model(spec, &atoms, &mut warnings)?;
@@ -145,7 +146,11 @@ pub fn atoms_to_particles(
     let kept = resolve_alternate_locations(&spec.path, atoms, model, &mut warnings);
     let kept = apply_filters(spec, kept, model)?;
     let records = make_records(spec, kept, &mut warnings);
-    Ok(LoadedParticles { records, warnings })
+    Ok(LoadedParticles {
+        records,
+        warnings,
+        sh: None,
+    })
 }
 
 /// The model numbers in order of first appearance.

@@ -65,6 +65,9 @@ pub fn finish_frame(
         ));
     }
     super::apply_include_options(spec, &mut loaded.records);
+    if spec.color_by == super::ColorBy::Uniform {
+        loaded.sh = None;
+    }
     super::check_records(path, &loaded.records)?;
     Ok(loaded)
 }

@@ -213,7 +213,11 @@ pub fn read(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
             ),
         ));
     }
-    Ok(LoadedParticles { records, warnings })
+    Ok(LoadedParticles {
+        records,
+        warnings,
+        sh: None,
+    })
 }
 
 /// The particles of frame `frame`, whose bytes `window` start at file offset `base`. Version 1.3
@@ -332,7 +336,11 @@ impl super::frame_source::FrameSource for MmpldFrames {
             &self.spec,
             path,
             index,
-            LoadedParticles { records, warnings },
+            LoadedParticles {
+                records,
+                warnings,
+                sh: None,
+            },
         )?;
         Ok(super::frame_source::Frame {
             index,

@@ -48,7 +48,9 @@ pub mod xtc;
 pub mod xyz_csv;
 
 pub use profile::Profile;
-pub use record::{ColorBy, EllipsoidRecord, IncludeSpec, ParticleRecord, ShColor, ShOrder};
+pub use record::{
+    ColorBy, EllipsoidRecord, IncludeSpec, ParticleRecord, ShCoefficients, ShColor, ShOrder,
+};
 
 use crate::error::{PgtError, Result};
 use std::path::Path;
@@ -60,6 +62,9 @@ pub struct LoadedParticles {
     pub records: Vec<ParticleRecord>,
     /// Remarks for the user, each naming the file.
     pub warnings: Vec<String>,
+    /// The SH coefficients of the records, one entry per record, where the include asks for
+    /// the view-dependent colour of a 3D Gaussian splatting PLY (`sh = "view"`, degree ≥ 1).
+    pub sh: Option<ShCoefficients>,
 }
 
 /// The one signature of every particle reader: the include (its `path` names the file in
@@ -291,6 +296,10 @@ pub fn load_bytes(spec: &IncludeSpec, format: &Format, bytes: &[u8]) -> Result<L
         return Err(no_particles(spec, format, bytes.len(), &loaded.warnings));
     }
     apply_include_options(spec, &mut loaded.records);
+    if spec.color_by == ColorBy::Uniform {
+        // No particle keeps a colour of its own, the view-dependent one included.
+        loaded.sh = None;
+    }
     check_records(&spec.path, &loaded.records)?;
     Ok(loaded)
 }

@@ -88,6 +88,41 @@ pub enum ShColor {
     View,
 }
 
+/// The SH coefficients of a file's particles where `sh = "view"` asks for the view-dependent
+/// colour (docs/design.md §9, "3D Gaussian splatting PLY"): kept beside the records so that the
+/// scene evaluates them for the eye of each frame ([`ShCoefficients::color`]), not once for
+/// one eye when the file is read.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ShCoefficients {
+    /// Coefficients per particle and channel: 4, 9 or 16 (degree 1 to 3; degree 0 has no
+    /// view-dependent part and keeps no table).
+    pub per_particle: usize,
+    /// RGB of each coefficient, particle after particle, in the order of the records: the DC
+    /// term first, then degree 1 and up in the order of [`crate::formats::ply::view_color`].
+    pub values: Vec<DVec3>,
+}
+
+impl ShCoefficients {
+    /// Particle `i`'s colour seen from `eye`: the reference rasteriser's `computeColorFromSH`
+    /// for the direction from the eye to `center`, clamped at 0 (the PLY reader's colour for
+    /// the same eye, bit for bit).
+    pub fn color(&self, i: usize, center: DVec3, eye: DVec3) -> DVec3 {
+        let k = self.per_particle;
+        let c = &self.values[i * k..(i + 1) * k];
+        crate::formats::ply::view_color(c[0], &c[1..], center - eye).max(DVec3::ZERO)
+    }
+
+    /// The number of particles the table holds.
+    pub fn len(&self) -> usize {
+        self.values.len() / self.per_particle.max(1)
+    }
+
+    /// Whether the table holds no particle.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+}
+
 /// The order of the `f_rest_*` coefficients of a 3D Gaussian splatting PLY.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, Deserialize, serde::Serialize)]
 #[serde(rename_all = "kebab-case")]
@@ -152,8 +187,9 @@ pub struct IncludeSpec {
     pub sh: Option<ShColor>,
     /// 3DGS PLY: the order of `f_rest_*` (channel-major by default).
     pub sh_order: Option<ShOrder>,
-    /// The scene camera's position, where `sh = "view"` needs it: set by scene validation,
-    /// never read from the file.
+    /// 3DGS PLY with `sh = "view"`: the eye the reader evaluates the records' colours for;
+    /// `None`: the DC colour, the coefficients kept in [`super::LoadedParticles::sh`] for the
+    /// scene to evaluate per frame. Never read from the file.
     #[serde(skip)]
     pub view_from: Option<glam::DVec3>,
     /// Forces a file format whatever the extension: the name of a particle format of

@@ -165,6 +165,7 @@ impl FrameSource for TopologyTrajectory {
         let loaded = LoadedParticles {
             records,
             warnings: Vec::new(),
+            sh: None,
         };
         Ok(Frame {
             index,

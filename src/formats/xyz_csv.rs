@@ -176,7 +176,11 @@ fn read_xyz_from(spec: &IncludeSpec, bytes: &[u8], first_line: usize) -> Result<
             super::elements::FALLBACK_RADIUS
         ));
     }
-    Ok(LoadedParticles { records, warnings })
+    Ok(LoadedParticles {
+        records,
+        warnings,
+        sh: None,
+    })
 }
 
 /// How far a row's `opacity` may be from the opacity its `sigma` gives, 1 − e^{−2rσ}: both
@@ -555,7 +559,11 @@ pub fn read_csv(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
             path.display()
         ));
     }
-    Ok(LoadedParticles { records, warnings })
+    Ok(LoadedParticles {
+        records,
+        warnings,
+        sh: None,
+    })
 }
 
 #[cfg(test)]

@@ -45,6 +45,10 @@ pub(super) struct CameraTable {
     pub from: Option<String>,
     /// With `from`: the one image whose camera this is; without it every image is a frame.
     pub image: Option<String>,
+    /// With `from` a `transforms.json`: nerfstudio's `dataparser_transforms.json` of the trained
+    /// model, which maps the dataset's cameras into the model's frame (relative to the scene
+    /// file).
+    pub dataparser: Option<String>,
     pub width: Option<i64>,
     pub height: Option<i64>,
     /// `[camera.orbit]`: the camera turns about an axis (docs/design.md §10).

@@ -10,17 +10,22 @@
 //! scene's frame count (without a playing include the count is open: only the camera moves).
 //! Scene frame i shows source frame `start + i·step` of each playing include.
 //!
+//! Every frame's particles with SH coefficients (`sh = "view"`) take the colour seen from that
+//! frame's camera position ([`super::view_color`]).
+//!
 //! Frame 0 is [`Scene::load`]'s scene; [`SceneFrames::frame`] reads one frame of each playing
 //! include on demand (nothing holds more than the frame being built) and is `&self`, so workers
 //! may build different frames at once.
 
 use super::load::{load_bare, load_toml, IncludeGroup, Loaded, ParticleMaker};
+use super::view_color::{recolor, ShRun};
 use super::{Scene, SceneLoadOptions};
 use crate::error::{PgtError, Result};
 use crate::formats::frames::{open_frames, uses_frames, FrameInfo, FrameSelection, FrameSource};
 use crate::formats::{format_of, IncludeSpec};
 use crate::geometry::CameraPath;
 use crate::optics::particle::Particle;
+use glam::DVec3;
 use std::path::Path;
 
 /// An include whose particles change with the frame.
@@ -42,6 +47,10 @@ pub struct SceneFrames {
     playing: Vec<Playing>,
     maker: ParticleMaker,
     frame_count: Option<usize>,
+    /// The SH coefficients of the includes that do not play (`sh = "view"`): every frame's
+    /// particles of these runs take the colour seen from that frame's eye
+    /// ([`super::view_color`]).
+    still_sh: Vec<ShRun>,
 }
 
 impl std::fmt::Debug for SceneFrames {
@@ -79,8 +88,16 @@ impl SceneFrames {
             maker,
         } = loaded;
         let mut playing: Vec<Playing> = Vec::new();
+        let mut still_sh = Vec::new();
         for group in &includes {
-            if let Some(p) = open_playing(&scene, group)? {
+            let opened = open_playing(&scene, group)?;
+            if let (None, Some(sh)) = (&opened, &group.sh) {
+                still_sh.push(ShRun {
+                    range: group.range.clone(),
+                    sh: sh.clone(),
+                });
+            }
+            if let Some(p) = opened {
                 if let Some(first) = playing.first() {
                     if first.selection.len() != p.selection.len() {
                         return Err(PgtError::Input {
@@ -118,6 +135,7 @@ impl SceneFrames {
             playing,
             maker,
             frame_count,
+            still_sh,
         })
     }
 
@@ -154,8 +172,9 @@ impl SceneFrames {
     }
 
     /// The scene of frame `index`: the static particles of frame 0, each playing include's
-    /// particles of its source frame, the camera of the path. A frame past the end, or a frame
-    /// a source cannot read, is an error naming the file and the frame.
+    /// particles of its source frame, the camera of the path, and the particles with SH
+    /// coefficients coloured for that camera's eye. A frame past the end, or a frame a source
+    /// cannot read, is an error naming the file and the frame.
     pub fn frame(&self, index: usize) -> Result<Scene> {
         if let Some(n) = self.frame_count.filter(|&n| index >= n) {
             return Err(PgtError::in_file(
@@ -173,25 +192,26 @@ impl SceneFrames {
                 ..self.first.clone()
             });
         }
+        let eye = camera.position;
+        let follows = self.maker.albedo_follows();
         let mut particles: Vec<Particle> = Vec::with_capacity(self.first.particles.len());
         let mut warnings = Vec::new();
         let mut taken = 0usize;
         for p in &self.playing {
-            particles.extend_from_slice(
-                self.first
-                    .particles
-                    .get(taken..p.range.start)
-                    .unwrap_or_default(),
-            );
+            self.copy_still(&mut particles, taken..p.range.start, eye);
             taken = p.range.end;
             let source_index = p.selection.source_index(index).unwrap_or(p.selection.start);
             let frame = p.source.read_frame(source_index)?;
+            let start = particles.len();
             for rec in &frame.particles.records {
                 particles.push(self.maker.particle(&p.record_path, rec, p.density)?);
             }
+            if let Some(sh) = &frame.particles.sh {
+                recolor(&mut particles[start..], sh, eye, follows);
+            }
             warnings.extend(frame.particles.warnings);
         }
-        particles.extend_from_slice(self.first.particles.get(taken..).unwrap_or_default());
+        self.copy_still(&mut particles, taken..self.first.particles.len(), eye);
         Ok(Scene {
             source: self.first.source.clone(),
             camera,
@@ -201,6 +221,19 @@ impl SceneFrames {
             warnings,
             provenance: self.first.provenance.clone(),
         })
+    }
+
+    /// Appends frame 0's particles `run` (between playing includes) to `particles`, those with
+    /// SH coefficients coloured for `eye`.
+    fn copy_still(&self, particles: &mut Vec<Particle>, run: std::ops::Range<usize>, eye: DVec3) {
+        let offset = particles.len();
+        particles.extend_from_slice(self.first.particles.get(run.clone()).unwrap_or_default());
+        for r in &self.still_sh {
+            if r.range.start >= run.start && r.range.end <= run.end {
+                let at = offset + r.range.start - run.start..offset + r.range.end - run.start;
+                recolor(&mut particles[at], &r.sh, eye, self.maker.albedo_follows());
+            }
+        }
     }
 }
 

@@ -11,6 +11,7 @@ mod framing;
 mod load;
 mod provenance;
 pub mod summary;
+mod view_color;
 
 pub use crate::formats::{ColorBy, IncludeSpec, ParticleRecord};
 pub use frames::SceneFrames;

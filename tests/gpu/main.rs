@@ -17,3 +17,4 @@ mod layout;
 mod methods;
 mod raster;
 mod sorted_blend;
+mod view_color;

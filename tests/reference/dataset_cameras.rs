@@ -281,6 +281,121 @@ fn an_off_centre_principal_point_and_unequal_focal_lengths_render_the_closed_for
     assert!(inside > 50 && outside > 50, "{inside} {outside}");
 }
 
+/// nerfstudio's dataparser transform, worked by hand: transform = Rz(90°) with translation
+/// (0.5, −0.25, 0.1), scale 0.5, on the camera-to-world of eye (1, 2, 3) with the identity
+/// rotation. c2w' = [T; 0 0 0 1]·c2w: the eye 0.5·(Rz·(1, 2, 3) + t) = 0.5·((−2, 1, 3) +
+/// (0.5, −0.25, 0.1)) = (−0.75, 0.375, 1.55); the axes Rz·x = y (right), Rz·y = −x (up),
+/// forward −z as before; the intrinsics unchanged.
+#[test]
+fn a_nerfstudio_dataparser_transform_maps_the_cameras_into_the_models_frame() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write(
+        d,
+        "transforms.json",
+        r#"{"fl_x": 30, "w": 40, "h": 20,
+            "frames": [{"file_path": "x.png", "transform_matrix": [[1,0,0,1],[0,1,0,2],[0,0,1,3],[0,0,0,1]]}]}"#,
+    );
+    write(
+        d,
+        "dp.json",
+        r#"{"transform": [[0, -1, 0, 0.5], [1, 0, 0, -0.25], [0, 0, 1, 0.1]], "scale": 0.5}"#,
+    );
+    let scene = write(
+        d,
+        "s.toml",
+        "[camera]\nfrom = \"transforms.json\"\ndataparser = \"dp.json\"\n[[particles]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\n",
+    );
+    let c = Scene::load(&scene, &SceneLoadOptions::default())
+        .unwrap()
+        .camera;
+    assert!(close(c.position, DVec3::new(-0.75, 0.375, 1.55)), "{c:?}");
+    assert!(close(c.right, DVec3::Y) && close(c.up, -DVec3::X), "{c:?}");
+    assert!(close(c.forward, -DVec3::Z), "{c:?}");
+    let k = c.intrinsics.unwrap();
+    assert_eq!(
+        (k.fx, k.fy, k.cx, k.cy, c.width, c.height),
+        (30.0, 30.0, 20.0, 10.0, 40, 20)
+    );
+    // Without the key the camera is the file's.
+    let plain = write(
+        d,
+        "plain.toml",
+        "[camera]\nfrom = \"transforms.json\"\n[[particles]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\n",
+    );
+    let c = Scene::load(&plain, &SceneLoadOptions::default())
+        .unwrap()
+        .camera;
+    assert!(close(c.position, DVec3::new(1.0, 2.0, 3.0)), "{c:?}");
+}
+
+/// A malformed dataparser file, or one given where it does not apply, exits 2 naming the file.
+#[test]
+fn a_bad_dataparser_file_exits_2_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    let d = dir.path();
+    write(
+        d,
+        "transforms.json",
+        r#"{"fl_x": 30, "w": 40, "h": 20,
+            "frames": [{"file_path": "x.png", "transform_matrix": [[1,0,0,1],[0,1,0,2],[0,0,1,3],[0,0,0,1]]}]}"#,
+    );
+    let pgt_camera = |toml: &str| {
+        let scene = write(d, "dp.toml", toml);
+        let out = Command::new(env!("CARGO_BIN_EXE_pgt"))
+            .arg("camera")
+            .arg(&scene)
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(2), "{toml}");
+        assert!(out.stdout.is_empty(), "{toml}: no output");
+        String::from_utf8_lossy(&out.stderr).into_owned()
+    };
+    let with = "[camera]\nfrom = \"transforms.json\"\ndataparser = \"dp.json\"\n";
+    for (text, words) in [
+        (
+            "{\"transform\": [[1, 0, 0, 0]\n, }",
+            "dp.json:2: not a nerfstudio dataparser_transforms.json",
+        ),
+        (
+            r#"{"transform": [[1, 0, 0, 0], [0, 1, 0, 0]], "scale": 1}"#,
+            "\"transform\" must be 3 rows",
+        ),
+        (
+            r#"{"transform": [[2, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0]], "scale": 1}"#,
+            "is not a rotation",
+        ),
+        (
+            r#"{"transform": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0]]}"#,
+            "\"scale\" must be a finite number > 0",
+        ),
+        (
+            r#"{"transform": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0]], "scale": -2}"#,
+            "got -2",
+        ),
+        (
+            r#"{"transform": [[1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 1, 1]], "scale": 1}"#,
+            "fourth row",
+        ),
+    ] {
+        write(d, "dp.json", text);
+        let e = pgt_camera(with);
+        assert!(e.contains("dp.json") && e.contains(words), "{text}: {e}");
+    }
+    std::fs::remove_file(d.join("dp.json")).unwrap();
+    let e = pgt_camera(with);
+    assert!(e.contains("dp.json"), "a missing file: {e}");
+    // Without camera.from, and with a COLMAP model.
+    let e = pgt_camera("[camera]\ndataparser = \"dp.json\"\n");
+    assert!(e.contains("dp.toml:1: camera.dataparser"), "{e}");
+    colmap_text(d);
+    let e = pgt_camera("[camera]\nfrom = \"sparse\"\ndataparser = \"dp.json\"\n");
+    assert!(
+        e.contains("camera.dataparser applies to a transforms.json"),
+        "{e}"
+    );
+}
+
 /// `pgt camera SCENE` on a scene whose `[camera] from` is `dataset`: exit 2 and stderr.
 fn refusal(dir: &Path, from: &str, image: Option<&str>) -> String {
     let image = image.map_or(String::new(), |i| format!("image = \"{i}\"\n"));

@@ -16,3 +16,4 @@ mod gaussians;
 mod limits;
 mod mc;
 mod scene_camera_paths;
+mod view_color;

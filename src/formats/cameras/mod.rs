@@ -40,6 +40,12 @@ pub fn read(path: &Path) -> Result<Vec<DatasetCamera>> {
     }
 }
 
+/// Whether `path` is a `transforms.json` as [`read`] tells it: a file whose JSON is an object.
+pub fn is_transforms_json(path: &Path) -> bool {
+    !path.is_dir()
+        && read_text(path).is_ok_and(|t| t.trim_start().as_bytes().first() == Some(&b'{'))
+}
+
 /// The camera of the image `name` (exactly as the file writes it, or a `file_path` without its
 /// leading "./" or its extension), or an error that names the file and a few of its images.
 pub fn find<'a>(

@@ -196,3 +196,78 @@ fn matrix(v: Option<&Value>) -> Result<[[f64; 4]; 3], String> {
     }
     Ok(m)
 }
+
+/// nerfstudio's `dataparser_transforms.json`, written beside a trained model: the transform
+/// (3×4, rotation and translation) and the scale its dataparser applied to the dataset's
+/// camera-to-world matrices before training (nerfstudio `DataparserOutputs.save_dataparser_transform`).
+/// A camera of the dataset lands in the trained model's frame as c2w' = [transform; 0 0 0 1]·c2w,
+/// its translation then multiplied by the scale ([`Dataparser::apply`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Dataparser {
+    /// The rows of the 3×4 transform.
+    pub transform: [[f64; 4]; 3],
+    pub scale: f64,
+}
+
+impl Dataparser {
+    /// Reads the file at `path`: an error names it (and the line where JSON fails).
+    pub fn read(path: &Path) -> Result<Dataparser> {
+        Dataparser::parse(&super::read_text(path)?, path)
+    }
+
+    /// Parses a `dataparser_transforms.json` (`text`, read from `path`): `"transform"` 3 rows of
+    /// 4 finite numbers (or 4 rows, the last 0 0 0 1) whose 3×3 part is a rotation, `"scale"` a
+    /// finite number > 0.
+    pub fn parse(text: &str, path: &Path) -> Result<Dataparser> {
+        let what = "a nerfstudio dataparser_transforms.json";
+        let top: Map<String, Value> = serde_json::from_str(text)
+            .map_err(|e| PgtError::at_line(path, e.line().max(1), format!("not {what}: {e}")))?;
+        let bad = |m: String| PgtError::in_file(path, format!("not {what}: {m}"));
+        let rows = top.get("transform");
+        let transform = matrix(rows).map_err(|_| {
+            bad("\"transform\" must be 3 rows of 4 finite numbers (or 4, the last 0 0 0 1)".into())
+        })?;
+        let last = rows.and_then(Value::as_array).and_then(|r| r.get(3));
+        if let Some(last) = last {
+            let unit = last.as_array().is_some_and(|r| {
+                r.iter().map(Value::as_f64).collect::<Vec<_>>()
+                    == [Some(0.0), Some(0.0), Some(0.0), Some(1.0)]
+            });
+            if !unit {
+                return Err(bad(format!(
+                    "the fourth row of \"transform\" must be 0 0 0 1, got {last}"
+                )));
+            }
+        }
+        let rotation =
+            DMat3::from_cols_array_2d(&transform.map(|r| [r[0], r[1], r[2]])).transpose();
+        check_rotation(rotation).map_err(|e| bad(format!("the 3×3 part of \"transform\" {e}")))?;
+        let scale = match top.get("scale") {
+            Some(Value::Number(n)) => n.as_f64().filter(|s| s.is_finite() && *s > 0.0),
+            _ => None,
+        };
+        let Some(scale) = scale else {
+            return Err(bad(format!(
+                "\"scale\" must be a finite number > 0, got {}",
+                top.get("scale")
+                    .map_or("nothing".to_string(), Value::to_string)
+            )));
+        };
+        Ok(Dataparser { transform, scale })
+    }
+
+    /// `camera` (a dataset camera, camera-to-world) in the trained model's frame: the eye
+    /// scale·(R·eye + t), the axes R·r, R·u, R·f; size and intrinsics unchanged.
+    pub fn apply(&self, camera: &Camera) -> Camera {
+        let m = &self.transform;
+        let rotation = DMat3::from_cols_array_2d(&m.map(|r| [r[0], r[1], r[2]])).transpose();
+        let t = DVec3::new(m[0][3], m[1][3], m[2][3]);
+        Camera {
+            position: self.scale * (rotation * camera.position + t),
+            right: rotation * camera.right,
+            up: rotation * camera.up,
+            forward: rotation * camera.forward,
+            ..*camera
+        }
+    }
+}

@@ -61,7 +61,8 @@ pub(super) fn exported(at: Location, v: &[f64], l: &Export) -> ParticleRecord {
 }
 
 /// One vertex as an ellipsoid (docs/design.md §9, "3D Gaussian splatting PLY"): semi-axes
-/// k·exp(scale_i), the normalised quaternion, Θmax = sigmoid(opacity), the SH colour.
+/// k·exp(scale_i), the normalised quaternion, Θmax = sigmoid(opacity), the SH colour; with
+/// `keep`, its SH coefficients too (DC first, then `f_rest` as RGB vectors), else none.
 pub(super) fn gaussian(
     path: &Path,
     i: usize,
@@ -69,7 +70,8 @@ pub(super) fn gaussian(
     v: &[f64],
     l: &Gaussians,
     opts: &Options,
-) -> Result<ParticleRecord> {
+    keep: bool,
+) -> Result<(ParticleRecord, Vec<DVec3>)> {
     let err = |msg: String| PgtError::Input {
         path: path.to_path_buf(),
         location: at.clone(),
@@ -107,18 +109,26 @@ pub(super) fn gaussian(
     if !dc.is_finite() {
         return Err(err(format!("f_dc_0..2 = {dc} is not finite")));
     }
+    let rest = if opts.view {
+        let rest = sh_rest(v, &l.rest, opts.order);
+        if !rest.iter().all(|c| c.is_finite()) {
+            return Err(err("an f_rest_* coefficient is not finite".to_string()));
+        }
+        rest
+    } else {
+        Vec::new()
+    };
     let color = match opts.view_from {
         None => SH_C0 * dc + 0.5,
-        Some(camera) => {
-            let rest = sh_rest(v, &l.rest, opts.order);
-            if !rest.iter().all(|c| c.is_finite()) {
-                return Err(err("an f_rest_* coefficient is not finite".to_string()));
-            }
-            view_color(dc, &rest, center - camera)
-        }
+        Some(camera) => view_color(dc, &rest, center - camera),
+    };
+    let coefficients = if keep {
+        std::iter::once(dc).chain(rest).collect()
+    } else {
+        Vec::new()
     };
     let semi_axes = DVec3::from(semi_axes);
-    Ok(ParticleRecord {
+    let record = ParticleRecord {
         center,
         radius: semi_axes.max_element(),
         color: Some(color.max(DVec3::ZERO)),
@@ -129,7 +139,8 @@ pub(super) fn gaussian(
             semi_axes,
             rotation: q.map(|c| c / norm),
         }),
-    })
+    };
+    Ok((record, coefficients))
 }
 
 /// α = 1/(1 + e^(−x)) for a logit x (±∞ give 1 and 0).

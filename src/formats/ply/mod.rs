@@ -25,7 +25,9 @@
 //! reads back as the particles it was written from.
 //!
 //! **Include options** ([`IncludeSpec`]): `extent` (k, standard deviations per semi-axis, > 0,
-//! default [`DEFAULT_EXTENT`]), `sh = "dc" | "view"` (default `"dc"`), `sh_order =
+//! default [`DEFAULT_EXTENT`]), `sh = "dc" | "view"` (default `"dc"`; `"view"` keeps every
+//! vertex's coefficients in [`LoadedParticles::sh`], which the scene evaluates for the eye of
+//! each frame), `sh_order =
 //! "channel-major" | "coefficient-major"` (the order of `f_rest`, default channel-major as the
 //! reference implementation writes it; EVER's training code writes coefficient-major).
 //!
@@ -101,7 +103,10 @@ pub fn is_splatting_file(path: &std::path::Path) -> bool {
 /// What the reader needs of the include, resolved.
 struct Options {
     extent: f64,
-    /// The camera position for `sh = "view"`; `None`: the DC colour.
+    /// `sh = "view"`: keep the SH coefficients ([`super::ShCoefficients`]).
+    view: bool,
+    /// The eye the records' colours are evaluated for (`sh = "view"` with
+    /// [`IncludeSpec::view_from`]); `None`: the DC colour.
     view_from: Option<DVec3>,
     order: ShOrder,
 }
@@ -126,38 +131,51 @@ fn options(spec: &IncludeSpec) -> Result<Options> {
             format!("include.extent must be finite and > 0, got {extent}"),
         ));
     }
-    let view_from = match spec.sh.unwrap_or_default() {
-        ShColor::Dc => None,
-        ShColor::View => Some(spec.view_from.ok_or_else(|| {
-            PgtError::in_file(
-                &spec.path,
-                "sh = \"view\" needs the camera's position: a scene whose [camera] sets `position` (a fixed camera)",
-            )
-        })?),
-    };
+    let view = spec.sh.unwrap_or_default() == ShColor::View;
     Ok(Options {
         extent,
-        view_from,
+        view,
+        view_from: spec.view_from.filter(|_| view),
         order: spec.sh_order.unwrap_or_default(),
     })
 }
 
-/// The [`super::Reader`] of 3DGS PLY: every vertex as an ellipsoid (see the module doc).
+/// The [`super::Reader`] of 3DGS PLY: every vertex as an ellipsoid (see the module doc), and
+/// with `sh = "view"` the SH coefficients of every vertex (degree ≥ 1).
 pub fn read(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
     let path = spec.path.as_path();
     let opts = options(spec)?;
     let h = header::header(path, bytes)?;
     let (v, layout) = layout::layout(path, &h)?;
     let mut warnings = Vec::new();
+    let mut sh = None;
     let records = match &layout {
         Layout::Gaussians(l) => {
-            let convert = |i, at, values: &[f64]| convert::gaussian(path, i, at, values, l, &opts);
-            data::vertices(path, bytes, &h, v, &convert, &mut warnings)?
+            let keep = opts.view && !l.rest.is_empty();
+            let values = std::cell::RefCell::new(Vec::new());
+            let convert = |i, at, vertex: &[f64]| {
+                let (record, coefficients) =
+                    convert::gaussian(path, i, at, vertex, l, &opts, keep)?;
+                values.borrow_mut().extend(coefficients);
+                Ok(record)
+            };
+            let records = data::vertices(path, bytes, &h, v, &convert, &mut warnings)?;
+            if keep {
+                sh = Some(super::ShCoefficients {
+                    per_particle: 1 + l.rest.len() / 3,
+                    values: values.into_inner(),
+                });
+            }
+            records
         }
         Layout::Export(l) => {
             let convert = |_, at, values: &[f64]| Ok(convert::exported(at, values, l));
             data::vertices(path, bytes, &h, v, &convert, &mut warnings)?
         }
     };
-    Ok(LoadedParticles { records, warnings })
+    Ok(LoadedParticles {
+        records,
+        warnings,
+        sh,
+    })
 }

@@ -309,14 +309,22 @@ fn view_colour_follows_the_direction_and_the_order() {
     w.rest[1] = 0.5;
     let mut s = spec();
     s.sh = Some(ShColor::View);
-    assert!(
-        read(&s, &file("binary_little_endian", &[w.clone()])).is_err(),
-        "no camera"
-    );
+    // Without an eye: the DC colour, and the coefficients kept for the scene (DC, then the
+    // three degree-1 vectors; red's z coefficient is f_rest_1).
+    let kept = read(&s, &file("binary_little_endian", &[w.clone()])).expect("ok");
+    assert_eq!(kept.records[0].color.expect("c").x, 0.5 + SH_C0 * 0.5);
+    let sh = kept.sh.expect("the coefficients");
+    assert_eq!(sh.per_particle, 4);
+    assert_eq!(sh.values[2], DVec3::new(0.5, 0.0, 0.0));
+    assert_eq!(sh.values[0].x, 0.5);
     s.view_from = Some(DVec3::new(1.0, 2.0, -7.0));
     let l = read(&s, &file("binary_little_endian", &[w.clone()])).expect("ok");
     let dc = l.records[0].color.expect("c");
     assert_eq!(dc.x, 0.5 + SH_C0 * 0.5 + SH_C1 * 1.0 * 0.5);
+    // The kept coefficients give the reader's colour for the same eye, bit for bit.
+    let eye = DVec3::new(1.0, 2.0, -7.0);
+    let center = l.records[0].center;
+    assert_eq!(l.sh.as_ref().expect("sh").color(0, center, eye), dc);
     // The same coefficient written coefficient-major: red of coefficient 2 is at index 3.
     w.rest = vec![0.0; 9];
     w.rest[3] = 0.5;

@@ -43,5 +43,6 @@ pub fn read(spec: &IncludeSpec, bytes: &[u8]) -> Result<LoadedParticles> {
     Ok(LoadedParticles {
         records: ev.records,
         warnings: ev.warnings,
+        sh: None,
     })
 }

@@ -70,27 +70,27 @@ pub(in crate::scene) fn load_bare(path: &Path, options: &SceneLoadOptions) -> Re
             "--sh applies to a PLY file of 3D Gaussian splatting (its SH coefficients); this file has none",
         ));
     }
-    let mut spec = IncludeSpec {
+    // With `sh = "view"` the records come with the DC colour and their coefficients, evaluated
+    // below for the eye the framing places (`super::color_for_eye`).
+    let spec = IncludeSpec {
         format: options.format,
         density: Some(defaults.density),
+        sh: (splatting && sh == ShColor::View).then_some(ShColor::View),
         ..IncludeSpec::bare(path)
     };
-    let loaded = crate::formats::load_particles(&spec)?;
-    let make = |loaded: &crate::formats::LoadedParticles| {
-        loaded
-            .records
-            .iter()
-            .map(|rec| record_particle(path, rec, &defaults, render.lambda, None))
-            .collect::<Result<Vec<_>>>()
-    };
-    let mut particles = make(&loaded)?;
+    let mut loaded = crate::formats::load_particles(&spec)?;
+    let mut particles = loaded
+        .records
+        .iter()
+        .map(|rec| record_particle(path, rec, &defaults, render.lambda, None))
+        .collect::<Result<Vec<_>>>()?;
     provenance.push_particles(ParticleOrigin {
         source: ParticleSource::File,
         line: None,
         profile: defaults.density,
         density: density_origin,
     });
-    let mut warnings = loaded.warnings;
+    let mut warnings = std::mem::take(&mut loaded.warnings);
     if particles.is_empty() {
         warnings.push(format!(
             "{}: the file has no particles; it renders the background",
@@ -101,13 +101,19 @@ pub(in crate::scene) fn load_bare(path: &Path, options: &SceneLoadOptions) -> Re
     camera::check_size(&whole, w as i64, h as i64)?;
     // Gaussians are framed by their 3σ extent (`framing::extent_radius`), as in a scene file.
     let camera = default_camera(&particles, w, h);
-    // The view-dependent colour needs the eye, which the framing places: read again from it.
-    if splatting && sh == ShColor::View {
-        spec.sh = Some(ShColor::View);
-        spec.view_from = Some(camera.position);
-        particles = make(&crate::formats::load_particles(&spec)?)?;
-    }
     let range = 0..particles.len();
+    let includes = vec![IncludeGroup {
+        spec,
+        location: Location::File,
+        range,
+        sh: loaded.sh.take().map(std::sync::Arc::new),
+    }];
+    super::color_for_eye(
+        &mut particles,
+        &includes,
+        camera.position,
+        defaults.albedo.is_none(),
+    );
     Ok(Loaded {
         scene: Scene {
             source: path.to_path_buf(),
@@ -119,11 +125,7 @@ pub(in crate::scene) fn load_bare(path: &Path, options: &SceneLoadOptions) -> Re
             provenance,
         },
         camera_path: CameraPath::Fixed(camera),
-        includes: vec![IncludeGroup {
-            spec,
-            location: Location::File,
-            range,
-        }],
+        includes,
         maker: ParticleMaker {
             defaults,
             lambda: render.lambda,

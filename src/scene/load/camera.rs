@@ -34,6 +34,11 @@ pub(super) fn path(
     if t.image.is_some() {
         return Err(table_at.err("camera.image names an image of camera.from, which is not set"));
     }
+    if t.dataparser.is_some() {
+        return Err(table_at.err(
+            "camera.dataparser maps the cameras of camera.from (a transforms.json), which is not set",
+        ));
+    }
     let table_size = check_size(
         &table_at,
         t.width.unwrap_or(DEFAULT_SIZE.0 as i64),

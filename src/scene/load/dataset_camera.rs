@@ -1,7 +1,9 @@
 //! `[camera] from = "…"` (docs/design.md §1 "Cameras of datasets"): a dataset's cameras
 //! ([`crate::formats::cameras`]) as one fixed camera (`image = "…"`) or as a sequence, one
 //! frame per image. The file gives pose, intrinsics and image size; `--size` scales the
-//! intrinsics to another size ([`crate::geometry::Intrinsics::scaled`]).
+//! intrinsics to another size ([`crate::geometry::Intrinsics::scaled`]); `dataparser` maps the
+//! cameras of a `transforms.json` into a nerfstudio model's frame
+//! ([`crate::formats::cameras::transforms::Dataparser`]).
 
 use super::super::file::CameraTable;
 use super::super::SceneLoadOptions;
@@ -50,9 +52,22 @@ pub(super) fn path(
     if !dataset.exists() {
         return Err(table_at.err(format!("camera.from: {} does not exist", dataset.display())));
     }
-    let all = cameras::read(&dataset)?;
+    let mut all = cameras::read(&dataset)?;
     if all.is_empty() {
         return Err(PgtError::in_file(&dataset, "the file lists no images"));
+    }
+    if let Some(dp) = &t.dataparser {
+        if !cameras::is_transforms_json(&dataset) {
+            return Err(table_at.err(format!(
+                "camera.dataparser applies to a transforms.json (nerfstudio's dataparser transform of its cameras); camera.from is {}",
+                dataset.display()
+            )));
+        }
+        let dp = source.path.parent().unwrap_or(Path::new(".")).join(dp);
+        let dataparser = cameras::transforms::Dataparser::read(&dp)?;
+        for c in &mut all {
+            c.camera = dataparser.apply(&c.camera);
+        }
     }
     let sized = |c: &Camera| -> Result<Camera> {
         check_size(&At::whole(&dataset), c.width as i64, c.height as i64)?;

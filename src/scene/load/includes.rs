@@ -3,7 +3,7 @@
 //! records made particles. A file that cannot be read is named at the line of the key that
 //! named it (`path`, `trajectory` or `sequence`), with the folder a relative path is taken from.
 
-use super::super::file::{CameraTable, SceneFile};
+use super::super::file::SceneFile;
 use super::super::provenance::{Origin, ParticleOrigin, ParticleSource, Provenance};
 use super::defaults::ResolvedDefaults;
 use super::particles::record_particle;
@@ -11,7 +11,6 @@ use super::IncludeGroup;
 use crate::error::{line_of, At, PgtError, Result, SourceText};
 use crate::formats::IncludeSpec;
 use crate::optics::particle::Particle;
-use glam::DVec3;
 use std::path::Path;
 use toml::Spanned;
 
@@ -32,13 +31,13 @@ pub(super) fn read_all(
     for (index, inc) in file.include.iter().enumerate() {
         let spec_at = source.at(inc.span());
         let mut spec = resolve(&spec_at, base, inc.get_ref().clone())?;
-        if spec.sh == Some(crate::formats::ShColor::View) {
-            spec.view_from = Some(view_position(&spec_at, &file.camera)?);
-        }
         // The readers see the density the particles get (a splatting file's semi-axes are its
         // standard deviations for Gaussians).
         spec.density = Some(spec.density.unwrap_or(defaults.density));
-        let loaded = crate::formats::load_particles(&spec)
+        // With `sh = "view"` the records come with the DC colour and their coefficients, which
+        // the scene evaluates for the eye of each frame once the camera is known
+        // (`super::color_for_eye`).
+        let mut loaded = crate::formats::load_particles(&spec)
             .map_err(|e| read_error(e, source, index, inc, &spec, base))?;
         warnings.extend(loaded.warnings);
         let start = particles.len();
@@ -69,6 +68,7 @@ pub(super) fn read_all(
             spec,
             location: spec_at.location.clone(),
             range: start..particles.len(),
+            sh: loaded.sh.take().map(std::sync::Arc::new),
         });
     }
     Ok((includes, warnings))
@@ -124,21 +124,6 @@ fn resolve(at: &At, base: &Path, mut spec: IncludeSpec) -> Result<IncludeSpec> {
     spec.trajectory = spec.trajectory.map(|t| base.join(t));
     spec.sequence = spec.sequence.map(|q| base.join(q));
     Ok(spec)
-}
-
-/// The camera position an include with `sh = "view"` evaluates its colours for: the `[camera]`
-/// table's `position`, which a fixed camera must set (a framed camera is placed after the
-/// particles are read, an orbit or keyframes move it).
-fn view_position(at: &At, table: &Option<Spanned<CameraTable>>) -> Result<DVec3> {
-    let t = table.as_ref().map(|t| t.get_ref());
-    match t {
-        Some(t) if t.orbit.is_none() && t.keyframes.is_empty() && t.position.is_some() => {
-            at.vec3("camera.position", t.position.unwrap_or_default())
-        }
-        _ => Err(at.err(
-            "include.sh = \"view\" evaluates the colours for the camera's position: set [camera] position (and look_at) for a fixed camera; a framed, orbiting or keyframed camera has no one position when the file is read",
-        )),
-    }
 }
 
 /// An error of reading the include `inc` (the `index`-th), `spec` its resolved keys. A file that
@@ -265,10 +250,6 @@ mod tests {
             (
                 "path = \"a.ply\"\nextent = -1.0",
                 "include.extent must be > 0",
-            ),
-            (
-                "path = \"a.ply\"\nsh = \"view\"",
-                "include.sh = \"view\" evaluates",
             ),
         ] {
             let e = err_text(&format!("\n[[include]]\n{keys}\n"));

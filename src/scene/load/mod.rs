@@ -57,6 +57,9 @@ pub(super) struct IncludeGroup {
     /// The scene file's line of the include (the whole file for a bare particle file).
     pub location: Location,
     pub range: std::ops::Range<usize>,
+    /// The SH coefficients of its frame-0 particles, where the include asks for the
+    /// view-dependent colour (`sh = "view"`, [`super::view_color`]).
+    pub sh: Option<std::sync::Arc<crate::formats::ShCoefficients>>,
 }
 
 /// Turns a format's records into particles with the scene's `[defaults]` and λ.
@@ -74,6 +77,27 @@ impl ParticleMaker {
         density: Option<Profile>,
     ) -> Result<Particle> {
         particles::record_particle(path, rec, &self.defaults, self.lambda, density)
+    }
+
+    /// Whether a particle's albedo is its colour (no `[defaults] albedo`), so that the albedo
+    /// follows a view-dependent colour ([`super::view_color::recolor`]).
+    pub fn albedo_follows(&self) -> bool {
+        self.defaults.albedo.is_none()
+    }
+}
+
+/// Gives the particles of every include with SH coefficients the colour seen from `eye` (frame
+/// 0's camera position; [`super::view_color`]).
+pub(super) fn color_for_eye(
+    particles: &mut [Particle],
+    includes: &[IncludeGroup],
+    eye: glam::DVec3,
+    albedo_follows: bool,
+) {
+    for g in includes {
+        if let Some(sh) = &g.sh {
+            super::view_color::recolor(&mut particles[g.range.clone()], sh, eye, albedo_follows);
+        }
     }
 }
 
@@ -159,6 +183,12 @@ fn load_toml_and_particles(
     let lights = lights::lights(&source, &file.lights, default_lights)?;
     let camera_path = camera::path(&source, &file.camera, options, &particles)?;
     let camera = camera::first(&source, &camera_path, &file.camera)?;
+    color_for_eye(
+        &mut particles,
+        &includes,
+        camera.position,
+        defaults.albedo.is_none(),
+    );
     if particles.is_empty() {
         warnings.push(format!(
             "{}: the scene has no particles; it renders the background",
