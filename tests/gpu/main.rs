@@ -16,4 +16,5 @@ mod intrinsics;
 mod layout;
 mod methods;
 mod raster;
+mod reference;
 mod sorted_blend;
