@@ -1,4 +1,4 @@
-// f64 exp, expm1 and log1p from +, −, ×, ÷, fma and ldexp (docs/design.md §13).
+// f64 exp, expm1 and log1p from +, −, ×, ÷, fma and ldexp (docs/design.md §12).
 //
 // Vulkan's extended instructions define exp and log for 16- and 32-bit floats only; WGSL's
 // builtins on f64 compile and return garbage (lavapipe: exp gives 0). The GPU reference calls

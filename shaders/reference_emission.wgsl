@@ -1,4 +1,4 @@
-// The exact reference of the emission model on the GPU in f64 (docs/design.md §13): spheres and
+// The exact reference of the emission model on the GPU in f64 (docs/design.md §12): spheres and
 // ellipsoids, one invocation per camera ray, with a bound on its own rounding.
 //
 // The constants REF_*, STATE_*, SCENE_*, PARAM_*, STATUS_*, the struct BvhNode and the bindings

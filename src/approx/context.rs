@@ -110,7 +110,7 @@ impl GpuContext {
     }
 
     /// [`GpuContext::new`] with f64 in shaders (`SHADER_F64`, Vulkan's `shaderFloat64`), as the
-    /// GPU reference needs (docs/design.md §13); an adapter without it is refused by name.
+    /// GPU reference needs (docs/design.md §12); an adapter without it is refused by name.
     pub fn with_f64(adapter_filter: Option<&str>) -> Result<GpuContext> {
         GpuContext::open(adapter_filter, true)
     }

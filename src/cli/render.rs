@@ -69,7 +69,7 @@ pub struct RenderArgs {
     /// With --frames, part I of N is every N-th frame from the I-th, written whole.
     #[arg(long, value_parser = pgt::parts::parse_part, value_name = "I/N")]
     pub part: Option<PartOf>,
-    /// Render on the GPU in f64 (docs/design.md §13): the same image and err as the CPU
+    /// Render on the GPU in f64 (docs/design.md §12): the same image and err as the CPU
     /// reference, within both errs. The emission model of spheres and ellipsoids; an adapter
     /// without f64 is refused by name.
     #[arg(long)]

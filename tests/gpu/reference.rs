@@ -1,4 +1,4 @@
-//! The exact reference on the GPU in f64 (docs/design.md §13): its exp, expm1 and log1p against
+//! The exact reference on the GPU in f64 (docs/design.md §12): its exp, expm1 and log1p against
 //! the CPU's libm, no transcendental builtin on f64 in its program, and its images against the
 //! CPU reference within err_gpu + err_cpu, the same bits on every run.
 
@@ -435,4 +435,118 @@ fn scenes_it_cannot_render_are_refused_by_name() {
     scene.particles[0].profile = Profile::Gaussian;
     let e = gpu::check_supported(&scene, &RenderOptions::default()).unwrap_err();
     assert!(e.to_string().contains("Gaussian"), "{e}");
+}
+
+const CLI_SCENE: &str = r#"
+[camera]
+position = [0.0, 0.0, -6.0]
+look_at  = [0.0, 0.0, 0.0]
+width    = 20
+height   = 16
+
+[render]
+mode  = "volume"
+model = "emission"
+background = [0.1, 0.2, 0.3]
+
+[[particles]]
+center = [-0.4, 0.0, 0.0]
+radius = 1.0
+color  = [1.0, 0.3, 0.1]
+opacity = 0.7
+
+[[particles]]
+center = [0.5, 0.2, 0.3]
+radius = 0.8
+color  = [0.1, 0.6, 1.0]
+opacity = 1.0
+"#;
+
+fn pgt(args: &[&str]) -> std::process::Output {
+    std::process::Command::new(env!("CARGO_BIN_EXE_pgt"))
+        .args(args)
+        .output()
+        .expect("pgt runs")
+}
+
+#[test]
+fn pgt_render_gpu_writes_the_library_s_image_and_err() {
+    let Some(ctx) = gpu64() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let scene_path = dir.path().join("scene.toml");
+    std::fs::write(&scene_path, CLI_SCENE).unwrap();
+    let out = dir.path().join("out.exr");
+    let run = pgt(&[
+        "render",
+        "--gpu",
+        scene_path.to_str().unwrap(),
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    assert!(
+        stderr.contains(" on "),
+        "the summary names the adapter: {stderr}"
+    );
+    let scene = Scene::load(&scene_path, &SceneLoadOptions::default()).unwrap();
+    let want = gpu::render_on(ctx, &scene, &RenderOptions::default()).unwrap();
+    let image = pgt::image_io::read_image(&out).unwrap();
+    let err = pgt::image_io::read_exr_layer(&out, "err").unwrap();
+    assert!(same_bits(&image, &want.image));
+    assert!(same_bits(&err, want.error.as_ref().unwrap()));
+}
+
+#[test]
+fn pgt_render_gpu_refuses_what_it_cannot_render_with_exit_2_and_no_file() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene_path = dir.path().join("scene.toml");
+    std::fs::write(&scene_path, CLI_SCENE).unwrap();
+    let out = dir.path().join("out.exr");
+    let (scene, out_s) = (scene_path.to_str().unwrap(), out.to_str().unwrap());
+    for (args, says) in [
+        (
+            vec!["render", "--gpu", "--model", "lit", scene, "-o", out_s],
+            "lit",
+        ),
+        (
+            vec![
+                "render",
+                "--gpu",
+                "--integrator",
+                "riemann",
+                scene,
+                "-o",
+                out_s,
+            ],
+            "riemann",
+        ),
+        (
+            vec!["render", "--gpu", "--part", "0/2", scene, "-o", out_s],
+            "--part",
+        ),
+    ]
+    .into_iter()
+    // Without any adapter the message names what to install instead (a skip outside CI).
+    .chain(gpu64().map(|_| {
+        (
+            vec![
+                "render",
+                "--gpu",
+                "--adapter",
+                "no such adapter",
+                scene,
+                "-o",
+                out_s,
+            ],
+            "no such adapter",
+        )
+    })) {
+        let run = pgt(&args);
+        let stderr = String::from_utf8_lossy(&run.stderr);
+        assert_eq!(run.status.code(), Some(2), "{args:?}: {stderr}");
+        assert!(stderr.contains(says), "{args:?}: {stderr}");
+        assert!(!stderr.contains("panicked"), "{stderr}");
+        assert!(!out.exists(), "{args:?} left {out_s}");
+    }
 }

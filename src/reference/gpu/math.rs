@@ -1,4 +1,4 @@
-//! f64 exp, expm1 and log1p on the GPU (`shaders/f64_math.wgsl`, docs/design.md §13) and their
+//! f64 exp, expm1 and log1p on the GPU (`shaders/f64_math.wgsl`, docs/design.md §12) and their
 //! error bounds.
 //!
 //! Vulkan's extended instructions have exp and log for 16- and 32-bit floats only, so the GPU

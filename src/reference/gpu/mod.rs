@@ -1,4 +1,4 @@
-//! The exact reference on the GPU in f64 (docs/design.md §13): `pgt render --gpu`.
+//! The exact reference on the GPU in f64 (docs/design.md §12): `pgt render --gpu`.
 //!
 //! The emission model of spheres and ellipsoids, closed form per interval as on the CPU
 //! (`optics::emission`), computed by `shaders/reference_emission.wgsl` one invocation per camera
@@ -156,7 +156,7 @@ pub fn pixel_mean(samples: &[RaySample]) -> (DVec3, DVec3) {
     )
 }
 
-/// A ray's err from what the GPU carried (docs/design.md §13): twice the composite's first-order
+/// A ray's err from what the GPU carried (docs/design.md §12): twice the composite's first-order
 /// rounding bound, plus Cmax per unit of the events' optical-depth uncertainty, at most
 /// max(L, Cmax) per channel (both L and the truth lie in [0, max(L, Cmax)]).
 pub fn ray_error(rounding: DVec3, depth: f64, radiance: DVec3, cmax: DVec3) -> DVec3 {

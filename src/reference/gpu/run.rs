@@ -1,4 +1,4 @@
-//! The GPU reference's buffers, passes and read-back (docs/design.md §13).
+//! The GPU reference's buffers, passes and read-back (docs/design.md §12).
 
 use super::program::{
     program, RefParams, ELLIPSOID_STRIDE, ENTRY_POINT, PARTICLE_STRIDE, P_COLOR, P_RADIUS, P_SHAPE,
