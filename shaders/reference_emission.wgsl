@@ -473,13 +473,14 @@ fn reference_main(@builtin(global_invocation_id) gid: vec3<u32>) {
             s.status = STATUS_DONE;
             break;
         }
-        if (take_batch(&s)) {
-            finish(&s, false);
-            s.status = STATUS_DONE;
-            break;
-        }
+        let ended = take_batch(&s);
         if (inside_overflowed) {
             s.status = STATUS_INSIDE_OVERFLOW;
+            break;
+        }
+        if (ended) {
+            finish(&s, false);
+            s.status = STATUS_DONE;
             break;
         }
         if (loop_iterations >= params.pass_yield) {

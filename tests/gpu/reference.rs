@@ -550,3 +550,24 @@ fn pgt_render_gpu_refuses_what_it_cannot_render_with_exit_2_and_no_file() {
         assert!(!out.exists(), "{args:?} left {out_s}");
     }
 }
+
+#[test]
+fn a_ray_inside_more_particles_than_it_holds_is_refused_by_name() {
+    let Some(ctx) = gpu64() else { return };
+    // Concentric spheres: the ray through the centre is inside all of them at once.
+    let n = gpu::program::INSIDE_MAX as usize + 6;
+    let particles = (0..n)
+        .map(|i| {
+            let r = 0.5 + 0.01 * i as f64;
+            super::support::volume::particle(DVec3::ZERO, r, DVec3::new(0.5, 0.5, 0.5), 0.1)
+        })
+        .collect();
+    let scene =
+        super::support::volume::scene(pgt::optics::models::EMISSION, particles, Vec::new(), 5);
+    let e = gpu::render_on(ctx, &scene, &RenderOptions::default()).unwrap_err();
+    assert!(
+        e.to_string()
+            .contains(&format!("more than {}", gpu::program::INSIDE_MAX)),
+        "{e}"
+    );
+}
