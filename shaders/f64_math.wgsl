@@ -148,33 +148,33 @@ fn f64_log1p_reduced(f: f64) -> f64 {
     return f - (hfsq - s * (hfsq + r));
 }
 
-// m and k with y = 2^k·m, √2/2 ≤ m < √2, for 2^−63 ≤ y < 2^1024 (by powers of two: exact):
+// m and k (an integer, as f64) with y = 2^k·m, √2/2 ≤ m < √2, for 2^−63 ≤ y < 2^1024 (by powers of two: exact):
 // first 1 ≤ m < 2, the exponent taken off a binary digit at a time.
 struct F64Split {
     m: f64,
-    k: i32,
+    k: f64,
 }
 
 fn f64_split(y: f64) -> F64Split {
     var m = y;
-    var k = 0;
-    if (m >= 1.3407807929942597e+154lf) { m = m * 7.458340731200207e-155lf; k = k + 512; }
-    if (m >= 1.157920892373162e+77lf) { m = m * 8.636168555094445e-78lf; k = k + 256; }
-    if (m >= 3.402823669209385e+38lf) { m = m * 2.938735877055719e-39lf; k = k + 128; }
-    if (m >= 1.8446744073709552e+19lf) { m = m * 5.421010862427522e-20lf; k = k + 64; }
-    if (m >= 4294967296.0lf) { m = m * 2.3283064365386963e-10lf; k = k + 32; }
-    if (m >= 65536.0lf) { m = m * 1.52587890625e-05lf; k = k + 16; }
-    if (m >= 256.0lf) { m = m * 0.00390625lf; k = k + 8; }
-    if (m >= 16.0lf) { m = m * 0.0625lf; k = k + 4; }
-    if (m >= 4.0lf) { m = m * 0.25lf; k = k + 2; }
-    if (m >= 2.0lf) { m = m * 0.5lf; k = k + 1; }
-    if (m < 4.656612873077393e-10lf) { m = m * 4294967296.0lf; k = k - 32; }
-    if (m < 3.0517578125e-05lf) { m = m * 65536.0lf; k = k - 16; }
-    if (m < 0.0078125lf) { m = m * 256.0lf; k = k - 8; }
-    if (m < 0.125lf) { m = m * 16.0lf; k = k - 4; }
-    if (m < 0.5lf) { m = m * 4.0lf; k = k - 2; }
-    if (m < 1.0lf) { m = m * 2.0lf; k = k - 1; }
-    if (m >= F64_SQRT2) { m = m * 0.5lf; k = k + 1; }
+    var k = 0.0lf;
+    if (m >= 1.3407807929942597e+154lf) { m = m * 7.458340731200207e-155lf; k = k + 512.0lf; }
+    if (m >= 1.157920892373162e+77lf) { m = m * 8.636168555094445e-78lf; k = k + 256.0lf; }
+    if (m >= 3.402823669209385e+38lf) { m = m * 2.938735877055719e-39lf; k = k + 128.0lf; }
+    if (m >= 1.8446744073709552e+19lf) { m = m * 5.421010862427522e-20lf; k = k + 64.0lf; }
+    if (m >= 4294967296.0lf) { m = m * 2.3283064365386963e-10lf; k = k + 32.0lf; }
+    if (m >= 65536.0lf) { m = m * 1.52587890625e-05lf; k = k + 16.0lf; }
+    if (m >= 256.0lf) { m = m * 0.00390625lf; k = k + 8.0lf; }
+    if (m >= 16.0lf) { m = m * 0.0625lf; k = k + 4.0lf; }
+    if (m >= 4.0lf) { m = m * 0.25lf; k = k + 2.0lf; }
+    if (m >= 2.0lf) { m = m * 0.5lf; k = k + 1.0lf; }
+    if (m < 4.656612873077393e-10lf) { m = m * 4294967296.0lf; k = k - 32.0lf; }
+    if (m < 3.0517578125e-05lf) { m = m * 65536.0lf; k = k - 16.0lf; }
+    if (m < 0.0078125lf) { m = m * 256.0lf; k = k - 8.0lf; }
+    if (m < 0.125lf) { m = m * 16.0lf; k = k - 4.0lf; }
+    if (m < 0.5lf) { m = m * 4.0lf; k = k - 2.0lf; }
+    if (m < 1.0lf) { m = m * 2.0lf; k = k - 1.0lf; }
+    if (m >= F64_SQRT2) { m = m * 0.5lf; k = k + 1.0lf; }
     return F64Split(m, k);
 }
 
@@ -191,7 +191,7 @@ fn f64_log1p(x: f64) -> f64 {
         c = 1.0lf - (y - x);
     }
     let split = f64_split(y);
-    let kf = f64(split.k);
+    let kf = split.k;
     let lo = kf * F64_LN2_LO + c / y;
     return kf * F64_LN2_HI + (f64_log1p_reduced(split.m - 1.0lf) + lo);
 }

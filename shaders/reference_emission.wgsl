@@ -55,6 +55,11 @@ fn vec_at(buffer_offset: u32) -> vec3<f64> {
     return vec3<f64>(particle_data[buffer_offset], particle_data[buffer_offset + 1u], particle_data[buffer_offset + 2u]);
 }
 
+// Three consecutive values of `ellipsoid_data`: a row of M.
+fn ellipsoid_row(at: u32) -> vec3<f64> {
+    return vec3<f64>(ellipsoid_data[at], ellipsoid_data[at + 1u], ellipsoid_data[at + 2u]);
+}
+
 // A chord with bounds on how far its computed ends lie from the exact ones. `ghost` > 0 where the
 // computed line misses but the exact one may cross: a bound on the exact chord's length, around
 // t_ghost.
@@ -114,9 +119,9 @@ fn particle_chord(o: vec3<f64>, d: vec3<f64>, i: u32) -> Chord64 {
         return chord_about(f, REF_U * big_f, d, ed, particle_data[base + REF_P_RADIUS]);
     }
     let e = u32(shape) * REF_ELLIPSOID_STRIDE;
-    let m0 = vec3<f64>(ellipsoid_data[e], ellipsoid_data[e + 1u], ellipsoid_data[e + 2u]);
-    let m1 = vec3<f64>(ellipsoid_data[e + 3u], ellipsoid_data[e + 4u], ellipsoid_data[e + 5u]);
-    let m2 = vec3<f64>(ellipsoid_data[e + 6u], ellipsoid_data[e + 7u], ellipsoid_data[e + 8u]);
+    let m0 = ellipsoid_row(e);
+    let m1 = ellipsoid_row(e + 3u);
+    let m2 = ellipsoid_row(e + 6u);
     let frobenius = ellipsoid_data[e + 9u];
     let fu = vec3<f64>(dot3(m0, f), dot3(m1, f), dot3(m2, f));
     let du = vec3<f64>(dot3(m0, d), dot3(m1, d), dot3(m2, d));
