@@ -153,35 +153,35 @@ pub fn trace(
                 cache: None,
             })
     })?;
+    let limit = storage_limit(ctx);
+    let sizes = [
+        ("the particles", std::mem::size_of_val(&data.particles[..])),
+        (
+            "the ellipsoids",
+            std::mem::size_of_val(&data.ellipsoids[..]),
+        ),
+        ("the BVH", std::mem::size_of_val(&data.buffers.nodes[..])),
+    ];
+    for (what, bytes) in sizes {
+        if bytes as u64 > limit {
+            return Err(PgtError::Gpu(format!(
+                "{what} of this scene take {bytes} bytes in f64, more than the {limit} bytes {} binds: render it on the CPU (without --gpu)",
+                ctx.adapter.name
+            )));
+        }
+    }
     let per_ray = (STATE_STRIDE * 8) as u64;
-    let chunk = (storage_limit(ctx) / per_ray).min(65535 * WORKGROUP as u64) as usize;
-    let scene_buffers = SceneGpu::new(ctx, &data);
+    let chunk = (limit / per_ray).min(65535 * WORKGROUP as u64) as usize;
+    let scene_buffers = ctx.checked("uploading the scene to the GPU reference", || {
+        SceneGpu::new(ctx, &data)
+    })?;
     let mut out = Vec::with_capacity(directions.len());
     let mut passes = 0;
     for part in directions.chunks(chunk.max(WORKGROUP as usize)) {
         let (state, chunk_passes) = run_chunk(ctx, &pipeline, &scene_buffers, part)?;
         passes = passes.max(chunk_passes);
         for ray in state.chunks_exact(STATE_STRIDE) {
-            match ray[STATE_STATUS] as u32 {
-                STATUS_DONE => {}
-                STATUS_INSIDE_OVERFLOW => {
-                    return Err(PgtError::Gpu(format!(
-                        "a ray is inside more than {} particles at once, more than the GPU reference holds: render this scene on the CPU (without --gpu)",
-                        super::program::INSIDE_MAX
-                    )))
-                }
-                STATUS_LOOP_LIMITED => {
-                    return Err(PgtError::Gpu(format!(
-                        "one batch of a ray's events took more than the {LOOP_BUDGET} loop iterations {} allows in a pass: render this scene on the CPU (without --gpu)",
-                        ctx.adapter.name
-                    )))
-                }
-                other => {
-                    return Err(PgtError::Gpu(format!(
-                        "a ray ended the GPU reference with status {other}"
-                    )))
-                }
-            }
+            check_finished(ctx, ray[STATE_STATUS] as u32)?;
             let v = |at: usize| DVec3::new(ray[at], ray[at + 1], ray[at + 2]);
             let radiance = v(STATE_RADIANCE);
             out.push(RaySample {
@@ -194,6 +194,24 @@ pub fn trace(
         samples: out,
         passes,
     })
+}
+
+/// An error naming why a ray did not finish, if it did not.
+fn check_finished(ctx: &GpuContext, status: u32) -> Result<()> {
+    match status {
+        STATUS_DONE => Ok(()),
+        STATUS_INSIDE_OVERFLOW => Err(PgtError::Gpu(format!(
+            "a ray is inside more than {} particles at once, more than the GPU reference holds: render this scene on the CPU (without --gpu)",
+            super::program::INSIDE_MAX
+        ))),
+        STATUS_LOOP_LIMITED => Err(PgtError::Gpu(format!(
+            "one batch of a ray's events took more than the {LOOP_BUDGET} loop iterations {} allows in a pass: render this scene on the CPU (without --gpu)",
+            ctx.adapter.name
+        ))),
+        other => Err(PgtError::Gpu(format!(
+            "a ray ended the GPU reference with status {other}"
+        ))),
+    }
 }
 
 /// The buffers every chunk of rays shares.
