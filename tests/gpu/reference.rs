@@ -709,3 +709,25 @@ fn err_bounds_the_distance_from_a_double_double_oracle_where_f64_geometry_is_off
     eprintln!("double-double oracle: the f64 value is off by at most {worst:.3e} of err ({covered} channels off at all)");
     assert!(covered > 100, "the f64 geometry should be off somewhere");
 }
+
+#[test]
+fn a_scene_without_visible_gas_is_the_background() {
+    let Some(ctx) = gpu64() else { return };
+    let invisible = super::support::volume::particle(DVec3::ZERO, 1.0, DVec3::ONE, 0.0);
+    for particles in [Vec::new(), vec![invisible]] {
+        let mut scene =
+            super::support::volume::scene(pgt::optics::models::EMISSION, particles, Vec::new(), 6);
+        scene.render.background = DVec3::new(0.2, 0.3, 0.4);
+        let out = gpu::render_on(ctx, &scene, &RenderOptions::default()).unwrap();
+        let cpu = reference::render(&scene, &RenderOptions::default()).unwrap();
+        assert!(out.image.pixels.iter().all(|p| *p == [0.2f32, 0.3, 0.4]));
+        // err: the CPU's float32 rounding, and the GPU's bound on its own f64 rounding on top.
+        let (ge, ce) = (out.error.as_ref().unwrap(), cpu.error.as_ref().unwrap());
+        for (g, c) in ge.pixels.iter().flatten().zip(ce.pixels.iter().flatten()) {
+            assert!(
+                *g >= *c && (*g as f64) <= 1.01 * *c as f64 + 1e-15,
+                "err {g:e} against the CPU's {c:e}"
+            );
+        }
+    }
+}
