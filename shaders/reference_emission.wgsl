@@ -106,14 +106,14 @@ fn chord_about(f: vec3<f64>, ef: f64, d: vec3<f64>, ed: f64, r: f64) -> Chord64 
     return c;
 }
 
-// Particle i's chord on the ray o + t·d (d within REF_RAY_DIRECTION_ERROR of the exact unit
-// direction), a sphere or an ellipsoid (src/geometry/ellipsoid.rs: the ray mapped by M to the unit
+// Particle i's chord on the ray o + t·d (d within scene_data[SCENE_DIRECTION_ERROR] of the
+// exact unit direction), a sphere or an ellipsoid (src/geometry/ellipsoid.rs: the ray mapped by M to the unit
 // sphere, s = k·t with k = |M·d|).
 fn particle_chord(o: vec3<f64>, d: vec3<f64>, i: u32) -> Chord64 {
     let base = i * REF_PARTICLE_STRIDE;
     let f = o - vec_at(base);
     let big_f = norm3(f);
-    let ed = REF_RAY_DIRECTION_ERROR;
+    let ed = scene_data[SCENE_DIRECTION_ERROR];
     let shape = particle_data[base + REF_P_SHAPE];
     if (shape < 0.0lf) {
         return chord_about(f, REF_U * big_f, d, ed, particle_data[base + REF_P_RADIUS]);

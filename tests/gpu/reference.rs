@@ -224,9 +224,15 @@ fn check_scene(ctx: &GpuContext, what: &str, scene: &Scene, spp: u32) {
         .flat_map(|y| (0..camera.width).map(move |x| camera.pixel_ray(x, y)))
         .collect();
     let directions: Vec<DVec3> = rays.iter().map(|r| r.direction).collect();
-    let samples = gpu::trace(ctx, scene, camera.position, &directions)
-        .unwrap()
-        .samples;
+    let samples = gpu::trace(
+        ctx,
+        scene,
+        camera.position,
+        &directions,
+        gpu::direction_error(camera),
+    )
+    .unwrap()
+    .samples;
     let mut worst_f64 = 0.0f64;
     for (ray, s) in rays.iter().zip(&samples) {
         let want = estimator.radiance(ray).radiance;
@@ -399,7 +405,14 @@ fn rays_with_many_events_go_on_over_passes_and_agree() {
         "the centre ray crosses {} particles",
         found.len()
     );
-    let traced = gpu::trace(ctx, &scene, camera.position, &[ray.direction]).unwrap();
+    let traced = gpu::trace(
+        ctx,
+        &scene,
+        camera.position,
+        &[ray.direction],
+        gpu::direction_error(camera),
+    )
+    .unwrap();
     if ctx.adapter.is_cpu {
         assert!(traced.passes > 1, "{} pass(es)", traced.passes);
     }
@@ -688,7 +701,14 @@ fn err_bounds_the_distance_from_a_double_double_oracle_where_f64_geometry_is_off
                 (target - origin).normalize()
             })
             .collect();
-        let traced = gpu::trace(ctx, &scene, origin, &directions).unwrap();
+        let traced = gpu::trace(
+            ctx,
+            &scene,
+            origin,
+            &directions,
+            gpu::NORMALIZED_DIRECTION_ERROR,
+        )
+        .unwrap();
         for (d, s) in directions.iter().zip(&traced.samples) {
             let want = one_sphere_oracle(origin, *d, center, radius, sigma, color, bg);
             for c in 0..3 {

@@ -11,7 +11,7 @@
 //! |stored − true| per pixel channel, where "true" is the emission integral along the exact ray
 //! through the sample position. Its parts ([`ray_error`]):
 //! * the chord ends: each end's distance from the exact one, bounded through the stable
-//!   intersection step by step (the ray's direction error [`program::RAY_DIRECTION_ERROR`], the
+//!   intersection step by step (the ray's direction error [`direction_error`], the
 //!   subtraction o − c, every rounding), becomes optical depth σ·δt, and a sliver of depth δτ in
 //!   front of radiance at most Cmax changes L by at most δτ·Cmax per channel;
 //! * the composite's rounding: relative bounds carried through σ, S, τ, the opacity and the
@@ -35,6 +35,7 @@ pub use run::{trace, RaySample, Traced};
 use super::{stored_pixel, RenderOptions, RenderOutput, RenderStats};
 use crate::approx::GpuContext;
 use crate::error::{PgtError, Result};
+use crate::geometry::Camera;
 use crate::image_io::RgbImage;
 use crate::optics::model::LightNeed;
 use crate::scene::{Profile, RenderMode, Scene};
@@ -106,7 +107,14 @@ pub fn render_on(ctx: &GpuContext, scene: &Scene, options: &RenderOptions) -> Re
             }
         }
     }
-    let samples = trace(ctx, scene, camera.position, &directions)?.samples;
+    let samples = trace(
+        ctx,
+        scene,
+        camera.position,
+        &directions,
+        direction_error(camera),
+    )?
+    .samples;
     let n = (k * k) as usize;
     let mut image = RgbImage::new(w, h);
     let mut err_image = RgbImage::new(w, h);
@@ -132,6 +140,29 @@ pub fn render_on(ctx: &GpuContext, scene: &Scene, options: &RenderOptions) -> Re
         },
     })
 }
+
+/// A bound on how far a ray of `camera` (`Camera::ray_at`, any sample position in the image)
+/// lies from the exact unit vector along f + a·r + b·u with the exact a and b of its sample
+/// position. With A and B the largest |a| and |b| over the image: the sample position and a
+/// carry at most 5u·A + 3u·|a| (the sub-pixel offset, the cancellation in 2x/W − 1, then two
+/// products; (x − cx)/fx less), b likewise; f + a·r + b·u adds 3u·(1 + |a| + |b|);
+/// |f + a·r + b·u| ≥ 1 (r, u ⊥ f); the normalisation 3u. So u·(6 + 11·(A + B)), taken as
+/// u·(8 + 12·(A + B)).
+pub fn direction_error(camera: &Camera) -> f64 {
+    let (w, h) = (camera.width as f64, camera.height as f64);
+    let (a, b) = match &camera.intrinsics {
+        None => ((w / h) * camera.tan_half_fov, camera.tan_half_fov),
+        Some(k) => (
+            k.cx.abs().max((w - k.cx).abs()) / k.fx,
+            k.cy.abs().max((h - k.cy).abs()) / k.fy,
+        ),
+    };
+    math::U * (8.0 + 12.0 * (a + b))
+}
+
+/// A bound on how far `v.normalize()` lies from the exact unit vector along v: for rays made
+/// by normalising an exact (or exactly given) vector.
+pub const NORMALIZED_DIRECTION_ERROR: f64 = 4.0 * math::U;
 
 /// The mean of a pixel's samples as `reference::render_pixel` forms it, and its error bound:
 /// the samples' bounds averaged, plus the rounding of the mean (k² additions and a product, of

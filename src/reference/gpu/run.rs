@@ -2,10 +2,10 @@
 
 use super::program::{
     program, RefParams, ELLIPSOID_STRIDE, ENTRY_POINT, PARTICLE_STRIDE, P_COLOR, P_RADIUS, P_SHAPE,
-    P_SIGMA, SCENE_BACKGROUND, SCENE_CMAX, SCENE_LEN, SCENE_ORIGIN, SCENE_RELATIVE_ORIGIN,
-    SCENE_SIGMA_TOTAL, STATE_DEPTH, STATE_ERROR, STATE_RADIANCE, STATE_STATUS, STATE_STRIDE,
-    STATE_TRANSMITTANCE, STATE_T_LAST, STATUS_DONE, STATUS_INSIDE_OVERFLOW, STATUS_LOOP_LIMITED,
-    WORKGROUP,
+    P_SIGMA, SCENE_BACKGROUND, SCENE_CMAX, SCENE_DIRECTION_ERROR, SCENE_LEN, SCENE_ORIGIN,
+    SCENE_RELATIVE_ORIGIN, SCENE_SIGMA_TOTAL, STATE_DEPTH, STATE_ERROR, STATE_RADIANCE,
+    STATE_STATUS, STATE_STRIDE, STATE_TRANSMITTANCE, STATE_T_LAST, STATUS_DONE,
+    STATUS_INSIDE_OVERFLOW, STATUS_LOOP_LIMITED, WORKGROUP,
 };
 use super::ray_error;
 use crate::approx::contract::{LOOP_BUDGET, STACK_DEPTH};
@@ -51,7 +51,7 @@ struct SceneData {
     cmax: DVec3,
 }
 
-fn scene_data(scene: &Scene, origin: DVec3) -> Result<SceneData> {
+fn scene_data(scene: &Scene, origin: DVec3, direction_error: f64) -> Result<SceneData> {
     let bvh = scene.build_gas_bvh();
     let buffers = SceneBuffers::new(scene, &bvh);
     if buffers.bvh_depth > STACK_DEPTH {
@@ -110,6 +110,7 @@ fn scene_data(scene: &Scene, origin: DVec3) -> Result<SceneData> {
     data[SCENE_BACKGROUND..SCENE_BACKGROUND + 3].copy_from_slice(&background.to_array());
     data[SCENE_CMAX..SCENE_CMAX + 3].copy_from_slice(&cmax.to_array());
     data[SCENE_SIGMA_TOTAL] = sigma_total * (1.0 + 1e-12);
+    data[SCENE_DIRECTION_ERROR] = direction_error;
     Ok(SceneData {
         scene: data,
         particles,
@@ -119,13 +120,16 @@ fn scene_data(scene: &Scene, origin: DVec3) -> Result<SceneData> {
     })
 }
 
-/// The rays from `origin` along `directions` (unit length, as `Camera::ray_at` makes them)
-/// through `scene` with the GPU reference: radiance and error bound of each, in order.
+/// The rays from `origin` along `directions` (unit length, as `Camera::ray_at` makes them, each
+/// within `direction_error` of the exact unit vector its truth is defined by:
+/// [`super::direction_error`]) through `scene` with the GPU reference: radiance and error bound
+/// of each, in order.
 pub fn trace(
     ctx: &GpuContext,
     scene: &Scene,
     origin: DVec3,
     directions: &[DVec3],
+    direction_error: f64,
 ) -> Result<Traced> {
     if !ctx.f64 {
         return Err(PgtError::Gpu(format!(
@@ -133,7 +137,7 @@ pub fn trace(
             ctx.adapter
         )));
     }
-    let data = scene_data(scene, origin)?;
+    let data = scene_data(scene, origin, direction_error)?;
     let program = program();
     program.validate_with(naga::valid::Capabilities::FLOAT64)?;
     let pipeline = ctx.checked("compiling the GPU reference", || {
