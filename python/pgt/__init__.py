@@ -227,6 +227,8 @@ def render(
     integrator: str = "adaptive",
     samples: int = 100,
     progress: Union[None, bool, ProgressCallback] = None,
+    gpu: bool = False,
+    adapter: Optional[str] = None,
 ) -> RenderResult:
     """Render the exact reference image of a scene (``pgt render``): f64 throughout, adaptive
     Gauss-Kronrod quadrature to ``tol`` with a per-pixel error bound.
@@ -241,6 +243,11 @@ def render(
       samples     samples per interval for integrator="riemann" [100].
       progress    None (silent), True (a tqdm bar if tqdm is installed, else a line on
                   stderr) or a callable(done, total) called with tiles done from this thread.
+      gpu         render on the GPU in f64 (``pgt render --gpu``): the same image and err
+                  within both errs; the emission model of spheres and ellipsoids, an adapter
+                  with f64 (others are refused with a GpuError) [False].
+      adapter     with gpu=True: the adapter whose name contains this [the first hardware
+                  adapter, else lavapipe].
 
     Returns a RenderResult: ``.image`` and ``.err`` (float32 arrays (height, width, 3), the
     values of ``pgt render``'s EXR and its err layer), ``.seconds``, ``.primary_rays``,
@@ -261,6 +268,8 @@ def render(
             integrator=integrator,
             samples=samples,
             progress=callback,
+            gpu=gpu,
+            adapter=adapter,
         )
     finally:
         if callback is not None and hasattr(callback, "close"):

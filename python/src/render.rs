@@ -163,7 +163,7 @@ fn run_polled<T: Send>(
 
 /// The reference render (`pgt render`); see `pgt.render` for the arguments.
 #[pyfunction]
-#[pyo3(signature = (scene, *, threads=None, spp=1, tol=None, integrator="adaptive", samples=100, progress=None))]
+#[pyo3(signature = (scene, *, threads=None, spp=1, tol=None, integrator="adaptive", samples=100, progress=None, gpu=false, adapter=None))]
 #[allow(clippy::too_many_arguments)]
 pub fn render(
     py: Python<'_>,
@@ -174,6 +174,8 @@ pub fn render(
     integrator: &str,
     samples: u32,
     progress: Option<&Bound<'_, PyAny>>,
+    gpu: bool,
+    adapter: Option<String>,
 ) -> PyResult<RenderResult> {
     let integrator = match integrator {
         "adaptive" => Integrator::Adaptive,
@@ -208,7 +210,12 @@ pub fn render(
     };
     let control = RenderControl::default();
     let out = run_polled(py, &control, progress, || {
-        pgt::reference::render_controlled(scene, &options, &control)
+        if gpu {
+            // docs/design.md §12: the same reference on the GPU in f64 (not stoppable midway).
+            pgt::reference::gpu::render(scene, &options, adapter.as_deref())
+        } else {
+            pgt::reference::render_controlled(scene, &options, &control)
+        }
     })?
     .map_err(|e| to_py(py, e))?;
     let s = out.stats;

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import pgt
-from conftest import bits
+from conftest import bits, in_ci
 
 
 def cli_render(run_cli, tmp_path, scene_path, *flags):
@@ -170,3 +170,29 @@ def test_unconverged_pixels_warn(tmp_path):
     assert result.unconverged >= 1
     x, y, e = result.worst_unconverged
     assert (x, y) == (4, 4) and e > scene.tol
+
+
+def test_render_on_the_gpu_is_the_cli_s_and_within_both_errs_of_the_cpu(example, tmp_path, run_cli):
+    """gpu=True is `pgt render --gpu` bit for bit (image and err), and within err_gpu + err_cpu
+    of the CPU reference (docs/design.md §12)."""
+    path = example("ellipsoids.toml")
+    scene = pgt.load_scene(path, size=(24, 20), model="emission")
+    try:
+        gpu = pgt.render(scene, gpu=True)
+    except pgt.NoAdapterError as e:
+        if in_ci():
+            pytest.fail(f"CI=true and no GPU adapter: {e}")
+        pytest.skip(f"no GPU adapter ({e})")
+    out = tmp_path / "gpu.exr"
+    run_cli("render", "--gpu", path, "--size", "24x20", "--model", "emission", "-o", out)
+    np.testing.assert_array_equal(bits(gpu.image), bits(pgt.read_image(out)))
+    np.testing.assert_array_equal(bits(gpu.err), bits(pgt.read_image(out, layer="err")))
+    cpu = pgt.render(scene)
+    difference = np.abs(gpu.image.astype(np.float64) - cpu.image)
+    assert (difference <= gpu.err.astype(np.float64) + cpu.err).all()
+
+
+def test_render_on_the_gpu_refuses_a_lit_scene_by_name(example):
+    scene = pgt.load_scene(example("ellipsoids.toml"), size=(8, 8), model="lit")
+    with pytest.raises(pgt.GpuError, match="lit"):
+        pgt.render(scene, gpu=True)

@@ -38,6 +38,9 @@ pub struct GpuContext {
     pub queue: wgpu::Queue,
     /// Whether compute passes can carry timestamp queries (`TIMESTAMP_QUERY`).
     pub timestamps: bool,
+    /// Whether the device was opened with f64 in shaders (`SHADER_F64`; only
+    /// [`GpuContext::with_f64`] asks for it).
+    pub f64: bool,
     /// Errors that reached the uncaptured-error handler, oldest first.
     uncaptured: Arc<Mutex<Vec<String>>>,
 }
@@ -103,6 +106,16 @@ impl GpuContext {
     /// (`--adapter`); without one, the first hardware adapter, else the first of any kind
     /// (lavapipe is a `Cpu` adapter).
     pub fn new(adapter_filter: Option<&str>) -> Result<GpuContext> {
+        GpuContext::open(adapter_filter, false)
+    }
+
+    /// [`GpuContext::new`] with f64 in shaders (`SHADER_F64`, Vulkan's `shaderFloat64`), as the
+    /// GPU reference needs (docs/design.md §12); an adapter without it is refused by name.
+    pub fn with_f64(adapter_filter: Option<&str>) -> Result<GpuContext> {
+        GpuContext::open(adapter_filter, true)
+    }
+
+    fn open(adapter_filter: Option<&str>, f64: bool) -> Result<GpuContext> {
         let instance = instance();
         let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
         if adapters.is_empty() {
@@ -148,11 +161,20 @@ impl GpuContext {
             )));
         }
         let timestamps = adapter.features().contains(wgpu::Features::TIMESTAMP_QUERY);
-        let required_features = if timestamps {
+        let mut required_features = if timestamps {
             wgpu::Features::TIMESTAMP_QUERY
         } else {
             wgpu::Features::empty()
         };
+        if f64 {
+            if !adapter.features().contains(wgpu::Features::SHADER_F64) {
+                return Err(PgtError::Gpu(format!(
+                    "the GPU reference needs f64 in shaders (Vulkan shaderFloat64, wgpu SHADER_F64), which {} does not offer; render on the CPU (pgt render without --gpu) or choose another adapter with --adapter",
+                    describe(&info)
+                )));
+            }
+            required_features |= wgpu::Features::SHADER_F64;
+        }
         // Ask for everything the adapter offers: the storage-buffer limits bound the scene size.
         let desc = wgpu::DeviceDescriptor {
             label: Some("pgt"),
@@ -174,6 +196,7 @@ impl GpuContext {
             device,
             queue,
             timestamps,
+            f64,
             uncaptured,
         })
     }

@@ -505,7 +505,7 @@ impl Upload {
 }
 
 /// Maps a MAP_READ buffer and copies its first `size` bytes out.
-fn read_back(ctx: &GpuContext, buffer: &wgpu::Buffer, size: u64) -> Result<Vec<u8>> {
+pub fn read_back(ctx: &GpuContext, buffer: &wgpu::Buffer, size: u64) -> Result<Vec<u8>> {
     let (tx, rx) = std::sync::mpsc::channel();
     buffer.map_async(wgpu::MapMode::Read, ..size, move |r| {
         let _ = tx.send(r);

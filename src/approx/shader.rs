@@ -165,6 +165,11 @@ impl ShaderProgram {
 
     /// Parses and validates the program with naga; errors name the file and line.
     pub fn validate(&self) -> Result<naga::Module> {
+        self.validate_with(naga::valid::Capabilities::default())
+    }
+
+    /// [`ShaderProgram::validate`] allowing `capabilities` (the GPU reference's f64).
+    pub fn validate_with(&self, capabilities: naga::valid::Capabilities) -> Result<naga::Module> {
         let module = naga::front::wgsl::parse_str(&self.source).map_err(|e| {
             let mut msg = String::new();
             let first = e.labels().find_map(|(span, _)| span.to_range());
@@ -184,10 +189,8 @@ impl ShaderProgram {
             }
             PgtError::Gpu(msg)
         })?;
-        let mut validator = naga::valid::Validator::new(
-            naga::valid::ValidationFlags::all(),
-            naga::valid::Capabilities::default(),
-        );
+        let mut validator =
+            naga::valid::Validator::new(naga::valid::ValidationFlags::all(), capabilities);
         validator.validate(&module).map_err(|e| {
             let mut msg = String::new();
             // The last span is the most specific (the expression, after the function that holds it).

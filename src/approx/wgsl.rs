@@ -64,7 +64,7 @@ impl WgslConst {
     }
 }
 
-fn struct_declaration<T: WgslStruct>(out: &mut String) {
+pub fn struct_declaration<T: WgslStruct>(out: &mut String) {
     let _ = writeln!(out, "struct {} {{", T::WGSL_NAME);
     for (name, ty) in T::WGSL_FIELDS {
         let _ = writeln!(out, "    {name}: {ty},");

@@ -69,6 +69,14 @@ pub struct RenderArgs {
     /// With --frames, part I of N is every N-th frame from the I-th, written whole.
     #[arg(long, value_parser = pgt::parts::parse_part, value_name = "I/N")]
     pub part: Option<PartOf>,
+    /// Render on the GPU in f64 (docs/design.md §12): the same image and err as the CPU
+    /// reference, within both errs. The emission model of spheres and ellipsoids; an adapter
+    /// without f64 is refused by name.
+    #[arg(long)]
+    pub gpu: bool,
+    /// With --gpu: use the adapter whose name contains this (case-insensitive).
+    #[arg(long, requires = "gpu")]
+    pub adapter: Option<String>,
     /// The former name of `--part`: still accepted, with a warning.
     #[arg(long, value_parser = pgt::parts::parse_part, value_name = "I/N", hide = true, conflicts_with = "part")]
     pub tile: Option<PartOf>,
@@ -117,6 +125,9 @@ impl RenderArgs {
 
 pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
     let part = args.part();
+    if args.gpu && (part.is_some() || args.frames.is_some()) {
+        anyhow::bail!("--gpu renders whole single images for now: drop --part or --frames");
+    }
     if let Some(range) = args.frames {
         return render_frames(&args, range, part);
     }
@@ -130,7 +141,15 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
     if let Some(part) = part {
         return render_part(&args, &scene, &render_options, part);
     }
-    let out = reference::render(&scene, &render_options)?;
+    let mut on = String::new();
+    let out = if args.gpu {
+        reference::gpu::check_supported(&scene, &render_options)?;
+        let ctx = pgt::approx::GpuContext::with_f64(args.adapter.as_deref())?;
+        on = format!(" on {}", ctx.adapter);
+        reference::gpu::render_on(&ctx, &scene, &render_options)?
+    } else {
+        reference::render(&scene, &render_options)?
+    };
     let layers: Vec<(&str, &pgt::image_io::RgbImage)> =
         out.error.iter().map(|e| ("err", e)).collect();
     write_image(&args.output, &out.image, &layers, args.exposure)?;
@@ -138,7 +157,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
     let rays = s.primary_rays + s.shadow_rays;
     let particles = scene.particles_text();
     let mut line = format!(
-        "rendered {} ({}x{}, {particles}, {} lights) in {:.2} s: {} primary + {} shadow rays, {}",
+        "rendered {} ({}x{}, {particles}, {} lights){on} in {:.2} s: {} primary + {} shadow rays, {}",
         args.output.display(),
         scene.camera.width,
         scene.camera.height,

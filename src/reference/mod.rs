@@ -3,6 +3,7 @@
 
 pub mod budget;
 pub mod gaussian;
+pub mod gpu;
 pub mod opaque;
 pub mod quadrature;
 pub mod riemann;

@@ -16,5 +16,6 @@ mod intrinsics;
 mod layout;
 mod methods;
 mod raster;
+mod reference;
 mod sorted_blend;
 mod view_color;
