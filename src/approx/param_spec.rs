@@ -9,6 +9,10 @@ pub const N_EXACT_ALL: u32 = u32::MAX;
 pub struct ParamSpec {
     /// Name on the command line (`--param NAME=VALUE`), in sweeps and in WGSL (`PARAM_NAME`).
     pub name: &'static str,
+    /// Whether a sweep's run labels and file names leave it out at its default value: the
+    /// parameters a method gains after its runs were named (splat's rasteriser constants), so
+    /// that those runs keep their names.
+    pub quiet_default: bool,
     pub default: u32,
     /// Smallest valid value.
     pub min: u32,

@@ -18,6 +18,7 @@ use std::path::PathBuf;
 pub const USER_PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "samples",
+        quiet_default: false,
         default: 100,
         min: 0,
         max: u32::MAX,
@@ -25,6 +26,7 @@ pub const USER_PARAMS: &[ParamSpec] = &[
     },
     ParamSpec {
         name: "n_exact",
+        quiet_default: false,
         default: N_EXACT_ALL,
         min: 0,
         max: N_EXACT_ALL,

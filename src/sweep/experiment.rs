@@ -669,6 +669,17 @@ mod tests {
     }
 
     #[test]
+    fn splats_rasteriser_constants_stay_out_of_labels_at_their_defaults() {
+        let e = parse(
+            "scene = \"s.toml\"\n[[approximations]]\nmethod = \"splat\"\n[[approximations]]\nmethod = \"splat\"\nalpha_cap = 999000\nnear = [10000]\n",
+        )
+        .unwrap();
+        assert_eq!(e.runs[0].label(), "splat");
+        assert_eq!(e.runs[0].file_stem(), "splat");
+        assert_eq!(e.runs[1].label(), "splat alpha_cap=999000 near=10000");
+    }
+
+    #[test]
     fn all_is_a_value_of_n_exact_only() {
         let e = parse("scene = \"s.toml\"\n[[approximations]]\nmethod = \"thesis\"\nsamples = [4]\nn_exact = [2, \"all\"]\n").unwrap();
         assert_eq!(e.runs[1].param("n_exact"), Some(ParamValue::All));

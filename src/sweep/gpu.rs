@@ -32,7 +32,7 @@ fn sweep_param(spec: &ParamSpec) -> SweepParam {
         // "all" is the sentinel N_EXACT_ALL = u32::MAX; counts stay below it.
         max: if accepts_all { u32::MAX - 1 } else { spec.max },
         accepts_all,
-        quiet_default: false,
+        quiet_default: spec.quiet_default,
         doc: spec.doc,
     }
 }

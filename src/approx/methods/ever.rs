@@ -35,6 +35,7 @@ pub struct Ever;
 const PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "batch",
+        quiet_default: false,
         default: 16,
         min: 1,
         max: EVER_MAX_BATCH,
@@ -42,6 +43,7 @@ const PARAMS: &[ParamSpec] = &[
     },
     ParamSpec {
         name: "stop_below",
+        quiet_default: false,
         default: 4000,
         min: 0,
         max: 1_000_000,
@@ -49,6 +51,7 @@ const PARAMS: &[ParamSpec] = &[
     },
     ParamSpec {
         name: "max_batches",
+        quiet_default: false,
         default: 400,
         min: 1,
         max: 1 << 24,

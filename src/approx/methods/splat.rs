@@ -63,6 +63,7 @@ pub struct Splat;
 pub const PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "footprint",
+        quiet_default: true,
         default: 0,
         min: 0,
         max: 1,
@@ -70,6 +71,7 @@ pub const PARAMS: &[ParamSpec] = &[
     },
     ParamSpec {
         name: "alpha_cap",
+        quiet_default: true,
         default: 990_000,
         min: 1,
         max: 1_000_000,
@@ -77,6 +79,7 @@ pub const PARAMS: &[ParamSpec] = &[
     },
     ParamSpec {
         name: "near",
+        quiet_default: true,
         default: 200_000,
         min: 0,
         max: 1_000_000_000,
@@ -84,6 +87,7 @@ pub const PARAMS: &[ParamSpec] = &[
     },
     ParamSpec {
         name: "jacobian_clamp",
+        quiet_default: true,
         default: 130,
         min: 1,
         max: 100_000,
@@ -91,6 +95,7 @@ pub const PARAMS: &[ParamSpec] = &[
     },
     ParamSpec {
         name: "dilation",
+        quiet_default: true,
         default: 300,
         min: 0,
         max: 1_000_000,
@@ -98,6 +103,7 @@ pub const PARAMS: &[ParamSpec] = &[
     },
     ParamSpec {
         name: "skip_denominator",
+        quiet_default: true,
         default: 255,
         min: 1,
         max: 1_000_000,
@@ -105,6 +111,7 @@ pub const PARAMS: &[ParamSpec] = &[
     },
     ParamSpec {
         name: "stop_below",
+        quiet_default: true,
         default: 100,
         min: 0,
         max: 1_000_000,
@@ -112,6 +119,7 @@ pub const PARAMS: &[ParamSpec] = &[
     },
     ParamSpec {
         name: "stop_inclusive",
+        quiet_default: true,
         default: 0,
         min: 0,
         max: 1,

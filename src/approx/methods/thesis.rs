@@ -29,6 +29,7 @@ pub struct Thesis;
 const PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "samples",
+        quiet_default: false,
         default: 100,
         min: 1,
         max: 1 << 24,
@@ -36,6 +37,7 @@ const PARAMS: &[ParamSpec] = &[
     },
     ParamSpec {
         name: "n_exact",
+        quiet_default: false,
         default: N_EXACT_ALL,
         min: 0,
         max: N_EXACT_ALL,
