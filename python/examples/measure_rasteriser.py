@@ -15,7 +15,11 @@ reference rasteriser in numpy (EWA projection with the Jacobian at the centre, +
 dilation, 3σ footprint, α = min(0.99, o·exp(−½ dᵀΣ₂D⁻¹d)), α < 1/255 skipped, front to back by
 centre depth); replace it with yours (a wrapper around gsplat's ``rasterization``, say).
 
-Run it:  python measure_rasteriser.py [OUT_DIR] [SIZE] [FRAMES]
+Along a dataset's cameras: ``pgt.dataset_cameras`` reads a COLMAP model, a transforms.json or a
+3DGS cameras.json into the same (viewmat, K) per image; ``colmap_points_as_gaussians`` starts
+the Gaussians as 3DGS training does, one per point of the model's sparse cloud.
+
+Run it:  python measure_rasteriser.py [OUT_DIR] [SIZE] [FRAMES | COLMAP_TEXT_MODEL_FOLDER]
 """
 
 from __future__ import annotations
@@ -66,6 +70,44 @@ def orbit(
         viewmat[:3, 3] = -R @ eye
         cameras.append((viewmat, K))
     return cameras
+
+
+def dataset(path: str, width: int) -> Tuple[List[Tuple[np.ndarray, np.ndarray]], int, int]:
+    """(viewmat, K) of every image of a dataset (``pgt.dataset_cameras``), with the images
+    scaled to ``width`` pixels (K's first two rows scale with them), and the scaled size."""
+    cameras = pgt.dataset_cameras(path)
+    scale = width / cameras[0]["width"]
+    height = max(1, round(cameras[0]["height"] * scale))
+    out = []
+    for c in cameras:
+        K = c["K"].copy()
+        K[:2] *= scale
+        out.append((c["viewmat"], K))
+    return out, width, height
+
+
+def colmap_points_as_gaussians(model: str) -> Dict[str, np.ndarray]:
+    """3DGS's initialisation from a COLMAP text model's ``points3D.txt``: one round Gaussian per
+    point, its standard deviation the root mean square distance to its three nearest points,
+    opacity 0.1, the point's colour as the degree-0 SH coefficient."""
+    rows = [
+        line.split()
+        for line in (Path(model) / "points3D.txt").read_text().splitlines()
+        if line.strip() and not line.startswith("#")
+    ]
+    means = np.array([[float(v) for v in r[1:4]] for r in rows])
+    rgb = np.array([[float(v) for v in r[4:7]] for r in rows]) / 255.0
+    d2 = ((means[:, None, :] - means[None, :, :]) ** 2).sum(-1)
+    np.fill_diagonal(d2, np.inf)
+    nearest = np.sort(d2, axis=1)[:, :3].mean(1)
+    n = len(means)
+    return {
+        "means": means,
+        "scales": np.tile(0.5 * np.log(np.maximum(nearest, 1e-7))[:, None], (1, 3)),
+        "quats": np.tile([1.0, 0.0, 0.0, 0.0], (n, 1)),
+        "opacities": np.full(n, np.log(0.1 / 0.9)),
+        "sh_or_colours": ((rgb - 0.5) / SH_C0)[:, None, :],
+    }
 
 
 def numpy_rasteriser(g: Dict[str, np.ndarray]) -> Render:
@@ -152,9 +194,14 @@ def measure(
 
 def main(out_dir: str = "measure_rasteriser", size: str = "96", frames: str = "8") -> pgt.SequenceComparison:
     width = int(size)
-    height = max(1, width * 3 // 4)
-    gaussians = make_gaussians()
-    cmp = measure(numpy_rasteriser(gaussians), gaussians, orbit(int(frames), width, height), width, height, Path(out_dir))
+    if Path(frames).is_dir():
+        gaussians = colmap_points_as_gaussians(frames)
+        cameras, width, height = dataset(frames, width)
+    else:
+        height = max(1, width * 3 // 4)
+        gaussians = make_gaussians()
+        cameras = orbit(int(frames), width, height)
+    cmp = measure(numpy_rasteriser(gaussians), gaussians, cameras, width, height, Path(out_dir))
     for frame in cmp.summary()["frames"]:
         line = f"frame {frame['frame']}: SSIM {frame['ssim']:.4f}  RMSE {frame['rmse']:.4f}  max {frame['max_abs']:.3f}"
         if frame["temporal"] is not None:  # every frame after the first

@@ -13,6 +13,7 @@
 
 mod approx;
 mod arrays;
+mod cameras;
 mod compare;
 mod errors;
 mod frames;
@@ -41,6 +42,7 @@ fn _pgt(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<scene::Scene>()?;
     m.add_function(wrap_pyfunction!(scene::load_scene, m)?)?;
     m.add_function(wrap_pyfunction!(gaussians::gaussian_particles, m)?)?;
+    m.add_function(wrap_pyfunction!(cameras::dataset_cameras, m)?)?;
     m.add_class::<frames::Frames>()?;
     m.add_function(wrap_pyfunction!(frames::load_frames, m)?)?;
     m.add_class::<render::RenderResult>()?;

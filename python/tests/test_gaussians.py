@@ -193,6 +193,35 @@ def test_a_dataset_camera_is_camera_from_K_of_its_pose(shared):
     assert np.allclose(a["projection"], b["projection"], rtol=1e-12, atol=1e-12)
 
 
+def test_dataset_cameras_are_the_colmap_models_poses(shared):
+    folder = shared("cameras/colmap/kapture_maupertuis_txt")
+    cameras = pgt.dataset_cameras(folder)
+    assert [c["name"] for c in cameras] == ["00.jpg", "01.jpg", "02.jpg", "03.jpg"]
+    binary = pgt.dataset_cameras(shared("cameras/colmap/kapture_maupertuis_bin_pycolmap"))
+    for c, b in zip(cameras, binary):
+        R, t, (w, h, f, cx, cy) = colmap_image(folder, c["name"])
+        assert (c["width"], c["height"]) == (w, h)
+        assert np.allclose(c["K"], [[f, 0, cx], [0, f, cy], [0, 0, 1]], rtol=1e-12, atol=0)
+        assert np.allclose(c["R"], R, atol=1e-12) and np.allclose(c["t"], t, atol=1e-9)
+        assert np.allclose(c["viewmat"][:3, :3], R, atol=1e-12) and np.allclose(c["viewmat"][:3, 3], t, atol=1e-9)
+        assert np.array_equal(c["viewmat"][3], [0, 0, 0, 1])
+        assert np.allclose(c["eye"], -R.T @ t, atol=1e-9)
+        assert np.allclose(c["camera_to_world"][:3, 3], c["eye"], atol=0)
+        assert np.allclose(b["viewmat"], c["viewmat"], atol=1e-6) and np.allclose(b["K"], c["K"], atol=1e-6)
+    with pytest.raises(pgt.FileError, match="not-a-model"):
+        pgt.dataset_cameras(folder / "not-a-model")
+
+
+def test_a_file_that_is_no_camera_file_is_refused_by_name(tmp_path):
+    bad = tmp_path / "cams.json"
+    bad.write_text("hello")
+    with pytest.raises(pgt.Error, match="cams.json: not a camera file"):
+        pgt.dataset_cameras(bad)
+    bad.write_text('{"frames": [{"transform_matrix": [[1, 0]]}]}')
+    with pytest.raises(pgt.Error, match="cams.json"):
+        pgt.dataset_cameras(bad)
+
+
 @pytest.fixture(scope="module")
 def example():
     spec = importlib.util.spec_from_file_location("measure_rasteriser", EXAMPLE)
@@ -219,6 +248,18 @@ def test_the_example_measures_a_numpy_rasteriser(example, tmp_path, capsys):
         assert ref.shape == (30, 40, 3) and ref.max() > 0.05 and err.max() < 1e-3
     printed = capsys.readouterr().out
     assert "frame 2:" in printed and "temporal p99" in printed and "report:" in printed
+
+
+def test_the_example_measures_along_a_colmap_models_cameras(example, shared, tmp_path):
+    folder = shared("cameras/colmap/kapture_maupertuis_txt")
+    cmp = example.main(str(tmp_path / "out"), "48", str(folder))
+    summary = cmp.summary()
+    assert cmp.frames == 4 and len(summary["frames"]) == 4
+    for frame in summary["frames"]:
+        assert 0.3 < frame["ssim"] < 0.9999 and 0 < frame["rmse"] < 0.3, frame
+    ref = pgt.read_image(tmp_path / "out" / "reference" / "f_0000.exr")
+    # 1919x1079 scaled to 48 wide; the sparse cloud lies in front of every camera.
+    assert ref.shape == (27, 48, 3) and ref.max() > 0.02
 
 
 def test_the_example_rasteriser_puts_a_gaussian_where_pgt_does(example):
