@@ -2,7 +2,8 @@
 # Runs one cargo-fuzz target for a while: scripts/fuzz.sh TARGET SECONDS [LIBFUZZER ARGS...]
 #
 # TARGET is a file stem of fuzz/fuzz_targets/ (pdb, mmcif, vrml, mmpld, xyz, csv, gro, psf, dcd,
-# xtc, ply, frames (the frame sources of pdb, xyz, mmpld, mmcif), scene, gate,
+# xtc, ply, frames (the frame sources of pdb, xyz, mmpld, mmcif), colmap, transforms, dataparser,
+# cameras_json, scene, gate,
 # experiment). The corpus (fuzz/corpus/TARGET, not committed) is seeded with the files in
 # tests/data and ../shared/data (when present), the examples and fuzz/seeds/TARGET. A crash is
 # minimised into fuzz/artifacts/TARGET/minimized-*; commit it under tests/data/fuzz/TARGET with
