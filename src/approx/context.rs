@@ -78,6 +78,17 @@ pub fn quiet_device_select_probe() {
     }
 }
 
+/// The refusal of an adapter (`described` by [`describe`]) whose `features` lack f64 in
+/// shaders, which the GPU reference needs (docs/design.md §12).
+fn require_f64(features: wgpu::Features, described: &str) -> Result<()> {
+    if features.contains(wgpu::Features::SHADER_F64) {
+        return Ok(());
+    }
+    Err(PgtError::Gpu(format!(
+        "the GPU reference needs f64 in shaders (Vulkan shaderFloat64, wgpu SHADER_F64), which {described} does not offer; render on the CPU (pgt render without --gpu) or choose another adapter with --adapter"
+    )))
+}
+
 fn describe(info: &wgpu::AdapterInfo) -> AdapterDescription {
     AdapterDescription {
         name: info.name.clone(),
@@ -167,12 +178,7 @@ impl GpuContext {
             wgpu::Features::empty()
         };
         if f64 {
-            if !adapter.features().contains(wgpu::Features::SHADER_F64) {
-                return Err(PgtError::Gpu(format!(
-                    "the GPU reference needs f64 in shaders (Vulkan shaderFloat64, wgpu SHADER_F64), which {} does not offer; render on the CPU (pgt render without --gpu) or choose another adapter with --adapter",
-                    describe(&info)
-                )));
-            }
+            require_f64(adapter.features(), &describe(&info).to_string())?;
             required_features |= wgpu::Features::SHADER_F64;
         }
         // Ask for everything the adapter offers: the storage-buffer limits bound the scene size.
@@ -227,5 +233,29 @@ impl GpuContext {
         }
         let all = v.drain(..).collect::<Vec<_>>().join("; ");
         Err(PgtError::Gpu(format!("{what}: {all}")))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An adapter without f64 is refused by name with the flag it lacks and what to do; one
+    /// with it passes (lavapipe offers f64, so the GPU tests cannot reach the refusal).
+    #[test]
+    fn an_adapter_without_f64_is_refused_by_name() {
+        let err = require_f64(
+            wgpu::Features::TIMESTAMP_QUERY,
+            "SomeGPU (Vulkan, DiscreteGpu)",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            err.contains("SomeGPU (Vulkan, DiscreteGpu) does not offer")
+                && err.contains("SHADER_F64")
+                && err.contains("--adapter"),
+            "{err}"
+        );
+        assert!(require_f64(wgpu::Features::SHADER_F64, "lavapipe").is_ok());
     }
 }
