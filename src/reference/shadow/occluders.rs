@@ -30,9 +30,11 @@
 //! is a superset of the spheres crossed, so the hits are the same, in the same order (tested).
 //!
 //! **Ellipsoids** (docs/design.md §9) are culled as their bounding spheres (a superset of what
-//! their own test would keep) and kept in a list of their own, after the spheres: each shadow
-//! ray tests them exactly with the ellipsoid's intersection, the one [`Bvh::all_hits`] uses,
-//! and their kinks are the ellipsoid's own. The spheres' lanes stay as they are.
+//! their own test would keep), their reach range is their own (the unit sphere's in their
+//! unit-sphere coordinates: `ellipsoid_reach_range`), and they are kept in a list of their own,
+//! after the spheres: each shadow ray tests them exactly with the ellipsoid's intersection, the
+//! one [`Bvh::all_hits`] uses (in lanes of shadow rays as the spheres, with the same
+//! arithmetic), and their kinks are the ellipsoid's own. The spheres' lanes stay as they are.
 
 // `!(a > b)` is deliberate: unlike `a <= b` it is also true when a value is NaN, so degenerate
 // input takes the safe branch.
@@ -139,7 +141,10 @@ impl Occluders {
         for_each_swept_leaf(bvh, &poly, |leaf| {
             // The leaf's centres and radii (the particles', in leaf order) lie together.
             for (k, (i, center, radius)) in leaf.spheres().enumerate() {
-                let (t_lo, t_hi) = reach_range(camera_ray, light, center, radius, tb);
+                let (t_lo, t_hi) = match leaf.ellipsoid(k) {
+                    None => reach_range(camera_ray, light, center, radius, tb),
+                    Some(e) => ellipsoid_reach_range(camera_ray, light, center, e, tb),
+                };
                 if !(t_lo <= tb && t_hi >= ta) {
                     continue;
                 }
@@ -315,10 +320,17 @@ impl Occluders {
             o.clear();
         }
         for (shadow, out) in shadow.chunks(LANES).zip(out.chunks_mut(LANES)) {
-            hits_in_lanes(&self.candidates, shadow, out);
-        }
-        if !self.ellipsoids.is_empty() {
-            ellipsoid_hits(&self.ellipsoid_candidates, &self.ellipsoids, shadow, out);
+            let lanes = Lanes::new(shadow);
+            hits_in_lanes(&self.candidates, &lanes, shadow, out);
+            if !self.ellipsoids.is_empty() {
+                ellipsoid_hits_in_lanes(
+                    &self.ellipsoid_candidates,
+                    &self.ellipsoids,
+                    &lanes,
+                    shadow,
+                    out,
+                );
+            }
         }
     }
 
@@ -332,61 +344,61 @@ impl Occluders {
     }
 }
 
-/// The ellipsoids' part of [`Occluders::hits_batch`]: each candidate (`candidates[k]` with its
-/// ellipsoid `ellipsoids[k]`) against every shadow ray whose reach range holds it, with the
-/// ellipsoid's own intersection, appended to `out`.
-#[inline(never)]
-fn ellipsoid_hits(
-    candidates: &[Candidate],
-    ellipsoids: &[Ellipsoid],
-    shadow: &[ShadowRay],
-    out: &mut [Vec<Hit>],
-) {
-    for (c, ellipsoid) in candidates.iter().zip(ellipsoids) {
-        for (s, o) in shadow.iter().zip(out.iter_mut()) {
-            // Written so that a NaN t tests every candidate, as in the lanes.
-            if s.t < c.t_lo || s.t > c.t_hi {
-                continue;
-            }
-            if let Some(chord) = ellipsoid.intersect(&s.ray, c.center) {
-                if chord.t_exit > 0.0 && chord.t_enter < s.t_max {
-                    o.push(Hit {
-                        index: c.index,
-                        chord,
-                    });
-                }
-            }
-        }
-    }
-}
-
 /// Shadow rays per pass of [`hits_in_lanes`]: one level of a quadrature segment (G7's seven
 /// nodes, or the eight K15 adds).
 const LANES: usize = 8;
 
-/// [`Occluders::hits_batch`] for up to [`LANES`] shadow rays, `out` cleared: each candidate in
-/// list order, against every shadow ray whose reach range holds it. The chords are
-/// `intersect_sphere`'s, with its arithmetic in the same order, computed for all lanes at once
-/// with no branch (so that the compiler puts them in SIMD lanes, two square roots per
-/// instruction, where the loop over one ray at a time waited for each), and kept where its
-/// checks pass. (Compiled for AVX2's four lanes it was no faster: 1UUN lit 128², one thread,
-/// 15 interleaved runs, fastest 1.27 s against 1.26 s.)
-fn hits_in_lanes(candidates: &[Candidate], shadow: &[ShadowRay], out: &mut [Vec<Hit>]) {
-    let n = shadow.len().min(LANES);
-    let (mut ox, mut oy, mut oz) = ([0.0; LANES], [0.0; LANES], [0.0; LANES]);
-    let (mut dx, mut dy, mut dz) = ([0.0; LANES], [0.0; LANES], [0.0; LANES]);
-    // The span of the rays' t: a candidate whose reach range misses all of it is skipped
-    // whole (any NaN t makes it (−∞, ∞), so that every candidate is tested).
-    let (mut t_first, mut t_last) = (f64::INFINITY, f64::NEG_INFINITY);
-    for (i, s) in shadow[..n].iter().enumerate() {
-        (ox[i], oy[i], oz[i]) = s.ray.origin.into();
-        (dx[i], dy[i], dz[i]) = s.ray.direction.into();
-        if s.t.is_nan() {
-            (t_first, t_last) = (f64::NEG_INFINITY, f64::INFINITY);
-        } else {
-            (t_first, t_last) = (t_first.min(s.t), t_last.max(s.t));
+/// Up to [`LANES`] shadow rays laid out for the lane loops: origins and directions by
+/// coordinate, and the span [t_first, t_last] of their camera-ray parameters (a candidate whose
+/// reach range misses all of it is skipped whole; any NaN t makes it (−∞, ∞), so that every
+/// candidate is tested).
+struct Lanes {
+    n: usize,
+    o: [[f64; LANES]; 3],
+    d: [[f64; LANES]; 3],
+    t_first: f64,
+    t_last: f64,
+}
+
+impl Lanes {
+    fn new(shadow: &[ShadowRay]) -> Lanes {
+        let n = shadow.len().min(LANES);
+        let (mut o, mut d) = ([[0.0; LANES]; 3], [[0.0; LANES]; 3]);
+        let (mut t_first, mut t_last) = (f64::INFINITY, f64::NEG_INFINITY);
+        for (i, s) in shadow[..n].iter().enumerate() {
+            (o[0][i], o[1][i], o[2][i]) = s.ray.origin.into();
+            (d[0][i], d[1][i], d[2][i]) = s.ray.direction.into();
+            if s.t.is_nan() {
+                (t_first, t_last) = (f64::NEG_INFINITY, f64::INFINITY);
+            } else {
+                (t_first, t_last) = (t_first.min(s.t), t_last.max(s.t));
+            }
+        }
+        Lanes {
+            n,
+            o,
+            d,
+            t_first,
+            t_last,
         }
     }
+}
+
+/// [`Occluders::hits_batch`] for up to [`LANES`] shadow rays (`lanes`, made from `shadow`),
+/// `out` cleared: each candidate in list order, against every shadow ray whose reach range
+/// holds it. The chords are `intersect_sphere`'s, with its arithmetic in the same order,
+/// computed for all lanes at once with no branch (so that the compiler puts them in SIMD
+/// lanes, two square roots per instruction, where the loop over one ray at a time waited for
+/// each), and kept where its checks pass. (Compiled for AVX2's four lanes it was no faster: 1UUN lit 128², one thread,
+/// 15 interleaved runs, fastest 1.27 s against 1.26 s.)
+fn hits_in_lanes(
+    candidates: &[Candidate],
+    lanes: &Lanes,
+    shadow: &[ShadowRay],
+    out: &mut [Vec<Hit>],
+) {
+    let (n, t_first, t_last) = (lanes.n, lanes.t_first, lanes.t_last);
+    let ([ox, oy, oz], [dx, dy, dz]) = (&lanes.o, &lanes.d);
     for c in candidates {
         if c.t_hi < t_first || c.t_lo > t_last {
             continue;
@@ -413,6 +425,97 @@ fn hits_in_lanes(candidates: &[Candidate], shadow: &[ShadowRay], out: &mut [Vec<
             let chord = Chord {
                 t_enter: t_c[i] - half[i],
                 t_exit: t_c[i] + half[i],
+            };
+            if chord.t_exit > 0.0 && chord.t_enter < s.t_max {
+                o.push(Hit {
+                    index: c.index,
+                    chord,
+                });
+            }
+        }
+    }
+}
+
+/// The ellipsoids' part of [`Occluders::hits_batch`], for up to [`LANES`] shadow rays
+/// (`lanes`, made from `shadow`): each candidate (`candidates[k]` with its ellipsoid
+/// `ellipsoids[k]`) against every shadow ray whose reach range holds it, appended to `out`.
+/// The chords are [`Ellipsoid::intersect`]'s, with its arithmetic in the same order (glam's
+/// matrix–vector product and length, the unit sphere's `intersect_sphere`, the division by k),
+/// computed for all lanes at once with no branch as in [`hits_in_lanes`], so the hits are
+/// bit for bit those of the ray-at-a-time test. Not inlined: the spheres' pass in
+/// [`Occluders::hits_batch`] keeps its own code.
+#[inline(never)]
+fn ellipsoid_hits_in_lanes(
+    candidates: &[Candidate],
+    ellipsoids: &[Ellipsoid],
+    lanes: &Lanes,
+    shadow: &[ShadowRay],
+    out: &mut [Vec<Hit>],
+) {
+    let (n, t_first, t_last) = (lanes.n, lanes.t_first, lanes.t_last);
+    let ([ox, oy, oz], [dx, dy, dz]) = (&lanes.o, &lanes.d);
+    // The direction every ray has, where they all have the same bits (a directional light's).
+    let bits = |s: &ShadowRay| s.ray.direction.to_array().map(f64::to_bits);
+    let shared_direction = shadow
+        .first()
+        .filter(|first| shadow[..n].iter().all(|s| bits(s) == bits(first)))
+        .map(|first| first.ray.direction);
+    for (c, ellipsoid) in candidates.iter().zip(ellipsoids) {
+        if c.t_hi < t_first || c.t_lo > t_last {
+            continue;
+        }
+        let (cx, cy, cz) = (c.center.x, c.center.y, c.center.z);
+        let m = ellipsoid.to_unit_matrix();
+        let (mx, my, mz) = (m.x_axis, m.y_axis, m.z_axis);
+        // e = M·d as glam's product sums it (x, then y, then z column), k = |e|, v = e/k:
+        // once for a direction all rays share (the same bits as per ray), else per ray.
+        let unit_direction = |(dx, dy, dz): (f64, f64, f64)| {
+            let ex = mx.x * dx + my.x * dy + mz.x * dz;
+            let ey = mx.y * dx + my.y * dy + mz.y * dz;
+            let ez = mx.z * dx + my.z * dy + mz.z * dz;
+            let k = (ex * ex + ey * ey + ez * ez).sqrt();
+            [ex / k, ey / k, ez / k, k]
+        };
+        let (mut vx, mut vy, mut vz, mut k) =
+            ([0.0; LANES], [0.0; LANES], [0.0; LANES], [0.0; LANES]);
+        match shared_direction {
+            Some(d) => {
+                let [x, y, z, w] = unit_direction(d.into());
+                (vx, vy, vz, k) = ([x; LANES], [y; LANES], [z; LANES], [w; LANES]);
+            }
+            None => {
+                for i in 0..LANES {
+                    [vx[i], vy[i], vz[i], k[i]] = unit_direction((dx[i], dy[i], dz[i]));
+                }
+            }
+        }
+        let (mut dist, mut half) = ([0.0; LANES], [0.0; LANES]);
+        let (mut enter, mut exit) = ([0.0; LANES], [0.0; LANES]);
+        for i in 0..LANES {
+            // u = M(o − c) as glam's product sums it; then the unit sphere's t_c, |l| and
+            // half-chord along v, and the chord's ends divided by k.
+            let (fx, fy, fz) = (ox[i] - cx, oy[i] - cy, oz[i] - cz);
+            let ux = mx.x * fx + my.x * fy + mz.x * fz;
+            let uy = mx.y * fx + my.y * fy + mz.y * fz;
+            let uz = mx.z * fx + my.z * fy + mz.z * fz;
+            let tc = -(ux * vx[i] + uy * vy[i] + uz * vz[i]);
+            let (lx, ly, lz) = (ux + tc * vx[i], uy + tc * vy[i], uz + tc * vz[i]);
+            let d = (lx * lx + ly * ly + lz * lz).sqrt();
+            let h = ((1.0 - d) * (1.0 + d)).sqrt();
+            dist[i] = d;
+            half[i] = h;
+            enter[i] = (tc - h) / k[i];
+            exit[i] = (tc + h) / k[i];
+        }
+        for (i, (s, o)) in shadow[..n].iter().zip(out.iter_mut()).enumerate() {
+            // As in `hits_in_lanes`: a NaN t tests every candidate, and the unit sphere's
+            // misses are |l| ≥ 1 and a half-chord ≤ 0.
+            if s.t < c.t_lo || s.t > c.t_hi || dist[i] >= 1.0 || half[i] <= 0.0 {
+                continue;
+            }
+            let chord = Chord {
+                t_enter: enter[i],
+                t_exit: exit[i],
             };
             if chord.t_exit > 0.0 && chord.t_enter < s.t_max {
                 o.push(Hit {
@@ -481,7 +584,57 @@ fn reach_range(camera_ray: &Ray, light: &Light, c: DVec3, r: f64, t_end: f64) ->
         + c.abs().max_element()
         + r
         + if t_end.is_finite() { t_end.abs() } else { 0.0 };
-    let pad = RANGE_PADDING * size;
+    range_of_padded(camera_ray, light, c, r, RANGE_PADDING * size)
+}
+
+/// [`reach_range`] of an ellipsoid `e` about `c`: the unit sphere's range for the camera ray
+/// and the light in the ellipsoid's unit-sphere coordinates (the map x ↦ M(x − c) takes lines
+/// to lines and shadow rays to the mapped light's shadow rays, as in `kinks::ellipsoid_roots`;
+/// a parameter s of the mapped ray with unit direction is k·t, k = |Md|), tighter than its
+/// bounding sphere's. The padding is the world one ([`RANGE_PADDING`] of the coordinates' size)
+/// divided by the shortest semi-axis, which bounds what a world distance becomes in unit
+/// coordinates, so it covers the round-off of the map and of the mapped roots and shadow ray
+/// tests as the sphere's covers its own.
+fn ellipsoid_reach_range(
+    camera_ray: &Ray,
+    light: &Light,
+    c: DVec3,
+    e: &Ellipsoid,
+    t_end: f64,
+) -> (f64, f64) {
+    let size = camera_ray.origin.abs().max_element()
+        + c.abs().max_element()
+        + e.bounding_radius()
+        + if t_end.is_finite() { t_end.abs() } else { 0.0 };
+    let pad = RANGE_PADDING * size / e.shortest_semi_axis();
+    let (unit, k) = e.unit_ray(camera_ray, c);
+    let mapped = match *light {
+        Light::Directional {
+            direction,
+            irradiance,
+        } => Light::Directional {
+            direction: e.to_unit(DVec3::ZERO, direction).normalize(),
+            irradiance,
+        },
+        Light::Point {
+            position,
+            intensity,
+            falloff,
+        } => Light::Point {
+            position: e.to_unit(c, position),
+            intensity,
+            falloff,
+        },
+    };
+    if !(k > 0.0 && k.is_finite()) {
+        return ALL;
+    }
+    let (s_lo, s_hi) = range_of_padded(&unit, &mapped, DVec3::ZERO, 1.0, pad);
+    (s_lo / k, s_hi / k)
+}
+
+/// [`reach_range`] with the radius padding `pad` given.
+fn range_of_padded(camera_ray: &Ray, light: &Light, c: DVec3, r: f64, pad: f64) -> (f64, f64) {
     if !pad.is_finite() {
         return ALL;
     }
@@ -658,6 +811,97 @@ mod tests {
             crossing > 5000,
             "the samples should cross spheres: {crossing}"
         );
+    }
+
+    /// An ellipsoid's own reach range holds every camera-ray parameter whose shadow ray towards
+    /// either kind of light crosses it (sampled densely, and bisected onto the edges of the
+    /// exact test), and lies within its bounding sphere's range, narrower in most cases (so
+    /// the test can fail and the cull gains).
+    #[test]
+    fn the_ellipsoid_reach_range_holds_every_shadow_ray_that_crosses_it() {
+        let mut rng = SplitMix64::new(23);
+        let mut v = |s: f64| {
+            DVec3::new(rng.next_f64(), rng.next_f64(), rng.next_f64()) * 2.0 * s - DVec3::splat(s)
+        };
+        let (mut narrower, mut finite, mut crossing) = (0, 0, 0);
+        for trial in 0..400 {
+            let w = v(1.0);
+            let axes = DVec3::new(1.0, 0.1 + w.x.abs(), 0.1 + w.y.abs()) * (0.3 + w.z.abs());
+            let q = glam::DQuat::from_xyzw(v(1.0).x, v(1.0).y, v(1.0).z, 0.5).normalize();
+            let (e, c) = (Ellipsoid::new(axes, q), v(3.0));
+            let light = if trial % 2 == 0 {
+                Light::Directional {
+                    direction: v(1.0).normalize(),
+                    irradiance: DVec3::ONE,
+                }
+            } else {
+                Light::Point {
+                    position: v(4.0),
+                    intensity: DVec3::ONE,
+                    falloff: Falloff::InverseSquare,
+                }
+            };
+            // Aimed near the centre, so that most bounding spheres' ranges are finite.
+            let origin = v(6.0);
+            let ray = Ray::new(origin, (c + v(1.0) - origin).normalize());
+            let (lo, hi) = ellipsoid_reach_range(&ray, &light, c, &e, 20.0);
+            let (b_lo, b_hi) = reach_range(&ray, &light, c, e.bounding_radius(), 20.0);
+            if lo <= hi {
+                // Within the sphere's, up to the larger padding of the ellipsoid's.
+                let inside = lo >= b_lo - 1e-3 && hi <= b_hi + 1e-3;
+                assert!(
+                    inside,
+                    "trial {trial}: [{lo}, {hi}] not in [{b_lo}, {b_hi}]"
+                );
+            }
+            if b_lo.is_finite() && b_hi.is_finite() && b_lo <= b_hi {
+                finite += 1;
+                narrower += usize::from(lo > b_lo || hi < b_hi);
+            }
+            let crosses = |t: f64| {
+                let Some(inc) = light.incident_at(ray.at(t)) else {
+                    return false;
+                };
+                let shadow = Ray {
+                    origin: ray.at(t),
+                    direction: inc.toward,
+                };
+                e.intersect(&shadow, c)
+                    .is_some_and(|h| h.t_exit > 0.0 && h.t_enter < inc.distance)
+            };
+            let mut check = |t: f64| {
+                if crosses(t) {
+                    crossing += 1;
+                    assert!(
+                        t >= lo && t <= hi,
+                        "trial {trial}: t {t} outside [{lo}, {hi}]"
+                    );
+                }
+            };
+            let ts: Vec<f64> = (0..800).map(|j| -20.0 + 0.05 * j as f64).collect();
+            for pair in ts.windows(2) {
+                check(pair[0]);
+                let (a, b) = (crosses(pair[0]), crosses(pair[1]));
+                if a != b {
+                    let (mut x0, mut x1) = (pair[0], pair[1]);
+                    for _ in 0..60 {
+                        let m = 0.5 * (x0 + x1);
+                        if crosses(m) == a {
+                            x0 = m;
+                        } else {
+                            x1 = m;
+                        }
+                    }
+                    check(x0);
+                    check(x1);
+                }
+            }
+        }
+        assert!(
+            finite > 100 && narrower * 2 > finite,
+            "the range should mostly be narrower: {narrower} of {finite}"
+        );
+        assert!(crossing > 5000, "the samples should cross: {crossing}");
     }
 
     /// The list-based hits equal the BVH's for random shadow rays from random camera segments,
