@@ -21,7 +21,7 @@
 //! every share of tol; the parts of err are [`ErrorParts`]). In that integrand the windows wide
 //! on a piece are one polynomial per piece (`reference::series`, their bound a part of err).
 //! The candidates are gathered front to back, and the gather stops where the ray surely stops
-//! ([`GaussianRenderer::gather`]).
+//! (`GaussianRenderer::gather`).
 //!
 //! **What is left out, and bounded into err.** The rendered medium is the true one less some
 //! density δσ ≥ 0: (1) every Gaussian whose k-σ ellipsoid the ray does not meet in front of
