@@ -122,6 +122,34 @@ fn shape_roots(ray: &Ray, light: &Light, shape: Shape) -> ([Option<f64>; 2], [u8
     }
 }
 
+/// `light` in the unit-sphere coordinates x ↦ M(x − c) of the ellipsoid `e` about `center`: a
+/// directional light's direction mapped and normalised, a point light's position mapped (the
+/// map takes shadow rays to the mapped light's shadow rays).
+pub(crate) fn light_in_unit_coordinates(
+    light: &Light,
+    center: DVec3,
+    e: &crate::geometry::Ellipsoid,
+) -> Light {
+    match *light {
+        Light::Directional {
+            direction,
+            irradiance,
+        } => Light::Directional {
+            direction: e.to_unit(DVec3::ZERO, direction).normalize(),
+            irradiance,
+        },
+        Light::Point {
+            position,
+            intensity,
+            falloff,
+        } => Light::Point {
+            position: e.to_unit(center, position),
+            intensity,
+            falloff,
+        },
+    }
+}
+
 /// [`shape_roots`] of an ellipsoid: the unit sphere's for the mapped ray and light.
 #[inline(never)]
 fn ellipsoid_roots(
@@ -131,24 +159,7 @@ fn ellipsoid_roots(
     ellipsoid: &crate::geometry::Ellipsoid,
 ) -> ([Option<f64>; 2], [u8; 2]) {
     let (unit, k) = ellipsoid.unit_ray(ray, center);
-    let mapped = match *light {
-        Light::Directional {
-            direction,
-            irradiance,
-        } => Light::Directional {
-            direction: ellipsoid.to_unit(DVec3::ZERO, direction).normalize(),
-            irradiance,
-        },
-        Light::Point {
-            position,
-            intensity,
-            falloff,
-        } => Light::Point {
-            position: ellipsoid.to_unit(center, position),
-            intensity,
-            falloff,
-        },
-    };
+    let mapped = light_in_unit_coordinates(light, center, ellipsoid);
     let (roots, sides) = sided_roots(&unit, &mapped, (DVec3::ZERO, 1.0));
     (roots.map(|s| s.map(|s| s / k)), sides)
 }

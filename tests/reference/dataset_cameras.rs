@@ -281,6 +281,11 @@ fn an_off_centre_principal_point_and_unequal_focal_lengths_render_the_closed_for
     assert!(inside > 50 && outside > 50, "{inside} {outside}");
 }
 
+/// A nerfstudio transforms.json of one frame: eye (1, 2, 3), the identity rotation, fx = fy = 30,
+/// 40×20 pixels.
+const ONE_FRAME_AT_1_2_3: &str = r#"{"fl_x": 30, "w": 40, "h": 20,
+    "frames": [{"file_path": "x.png", "transform_matrix": [[1,0,0,1],[0,1,0,2],[0,0,1,3],[0,0,0,1]]}]}"#;
+
 /// nerfstudio's dataparser transform, worked by hand: transform = Rz(90°) with translation
 /// (0.5, −0.25, 0.1), scale 0.5, on the camera-to-world of eye (1, 2, 3) with the identity
 /// rotation. c2w' = [T; 0 0 0 1]·c2w: the eye 0.5·(Rz·(1, 2, 3) + t) = 0.5·((−2, 1, 3) +
@@ -290,12 +295,7 @@ fn an_off_centre_principal_point_and_unequal_focal_lengths_render_the_closed_for
 fn a_nerfstudio_dataparser_transform_maps_the_cameras_into_the_models_frame() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    write(
-        d,
-        "transforms.json",
-        r#"{"fl_x": 30, "w": 40, "h": 20,
-            "frames": [{"file_path": "x.png", "transform_matrix": [[1,0,0,1],[0,1,0,2],[0,0,1,3],[0,0,0,1]]}]}"#,
-    );
+    write(d, "transforms.json", ONE_FRAME_AT_1_2_3);
     write(
         d,
         "dp.json",
@@ -334,12 +334,7 @@ fn a_nerfstudio_dataparser_transform_maps_the_cameras_into_the_models_frame() {
 fn a_bad_dataparser_file_exits_2_naming_it() {
     let dir = tempfile::tempdir().unwrap();
     let d = dir.path();
-    write(
-        d,
-        "transforms.json",
-        r#"{"fl_x": 30, "w": 40, "h": 20,
-            "frames": [{"file_path": "x.png", "transform_matrix": [[1,0,0,1],[0,1,0,2],[0,0,1,3],[0,0,0,1]]}]}"#,
-    );
+    write(d, "transforms.json", ONE_FRAME_AT_1_2_3);
     let pgt_camera = |toml: &str| {
         let scene = write(d, "dp.toml", toml);
         let out = Command::new(env!("CARGO_BIN_EXE_pgt"))

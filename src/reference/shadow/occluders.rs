@@ -608,24 +608,7 @@ fn ellipsoid_reach_range(
         + if t_end.is_finite() { t_end.abs() } else { 0.0 };
     let pad = RANGE_PADDING * size / e.shortest_semi_axis();
     let (unit, k) = e.unit_ray(camera_ray, c);
-    let mapped = match *light {
-        Light::Directional {
-            direction,
-            irradiance,
-        } => Light::Directional {
-            direction: e.to_unit(DVec3::ZERO, direction).normalize(),
-            irradiance,
-        },
-        Light::Point {
-            position,
-            intensity,
-            falloff,
-        } => Light::Point {
-            position: e.to_unit(c, position),
-            intensity,
-            falloff,
-        },
-    };
+    let mapped = crate::optics::kinks::light_in_unit_coordinates(light, c, e);
     if !(k > 0.0 && k.is_finite()) {
         return ALL;
     }
