@@ -211,6 +211,14 @@ struct Scratch {
     open: Vec<usize>,
     /// The (end, depth) pairs of a front-to-back gather ([`narrow_reach`]).
     reach: Vec<(f64, f64)>,
+    /// The long pieces tried by [`choose_long_pieces`], the narrow windows' cuts and the
+    /// windows' standard deviations, sorted.
+    long: Vec<f64>,
+    fixed: Vec<f64>,
+    sizes: Vec<f64>,
+    ends: Vec<f64>,
+    /// `points` are long pieces, on which every open window counts whole.
+    long_pieces: bool,
     /// Where the last gather stopped (+∞: it gathered the whole ray).
     reach_end: f64,
     /// The last sweep ran out of gathered windows before the ray could stop.
@@ -565,13 +573,21 @@ impl GaussianRenderer {
                 s.open.push(next);
                 next += 1;
             }
-            let (windows, members) = (&mut s.windows, &mut s.members);
+            let (windows, members, long) = (&mut s.windows, &mut s.members, s.long_pieces);
             s.open.retain(|&k| {
                 let w = &mut windows[k];
                 if w.hi <= a {
                     return false;
                 }
-                let (x0, x1) = (w.lo.max(a), w.hi.min(b));
+                // On long pieces a window open on the piece counts on all of it: its
+                // Gaussian's tail beyond the window's ends only brings the rendered medium
+                // nearer the true one (what is left out stays within Δ), and the window is
+                // summed as a polynomial on a piece it only partly covers.
+                let (x0, x1) = if long {
+                    (a, b)
+                } else {
+                    (w.lo.max(a), w.hi.min(b))
+                };
                 // The erfc at x0 is the one the last piece computed at its end, where the
                 // window goes on.
                 let from = match w.tail_at {
@@ -979,7 +995,141 @@ fn cut_pieces(s: &mut Scratch, lights: &[Light], ray: &Ray) {
     if s.points.last().is_some_and(|&last| last < end) {
         s.points.push(end);
     }
+    s.long_pieces = false;
+    if lights.is_empty() {
+        choose_long_pieces(s);
+    }
 }
+
+/// The longest piece, in standard deviations of each window open on it wider than the narrow
+/// ones: there the window is wide (r = h/(2s) ≤ 1/2) and its polynomial of degree 16 leaves
+/// at most ~10⁻¹³ of its peak out.
+const LONG_PIECE: f64 = 0.5;
+
+/// Long pieces are tried where the thinned cuts' pieces have at least this many windows open
+/// on them on average: with fewer, the windows rarely overlap enough to pay for the trial.
+const MIN_OPEN_FOR_LONG: usize = 48;
+
+/// The quantiles of the windows' standard deviations below which a window is narrow, tried by
+/// [`choose_long_pieces`].
+const NARROW_QUANTILES: [f64; 2] = [0.05, 0.2];
+
+/// Where no light scatters, replaces the thinned cuts by long pieces when that costs less:
+/// pieces as long as [`LONG_PIECE`] standard deviations of every window open on them, cut also
+/// at the ends and centres of the narrow windows (those below a quantile of the ray's standard
+/// deviations, [`NARROW_QUANTILES`]), which keep their own pieces. Flat Gaussians seen edge-on
+/// and face-on in one ray cut it at every window's ends though nearly every window is wide on
+/// the pieces between (docs/performance.md "Long pieces"); the cost compared is the sweep's,
+/// a pair of a window and a piece it is open on, eight where it is not wide there.
+fn choose_long_pieces(s: &mut Scratch) {
+    if s.windows.len() < 2 {
+        return;
+    }
+    s.ends.clear();
+    s.ends.extend(s.windows.iter().map(|w| w.hi));
+    s.ends.sort_unstable_by(f64::total_cmp);
+    let mut best = sweep_cost(&s.windows, &s.ends, &s.points);
+    let pieces = s.points.len().saturating_sub(1);
+    if best < (MIN_OPEN_FOR_LONG + PIECE_COST) * pieces {
+        return;
+    }
+    s.sizes.clear();
+    s.sizes.extend(s.windows.iter().map(|w| w.profile.s));
+    s.sizes.sort_unstable_by(f64::total_cmp);
+    let limit = 4 * s.points.len();
+    for q in NARROW_QUANTILES {
+        let narrow = s.sizes[(q * s.sizes.len() as f64) as usize];
+        let long = (&s.windows[..], &mut s.long, &mut s.fixed, &mut s.open);
+        if !cut_long_pieces(long, narrow, limit) {
+            continue;
+        }
+        let cost = sweep_cost(&s.windows, &s.ends, &s.long);
+        if cost < best {
+            best = cost;
+            std::mem::swap(&mut s.points, &mut s.long);
+            s.long_pieces = true;
+        }
+    }
+}
+
+/// Fills `points` with pieces no longer than 2·[`LONG_PIECE`] standard deviations of any window
+/// of s ≥ `narrow` open on them, cut at the ends and centres of the windows of s < `narrow`;
+/// false where that takes more than `limit` points or a piece would be empty in f64.
+fn cut_long_pieces(
+    (windows, points, fixed, open): (&[Window], &mut Vec<f64>, &mut Vec<f64>, &mut Vec<usize>),
+    narrow: f64,
+    limit: usize,
+) -> bool {
+    points.clear();
+    fixed.clear();
+    open.clear();
+    for w in windows.iter().filter(|w| w.profile.s < narrow) {
+        fixed.extend([w.lo, w.hi]);
+        if w.profile.t_star > w.lo && w.profile.t_star < w.hi {
+            fixed.push(w.profile.t_star);
+        }
+    }
+    fixed.sort_unstable_by(f64::total_cmp);
+    let end = windows.iter().fold(f64::NEG_INFINITY, |e, w| e.max(w.hi));
+    // Windows are sorted by their start.
+    let mut t = windows[0].lo;
+    points.push(t);
+    let (mut next, mut f) = (0, 0);
+    while t < end {
+        while next < windows.len() && windows[next].lo <= t {
+            if windows[next].profile.s >= narrow {
+                open.push(next);
+            }
+            next += 1;
+        }
+        open.retain(|&k| windows[k].hi > t);
+        while f < fixed.len() && fixed[f] <= t {
+            f += 1;
+        }
+        let mut b = fixed.get(f).map_or(end, |&x| x.min(end));
+        for &k in open.iter() {
+            b = b.min(t + 2.0 * LONG_PIECE * windows[k].profile.s);
+        }
+        // A window that starts on the piece shortens it to its own length, or ends it where
+        // it starts.
+        for w in &windows[next..] {
+            if w.lo >= b {
+                break;
+            }
+            if w.profile.s >= narrow {
+                b = b.min(w.lo.max(t + 2.0 * LONG_PIECE * w.profile.s));
+            }
+        }
+        if b <= t || points.len() >= limit {
+            return false;
+        }
+        points.push(b);
+        t = b;
+    }
+    true
+}
+
+/// What sweeping the pieces between `points` costs: one for each window open on a piece
+/// (an erfc and a polynomial term) and [`PIECE_COST`] a piece (its quadrature's nodes), from
+/// the windows' starts (sorted, as `windows` is) and `ends` (sorted).
+fn sweep_cost(windows: &[Window], ends: &[f64], points: &[f64]) -> usize {
+    let (mut started, mut ended, mut cost) = (0, 0, 0);
+    for piece in points.windows(2) {
+        let (a, b) = (piece[0], piece[1]);
+        while started < windows.len() && windows[started].lo < b {
+            started += 1;
+        }
+        while ended < ends.len() && ends[ended] <= a {
+            ended += 1;
+        }
+        cost += started - ended + PIECE_COST;
+    }
+    cost
+}
+
+/// What a piece costs beyond its windows in [`sweep_cost`]'s units: the quadrature's seven
+/// nodes or more, each two polynomials.
+const PIECE_COST: usize = 8;
 
 /// The depth of a 1D Gaussian beyond 3 standard deviations on one side, rounded up:
 /// erfc(3/√2)/2 = 0.0013499.
@@ -1012,5 +1162,106 @@ fn auto_cutoff(line_depth: f64, m_max: f64, tol: f64) -> f64 {
         (2.0 * ratio.ln()).sqrt().max(MIN_AUTO_CUTOFF)
     } else {
         MIN_AUTO_CUTOFF
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A window of standard deviation `s` along the ray about `t_star`, six of them each side.
+    fn window(index: u32, t_star: f64, s: f64) -> Window {
+        Window {
+            index,
+            profile: GaussianAlongRay {
+                t_star,
+                s,
+                peak: 0.1,
+            },
+            lo: t_star - 6.0 * s,
+            hi: t_star + 6.0 * s,
+            tail_at: None,
+        }
+    }
+
+    fn cut(windows: Vec<Window>, lights: &[Light]) -> Scratch {
+        let mut s = Scratch {
+            windows,
+            ..Scratch::default()
+        };
+        s.windows.sort_unstable_by(|a, b| a.lo.total_cmp(&b.lo));
+        let ray = Ray {
+            origin: DVec3::ZERO,
+            direction: DVec3::Z,
+        };
+        cut_pieces(&mut s, lights, &ray);
+        s.ends.clear();
+        s.ends.extend(s.windows.iter().map(|w| w.hi));
+        s.ends.sort_unstable_by(f64::total_cmp);
+        s
+    }
+
+    /// Many wide windows overlapping and a few flat ones among them (a ray along hair-like
+    /// splats): long pieces, each short enough for every wide window open on it to be wide,
+    /// the flat windows' ends and centres kept, and fewer pieces than the thinned cuts give.
+    #[test]
+    fn overlapping_wide_windows_take_long_pieces_and_narrow_ones_keep_their_cuts() {
+        // Standard deviations from 0.5 to 2.2, and three grazing windows far wider, which make
+        // the thinned cuts' gap wider than most windows: those keep their own cuts.
+        let mut windows: Vec<Window> = (0..120)
+            .map(|i| {
+                let s = 0.5 * (1.5 * f64::from(i % 11) / 10.0).exp();
+                window(i, 10.0 + 0.05 * f64::from(i), s)
+            })
+            .collect();
+        for k in 0..3 {
+            windows.push(window(300 + k, 12.0 + f64::from(k), 60.0));
+        }
+        let flat: Vec<(f64, f64)> = (0..12)
+            .map(|i| (8.0 + 0.61 * f64::from(i), 0.002 + 0.0001 * f64::from(i)))
+            .collect();
+        for (k, &(t, s)) in flat.iter().enumerate() {
+            windows.push(window(200 + k as u32, t, s));
+        }
+        // A sun keeps the thinned cuts (its shadow rays need no cut of their own).
+        let sun = Light::Directional {
+            direction: DVec3::NEG_Y,
+            irradiance: DVec3::ONE,
+        };
+        let thinned = cut(windows.clone(), &[sun]);
+        let s = cut(windows, &[]);
+        assert!(s.long_pieces, "{} points", s.points.len());
+        let narrow = s.sizes[(NARROW_QUANTILES[1] * s.sizes.len() as f64) as usize];
+        for piece in s.points.windows(2) {
+            let (a, b) = (piece[0], piece[1]);
+            assert!(b > a);
+            for w in s.windows.iter().filter(|w| w.lo < b && w.hi > a) {
+                if w.profile.s >= narrow {
+                    assert!(
+                        0.5 * (b - a) <= LONG_PIECE * w.profile.s * (1.0 + 1e-12),
+                        "[{a}, {b}] is too long for s = {}",
+                        w.profile.s
+                    );
+                }
+            }
+        }
+        for &(t, sd) in &flat {
+            for x in [t - 6.0 * sd, t, t + 6.0 * sd] {
+                assert!(s.points.contains(&x), "{x} is not a cut");
+            }
+        }
+        let cost = sweep_cost(&s.windows, &s.ends, &s.points);
+        let before = sweep_cost(&thinned.windows, &thinned.ends, &thinned.points);
+        assert!(cost < before, "{cost} against {before}");
+    }
+
+    /// Where few windows overlap, the thinned cuts stay (and with them the images of sparse
+    /// scenes).
+    #[test]
+    fn sparse_windows_keep_the_thinned_cuts() {
+        let windows = (0..30)
+            .map(|i| window(i, 2.0 + 1.5 * f64::from(i), 0.3 + 0.01 * f64::from(i)))
+            .collect();
+        assert!(!cut(windows, &[]).long_pieces);
     }
 }
