@@ -41,27 +41,29 @@
 //! transmittance has fallen to T with T·M ≤ twice the ray-stop share of tol stops: what lies
 //! beyond is in [0, T·M], taken as its midpoint with half of it in err.
 //!
-//! **Single-scatter.** The source is Q = a·E + α·(1/4π)·Σ_l E_l·T_l (docs/design.md §2), so
-//! σ·Q = a·Σσᵢ(t)Cᵢ + (1/4π)·Σᵢσᵢ(t)αᵢ·Σ_l E_l(x_t)·T_l(x_t): the first term is the emission
-//! model's with colours a·Cᵢ, the second is added to the quadrature's integrand of every piece,
-//! with T_l in closed form: the sum of the erf depths, over [0, d_l], of the Gaussians whose k-σ
-//! ellipsoid the shadow ray meets. The model is asked for its per-light part
+//! **Single-scatter.** The source is Q = a·E + α·(1/4π)·Σ_l E_l·T_l (docs/design.md §2), so σ·Q =
+//! a·Σσᵢ(t)Cᵢ + (1/4π)·Σᵢσᵢ(t)αᵢ·Σ_l E_l(x_t)·T_l(x_t): the first term is the emission model's with
+//! colours a·Cᵢ, the second is added to the quadrature's integrand of every piece, with T_l in
+//! closed form: the sum of the erf depths, over [0, d_l], of the Gaussians whose k-σ ellipsoid the
+//! shadow ray meets (a point light's by a BVH traversal per shadow ray, a directional light's from
+//! one list per piece, `reference::sun_lists`). The model is asked for its per-light part
 //! (`OpticalModel::light_source`, at the σ-weighted albedo of the point), never by name; a model
 //! that needs the shadow ray's radiance (lit) is refused. A point light's nearest point on the
-//! camera ray is a cut, where its 1/d² peaks. Two more things go into err: M above bounds Q on
-//! this ray, a·max Cᵢ + the model's part at max αᵢ and each light's largest irradiance on the
-//! ray (`Light::max_irradiance_beyond`, +∞ for a ray through a point light, which is then
-//! reported as not converged); and each shadow ray leaves out at most the same missed depth
-//! Δ_far as a camera ray, so the rendered T_l is at most e^{Δ_far} times the true one and the
-//! scattered radiance is high by at most (L + err)·(1 − e^{−Δ_far}). A shadow ray stops once
-//! its depth reaches D with e^{−D}·Σ_l q̂_l within the shadow-stop share of tol (q̂_l the bound
-//! of light l's part on this ray): its T_l is then high by at most e^{−D}, the pixel by at most
-//! e^{−D}·Σ_l q̂_l, which goes into err where a shadow ray stopped; where no shadow ray can stop,
-//! that share is the quadrature's.
+//! camera ray is a cut, where its 1/d² peaks. Two more things go into err: M above bounds Q on this
+//! ray, a·max Cᵢ + the model's part at max αᵢ and each light's largest irradiance on the ray
+//! (`Light::max_irradiance_beyond`, +∞ for a ray through a point light, which is then reported as
+//! not converged); and each shadow ray leaves out at most the same missed depth Δ_far as a camera
+//! ray, so the rendered T_l is at most e^{Δ_far} times the true one and the scattered radiance is
+//! high by at most (L + err)·(1 − e^{−Δ_far}). A shadow ray stops once its depth reaches D with
+//! e^{−D}·Σ_l q̂_l within the shadow-stop share of tol (q̂_l the bound of light l's part on this
+//! ray): its T_l is then high by at most e^{−D}, the pixel by at most e^{−D}·Σ_l q̂_l, which goes
+//! into err where a shadow ray stopped; where no shadow ray can stop, that share is the
+//! quadrature's.
 
 use super::budget::gaussian as share;
 use super::quadrature::{integrate_adaptive, Piece};
 use super::series::{WideSum, MAX_HALF_WIDTH};
+use super::sun_lists::{SunGaussian, SunLists};
 use super::volume::MAX_SEGMENTS;
 use super::{Integrator, RadianceEstimator, Sample};
 use crate::error::{PgtError, Result};
@@ -108,10 +110,15 @@ pub struct GaussianRenderer {
     tol: f64,
     /// The bound on the depth of the Gaussians a ray does not meet within k σ.
     far_depth: f64,
+    /// k, the cut-off of the ellipsoids in `bvh`.
+    cutoff: f64,
     model: &'static dyn OpticalModel,
     params: SourceParams,
     /// The lights whose part of Q is integrated: empty where the model has none.
     lights: Vec<Light>,
+    /// The unit direction toward each directional light of `lights`, in their order: their
+    /// shadow rays take a candidate list per piece (`reference::sun_lists`).
+    suns: Vec<DVec3>,
     /// Per channel, the largest k·Cᵢ, colour and albedo of any Gaussian.
     max_emitted: DVec3,
     max_color: DVec3,
@@ -223,6 +230,8 @@ struct Scratch {
     reach_end: f64,
     /// The last sweep ran out of gathered windows before the ray could stop.
     incomplete: bool,
+    /// The directional lights' candidate lists of the queued pieces.
+    suns: SunLists,
 }
 
 thread_local! {
@@ -278,6 +287,13 @@ impl GaussianRenderer {
         } else {
             scene.lights.clone()
         };
+        let suns = lights
+            .iter()
+            .filter_map(|l| match *l {
+                Light::Directional { direction, .. } => Some(-direction),
+                Light::Point { .. } => None,
+            })
+            .collect();
         let background = scene.render.background;
         let bound = gaussians.iter().fold(background, |m, g| m.max(g.emitted));
         let max_emitted = gaussians.iter().fold(DVec3::ZERO, |m, g| m.max(g.emitted));
@@ -297,9 +313,11 @@ impl GaussianRenderer {
             bound,
             tol,
             far_depth: 0.0,
+            cutoff: 0.0,
             model,
             params,
             lights,
+            suns,
             max_emitted,
             max_color,
             max_albedo,
@@ -308,6 +326,7 @@ impl GaussianRenderer {
             auto_cutoff(line_depth, renderer.typical_bound().max_element(), tol)
         });
         let gaussians = &renderer.gaussians;
+        renderer.cutoff = cutoff;
         renderer.far_depth = line_depth * (-0.5 * cutoff * cutoff).exp();
         renderer.bvh = Bvh::build_shapes(
             gaussians.iter().map(|g| g.center).collect(),
@@ -750,8 +769,11 @@ impl GaussianRenderer {
         let mut shadow_rays = 0;
         let mut stopped = false;
         if !s.pieces.is_empty() {
+            if !self.suns.is_empty() {
+                self.gather_suns(ray, s);
+            }
             let (windows, members, deviations) = (&s.windows, &s.members, &s.deviations);
-            let series = &s.series;
+            let (series, suns) = (&s.series, &s.suns);
             let scatters = !self.lights.is_empty();
             let integrand = |tag: usize, t: f64| {
                 let d = &deviations[tag];
@@ -788,13 +810,18 @@ impl GaussianRenderer {
                         emission: color / sigma,
                         albedo: albedo / sigma,
                     };
+                    let mut sun = 0;
                     for light in &self.lights {
                         let Some(incident) = light.incident_at(x) else {
                             continue;
                         };
                         shadow_rays += 1;
-                        let (transmittance, cut) =
-                            self.transmittance(x, incident.toward, incident.distance, stop_depth);
+                        let (transmittance, cut) = if let Light::Directional { .. } = light {
+                            sun += 1;
+                            suns.transmittance(tag, sun - 1, t, stop_depth)
+                        } else {
+                            self.transmittance(x, incident.toward, incident.distance, stop_depth)
+                        };
                         stopped |= cut;
                         let sample = LightSample {
                             radiance: DVec3::ZERO,
@@ -831,9 +858,26 @@ impl GaussianRenderer {
         (converged, shadow_rays, stopped)
     }
 
-    /// T_l: the transmittance from `x` over `distance` along `toward` (unit) through the
-    /// Gaussians whose k-σ ellipsoid that stretch meets, in closed form, in the BVH's order;
-    /// stopped once the depth reaches `stop_depth` (then true).
+    /// The directional lights' candidate lists of the queued pieces (`s.suns`, by the pieces'
+    /// tags, which are their positions in `s.pieces`).
+    fn gather_suns(&self, ray: &Ray, s: &mut Scratch) {
+        debug_assert!(s.pieces.iter().enumerate().all(|(k, p)| p.tag == k));
+        let gaussian = |index: u32| {
+            let g = &self.gaussians[index as usize];
+            SunGaussian {
+                center: g.center,
+                to_unit: g.shape.to_unit_matrix(),
+                sigma: g.sigma,
+            }
+        };
+        let pieces = s.pieces.iter().map(|p| (p.lo, p.hi));
+        s.suns
+            .gather(&self.bvh, gaussian, self.cutoff, ray, pieces, &self.suns);
+    }
+
+    /// T_l of a point light: the transmittance from `x` over `distance` along `toward` (unit)
+    /// through the Gaussians whose k-σ ellipsoid that stretch meets, in closed form, in the
+    /// BVH's order; stopped once the depth reaches `stop_depth` (then true).
     fn transmittance(
         &self,
         x: DVec3,

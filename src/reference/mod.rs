@@ -10,6 +10,7 @@ pub mod riemann;
 pub mod rows;
 pub mod series;
 pub mod shadow;
+pub mod sun_lists;
 pub mod volume;
 
 use crate::error::{PgtError, Result};

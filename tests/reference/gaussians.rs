@@ -4,7 +4,8 @@
 //! mapping through a scene file, the bound on the cut-off for k from 2 to 8, the coverage of
 //! err on a scene of a few thousand overlapping Gaussians, the single-scatter model against a
 //! brute-force nested sum and its err against a much tighter render with a point light inside
-//! the gas, and the refusals by name.
+//! the gas, a sun through a layer of small Gaussians against a sum over every Gaussian's shadow
+//! depth in closed form, and the refusals by name.
 //!
 //! The oracles evaluate σ(x) = σᵢ·exp(−½(x − c)ᵀΣ⁻¹(x − c)) in 3D with Σ = R·S²·Rᵀ built here
 //! from the quaternion, never through `optics::gaussian`.
@@ -707,6 +708,149 @@ fn single_scatter_matches_a_nested_brute_force_sum() {
             "{fine} vs {unlit}"
         );
     }
+}
+
+/// The optical depth over [0, ∞) of one Gaussian along `ray`, in closed form from its 3D
+/// covariance (not through `optics::gaussian`): with A = Σ⁻¹ the exponent along x + r·u is
+/// −½(αr² + 2βr + γ), α = uᵀAu, β = uᵀA(x − c), γ = (x − c)ᵀA(x − c), so the depth is
+/// σ·e^{−½(γ − β²/α)}·√(π/(2α))·erfc(β/√(2α)).
+fn half_line_depth(p: &Particle, ray: &Ray) -> f64 {
+    let (std, rotation) = match &p.ellipsoid {
+        Some(e) => (e.semi_axes(), e.rotation()),
+        None => (DVec3::splat(p.radius), DQuat::IDENTITY),
+    };
+    let r = DMat3::from_quat(rotation);
+    let a = r * DMat3::from_diagonal(DVec3::ONE / (std * std)) * r.transpose();
+    let (u, x) = (ray.direction, ray.origin - p.center);
+    let (alpha, beta, gamma) = (u.dot(a * u), u.dot(a * x), x.dot(a * x));
+    let least = (gamma - beta * beta / alpha).max(0.0);
+    p.sigma
+        * (-0.5 * least).exp()
+        * (std::f64::consts::PI / (2.0 * alpha)).sqrt()
+        * libm::erfc(beta / (2.0 * alpha).sqrt())
+}
+
+/// The single-scatter integral of a sun alone along `ray` by `n` midpoint steps over
+/// [0, t_max], each step exact for its midpoint's density and source, with the sun's
+/// transmittance from the depth of every Gaussian of the scene in closed form
+/// ([`half_line_depth`]: no cut-off, no list, no BVH).
+fn sunlit_sum(s: &Scene, ray: &Ray, t_max: f64, n: usize) -> DVec3 {
+    let [Light::Directional {
+        direction,
+        irradiance,
+    }] = s.lights[..]
+    else {
+        panic!("one sun");
+    };
+    let a = s.render.emission_weight;
+    let dt = t_max / n as f64;
+    let (mut l, mut t) = (DVec3::ZERO, 1.0);
+    for k in 0..n {
+        let x = ray.at((k as f64 + 0.5) * dt);
+        let (mut sigma, mut emitted, mut albedo) = (0.0, DVec3::ZERO, DVec3::ZERO);
+        for p in &s.particles {
+            let d = density(p, x);
+            sigma += d;
+            emitted += d * p.color;
+            albedo += d * p.albedo;
+        }
+        if sigma <= 0.0 {
+            continue;
+        }
+        let shadow = Ray::new(x, -direction);
+        let depth: f64 = s
+            .particles
+            .iter()
+            .map(|p| half_line_depth(p, &shadow))
+            .sum();
+        let q = a * emitted + albedo * irradiance * (-depth).exp() / (4.0 * std::f64::consts::PI);
+        let absorbed = -(-sigma * dt).exp_m1();
+        l += t * absorbed * q / sigma;
+        t *= 1.0 - absorbed;
+    }
+    l + t * s.render.background
+}
+
+/// A sun above a cloud on the camera's axis, and between them a layer of small round and flat
+/// Gaussians whose shadows stripe the cloud: the shadow rays of each piece of a camera ray take
+/// their Gaussians from one list per piece (`reference::sun_lists`), and a list that left out
+/// a Gaussian a shadow ray meets would brighten a stripe far beyond err. Against a midpoint sum
+/// whose shadow rays take every Gaussian of the scene in closed form.
+#[test]
+fn a_sun_through_a_layer_of_small_gaussians_matches_a_sum_over_every_gaussian() {
+    let mut rng = Rng::new(2047);
+    let mut particles: Vec<Particle> = (0..3)
+        .map(|_| {
+            gaussian(
+                rng.vec3(-0.3, 0.3),
+                DVec3::new(
+                    rng.range(0.6, 1.0),
+                    rng.range(0.6, 1.0),
+                    rng.range(0.6, 1.0),
+                ),
+                turned(rng.range(0.0, 3.0)),
+                rng.vec3(0.2, 1.0),
+                rng.range(0.3, 0.8),
+            )
+        })
+        .collect();
+    for k in 0..80 {
+        let mut std = DVec3::new(
+            rng.range(0.03, 0.2),
+            rng.range(0.03, 0.2),
+            rng.range(0.03, 0.2),
+        );
+        if k % 2 == 0 {
+            std.y = 1e-3 * std.x;
+        }
+        let center = DVec3::new(
+            rng.range(-1.2, 1.8),
+            rng.range(0.6, 2.5),
+            rng.range(-2.0, 1.5),
+        );
+        let p = gaussian(
+            center,
+            std,
+            turned(rng.range(0.0, 3.0)),
+            rng.vec3(0.0, 1.0),
+            1.0,
+        );
+        // Each stops about half the light through its centre across its thinnest axis.
+        let sigma = 0.7 / (std.min_element() * SQRT_TAU);
+        particles.push(Particle { sigma, ..p });
+    }
+    let sun = vec![Light::Directional {
+        direction: DVec3::new(-0.4, -1.0, 0.3).normalize(),
+        irradiance: DVec3::new(1.0, 0.9, 0.7),
+    }];
+    let s = single_scatter_scene(particles.clone(), sun.clone(), 16, 1e-7);
+    let r = renderer(&s);
+    let mut open = s.clone();
+    open.particles.truncate(3);
+    let mut striped = 0;
+    for (x, y) in [(8.0, 8.0), (7.3, 8.6), (8.9, 7.7), (8.2, 9.4), (6.6, 7.1)] {
+        let ray = s.camera.ray_at(x, y);
+        let fine = sunlit_sum(&s, &ray, 24.0, 40_000);
+        let coarse = sunlit_sum(&s, &ray, 24.0, 20_000);
+        let sum_error = (fine - coarse).abs();
+        let got = r.radiance(&ray);
+        assert!(got.shadow_rays > 0 && !got.unconverged, "{got:?}");
+        for c in 0..3 {
+            assert!(
+                (got.radiance[c] - fine[c]).abs() <= got.error[c] + sum_error[c] + 1e-10,
+                "({x}, {y}) channel {c}: {} against the sum over every Gaussian {} (err {}, sum {})",
+                got.radiance[c],
+                fine[c],
+                got.error[c],
+                sum_error[c]
+            );
+        }
+        assert!(sum_error.max_element() < 1e-6, "{sum_error}");
+        // The layer's shadows are what is tested: without it the pixel is far off.
+        let unshadowed = sunlit_sum(&open, &ray, 24.0, 40_000);
+        striped += usize::from((fine - unshadowed).abs().max_element() > 1e-3);
+    }
+    assert!(striped >= 4, "the layer shades {striped} of 5 rays");
 }
 
 #[test]
