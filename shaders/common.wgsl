@@ -443,10 +443,6 @@ fn pixel_tile(pixel: vec2<u32>) -> u32 {
     return (pixel.y / TILE_SIDE) * columns + pixel.x / TILE_SIDE;
 }
 
-// 3D Gaussian splatting's opacity of a splat at a pixel centre (its forward.cu renderCUDA):
-// α = min(cap, o·exp(−½ dᵀΣ₂D⁻¹d)), d the offset from the projected centre, cap the frame's
-// splat_alpha_cap (3DGS 0.99, gsplat 0.999); 0 where the quadratic form is negative
-// (rounding), as 3DGS and gsplat skip it.
 // Whether a pixel whose transmittance would become `next` stops before this splat: below the
 // frame's splat_stop_below (3DGS: test_T < 0.0001), or also equal to it where
 // splat_stop_inclusive is 1 (gsplat: next_T <= 1e-4).
@@ -455,6 +451,10 @@ fn splat_stops(next: f32) -> bool {
         || (frame.splat_stop_inclusive != 0u && next == frame.splat_stop_below);
 }
 
+// 3D Gaussian splatting's opacity of a splat at a pixel centre (its forward.cu renderCUDA):
+// α = min(cap, o·exp(−½ dᵀΣ₂D⁻¹d)), d the offset from the projected centre, cap the frame's
+// splat_alpha_cap (3DGS 0.99, gsplat 0.999); 0 where the quadratic form is negative
+// (rounding), as 3DGS and gsplat skip it.
 fn splat_alpha(s: Splat, pixel: vec2<u32>) -> f32 {
     let d = vec2<f32>(s.mean_x, s.mean_y) - (vec2<f32>(pixel) + vec2<f32>(0.5));
     let power = -0.5 * (s.conic_a * d.x * d.x + s.conic_c * d.y * d.y) - s.conic_b * d.x * d.y;
@@ -462,6 +462,36 @@ fn splat_alpha(s: Splat, pixel: vec2<u32>) -> f32 {
         return 0.0;
     }
     return min(frame.splat_alpha_cap, s.opacity * exp(power));
+}
+
+// Front-to-back α compositing as 3D Gaussian splatting does it (forward.cu renderCUDA):
+// L = Σ αᵢ·Tᵢ·Cᵢ + T·L_bg, Tᵢ the transmittance in front of splat i, the pixel stopping at the
+// first splat that would take it to the stop (splat_stops; that splat not added). The splat
+// methods and gauss-ray blend with it.
+struct AlphaBlend {
+    radiance: vec3<f32>,
+    transmittance: f32,
+}
+
+fn alpha_blend_start() -> AlphaBlend {
+    return AlphaBlend(vec3<f32>(0.0), 1.0);
+}
+
+// Adds a splat of colour `color` and opacity `alpha` behind what `b` holds; false where the
+// pixel stops before it (`b` unchanged).
+fn alpha_blend_over(b: ptr<function, AlphaBlend>, color: vec3<f32>, alpha: f32) -> bool {
+    let next = (*b).transmittance * (1.0 - alpha);
+    if (splat_stops(next)) {
+        return false;
+    }
+    (*b).radiance = (*b).radiance + color * (alpha * (*b).transmittance);
+    (*b).transmittance = next;
+    return true;
+}
+
+// The pixel's value: what was blended, and the background through the transmittance left.
+fn alpha_blend_end(b: AlphaBlend) -> vec3<f32> {
+    return b.radiance + b.transmittance * frame.background;
 }
 
 // A Gaussian's maximum response along a ray, for a shape widened to `widened` standard

@@ -11,84 +11,27 @@
 // when T < stop_below·10⁻⁶ (EVER: 0.004) or after max_batches batches (EVER: 400 iterations);
 // the background then still shows through the T left, the gas behind the stop does not.
 
-// The batch (EVER_MAX_BATCH, generated: the `batch` parameter's maximum): events sorted by (t, key), key = 2·particle index + (0 entry, 1 exit).
-var<private> ever_t: array<f32, EVER_MAX_BATCH>;
-var<private> ever_key: array<u32, EVER_MAX_BATCH>;
-var<private> ever_count: u32;
+// The batch of shaders/nearest_events.wgsl: events sorted by (t, key), key = 2·particle index
+// + (0 entry, 1 exit); EVER_MAX_BATCH is generated (the `batch` parameter's maximum). An event
+// carries nothing besides.
+alias EventT = f32;
+alias EventValue = u32;
+const EVENT_CAPACITY: u32 = EVER_MAX_BATCH;
+const EVENT_T_FAR: f32 = T_FAR;
 
-// Whether event (t_a, key_a) comes before (t_b, key_b).
-fn ever_before(t_a: f32, key_a: u32, t_b: f32, key_b: u32) -> bool {
-    return t_a < t_b || (t_a == t_b && key_a < key_b);
-}
-
-// Inserts an event into the batch of capacity `capacity`, keeping the nearest ones.
-fn ever_insert(t: f32, key: u32, capacity: u32) {
-    var slot = ever_count;
-    if (slot >= capacity) {
-        let last = capacity - 1u;
-        if (!ever_before(t, key, ever_t[last], ever_key[last])) {
-            return;
-        }
-        slot = last;
-    } else {
-        ever_count = slot + 1u;
-    }
-    loop {
-        count_iteration();
-        if (slot == 0u || !ever_before(t, key, ever_t[slot - 1u], ever_key[slot - 1u])) {
-            break;
-        }
-        ever_t[slot] = ever_t[slot - 1u];
-        ever_key[slot] = ever_key[slot - 1u];
-        slot = slot - 1u;
-    }
-    ever_t[slot] = t;
-    ever_key[slot] = key;
-}
-
-// One traversal: the `capacity` nearest events after (t_last, key_last). An entry behind the
-// camera (a camera inside the particle) is an event at t = 0; a particle wholly behind it has none.
-fn ever_collect(ray: Ray, t_last: f32, key_last: u32, capacity: u32) {
-    ever_count = 0u;
-    if (frame.particle_count == 0u) {
+// Particle i's entry and exit after (t_after, key_after). An entry behind the camera (a camera
+// inside the particle) is an event at t = 0; a particle wholly behind it has none.
+fn event_visit(ray: EventRay, i: u32, t_after: f32, key_after: u32, capacity: u32) {
+    let c = intersect_particle(Ray(ray.origin, ray.direction), particles[i]);
+    if (!c.hit || c.t_exit <= 0.0) {
         return;
     }
-    let inv = safe_inverse(ray.direction);
-    traversal_stack[0] = 0u;
-    var sp = 1u;
-    while (sp > 0u) {
-        count_iteration();
-        sp = sp - 1u;
-        let node = nodes[traversal_stack[sp]];
-        // A full batch prunes boxes that start beyond its farthest event.
-        var t_max = T_FAR;
-        if (ever_count >= capacity) {
-            t_max = ever_t[capacity - 1u];
-        }
-        if (!ray_box(ray.origin, inv, node.min, node.max, max(t_last, 0.0), t_max)) {
-            continue;
-        }
-        if (node.count > 0u) {
-            for (var k = 0u; k < node.count; k = k + 1u) {
-                count_iteration();
-                let i = leaf_indices[node.first + k];
-                let c = intersect_particle(ray, particles[i]);
-                if (!c.hit || c.t_exit <= 0.0) {
-                    continue;
-                }
-                let t_enter = max(c.t_enter, 0.0);
-                if (ever_before(t_last, key_last, t_enter, 2u * i)) {
-                    ever_insert(t_enter, 2u * i, capacity);
-                }
-                if (ever_before(t_last, key_last, c.t_exit, 2u * i + 1u)) {
-                    ever_insert(c.t_exit, 2u * i + 1u, capacity);
-                }
-            }
-        } else if (sp + 2u <= STACK_SIZE) {
-            traversal_stack[sp] = node.first;
-            traversal_stack[sp + 1u] = node.first + 1u;
-            sp = sp + 2u;
-        }
+    let t_enter = max(c.t_enter, 0.0);
+    if (event_before(t_after, key_after, t_enter, 2u * i)) {
+        event_insert(t_enter, 2u * i, 0u, capacity);
+    }
+    if (event_before(t_after, key_after, c.t_exit, 2u * i + 1u)) {
+        event_insert(c.t_exit, 2u * i + 1u, 0u, capacity);
     }
 }
 
@@ -109,16 +52,17 @@ fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {
     var t_last = -1.0;
     var key_last = 0u;
     var done = false;
+    let traced = EventRay(ray.origin, ray.origin, ray.direction, safe_inverse(ray.direction));
     for (var b = 0u; b < max_batches && !done; b = b + 1u) {
         count_iteration();
-        ever_collect(ray, t_last, key_last, capacity);
-        if (ever_count == 0u) {
+        events_collect(traced, t_last, key_last, capacity, frame.particle_count);
+        if (events_count == 0u) {
             break;
         }
-        for (var e = 0u; e < ever_count; e = e + 1u) {
+        for (var e = 0u; e < events_count; e = e + 1u) {
             count_iteration();
-            let t = ever_t[e];
-            let key = ever_key[e];
+            let t = events_t[e];
+            let key = events_key[e];
             let dt = t - t_cur;
             if (dt > 0.0) {
                 if (opaque_inside > 0u) {

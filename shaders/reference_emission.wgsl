@@ -3,7 +3,8 @@
 //
 // The constants REF_*, STATE_*, SCENE_*, PARAM_*, STATUS_*, the struct BvhNode and the bindings
 // are generated from src/reference/gpu/program.rs and prepended, with shaders/f64_math.wgsl (no
-// transcendental builtin is ever called on f64: lavapipe's return garbage).
+// transcendental builtin is ever called on f64: lavapipe's return garbage) and
+// shaders/nearest_events.wgsl (the batch and its BVH traversal, shared with ever and gauss-ray).
 //
 // Along the ray the particles' entry and exit points are events, taken in order of (t, key),
 // key = 4·index + kind (0 entry, 1 exit, 2 ghost), a batch of REF_BATCH at a time: each batch is
@@ -28,13 +29,14 @@ fn count_iteration() {
     loop_iterations = loop_iterations + 1u;
 }
 
-var<private> traversal_stack: array<u32, REF_STACK_SIZE>;
+var<private> traversal_stack: array<u32, STACK_SIZE>;
 
-// The batch: events sorted by (t, key), each with the optical depth by which it may be off.
-var<private> ev_t: array<f64, REF_BATCH>;
-var<private> ev_key: array<u32, REF_BATCH>;
-var<private> ev_depth: array<f64, REF_BATCH>;
-var<private> ev_count: u32;
+// The batch of shaders/nearest_events.wgsl: events sorted by (t, key), each with the optical
+// depth by which it may be off.
+alias EventT = f64;
+alias EventValue = f64;
+const EVENT_CAPACITY: u32 = REF_BATCH;
+const EVENT_T_FAR: f64 = REF_HUGE;
 
 // The particles the ray is inside at the last event taken, sorted by index.
 var<private> inside: array<u32, REF_INSIDE_MAX>;
@@ -146,37 +148,6 @@ fn particle_chord(o: vec3<f64>, d: vec3<f64>, i: u32) -> Chord64 {
     return c;
 }
 
-fn event_before(t_a: f64, key_a: u32, t_b: f64, key_b: u32) -> bool {
-    return t_a < t_b || (t_a == t_b && key_a < key_b);
-}
-
-// Inserts an event into the batch, keeping the nearest REF_BATCH.
-fn event_insert(t: f64, key: u32, depth: f64) {
-    var slot = ev_count;
-    if (slot >= REF_BATCH) {
-        let last = REF_BATCH - 1u;
-        if (!event_before(t, key, ev_t[last], ev_key[last])) {
-            return;
-        }
-        slot = last;
-    } else {
-        ev_count = slot + 1u;
-    }
-    loop {
-        count_iteration();
-        if (slot == 0u || !event_before(t, key, ev_t[slot - 1u], ev_key[slot - 1u])) {
-            break;
-        }
-        ev_t[slot] = ev_t[slot - 1u];
-        ev_key[slot] = ev_key[slot - 1u];
-        ev_depth[slot] = ev_depth[slot - 1u];
-        slot = slot - 1u;
-    }
-    ev_t[slot] = t;
-    ev_key[slot] = key;
-    ev_depth[slot] = depth;
-}
-
 fn inside_insert(i: u32) {
     if (inside_count >= REF_INSIDE_MAX) {
         inside_overflowed = true;
@@ -217,8 +188,8 @@ fn sigma_of(i: u32) -> f64 {
 
 // The events of particle i after (t_last, key_last) into the batch, and i into the inside set
 // where the ray is inside it there.
-fn visit_particle(o: vec3<f64>, d: vec3<f64>, i: u32, t_last: f64, key_last: u32) {
-    let c = particle_chord(o, d, i);
+fn event_visit(ray: EventRay, i: u32, t_last: f64, key_last: u32, capacity: u32) {
+    let c = particle_chord(ray.origin, ray.direction, i);
     let sigma = sigma_of(i);
     let opaque = sigma < 0.0lf;
     // A finite σ turns a chord-end error into optical depth; a Θmax = 1 particle's entry moves
@@ -228,7 +199,7 @@ fn visit_particle(o: vec3<f64>, d: vec3<f64>, i: u32, t_last: f64, key_last: u32
         if (c.ghost > 0.0lf) {
             let t_g = max(c.t_ghost, 0.0lf);
             if (c.t_ghost + c.ghost > 0.0lf && event_before(t_last, key_last, t_g, 4u * i + 2u)) {
-                event_insert(t_g, 4u * i + 2u, select(sigma * c.ghost, REF_HUGE, opaque));
+                event_insert(t_g, 4u * i + 2u, select(sigma * c.ghost, REF_HUGE, opaque), capacity);
             }
         }
         return;
@@ -236,83 +207,31 @@ fn visit_particle(o: vec3<f64>, d: vec3<f64>, i: u32, t_last: f64, key_last: u32
     if (c.t_exit <= 0.0lf) {
         // Behind the eye, unless the exact exit may lie in front of it.
         if (c.t_exit + c.err_exit > 0.0lf && event_before(t_last, key_last, 0.0lf, 4u * i + 2u)) {
-            event_insert(0.0lf, 4u * i + 2u, select(sigma * (c.t_exit + c.err_exit), REF_HUGE, opaque));
+            event_insert(0.0lf, 4u * i + 2u, select(sigma * (c.t_exit + c.err_exit), REF_HUGE, opaque), capacity);
         }
         return;
     }
     let t_enter = max(c.t_enter, 0.0lf);
     let exit_after = event_before(t_last, key_last, c.t_exit, 4u * i + 1u);
     if (event_before(t_last, key_last, t_enter, 4u * i)) {
-        event_insert(t_enter, 4u * i, per_length * c.err_enter);
+        event_insert(t_enter, 4u * i, per_length * c.err_enter, capacity);
     } else if (exit_after) {
         inside_insert(i);
     }
     if (exit_after) {
-        event_insert(c.t_exit, 4u * i + 1u, select(sigma * c.err_exit, 0.0lf, opaque));
+        event_insert(c.t_exit, 4u * i + 1u, select(sigma * c.err_exit, 0.0lf, opaque), capacity);
     }
 }
 
-// Slab test of the camera-relative f32 box (padded outwards by the approximation's layout,
-// far more than any f64 rounding here) against the ray from the camera-relative origin `rel`:
-// where the ray enters it within [t_min, t_max], or −1 where it does not.
-fn box_entry(rel: vec3<f64>, inv: vec3<f64>, node: BvhNode, t_min: f64, t_max: f64) -> f64 {
-    let t0 = (vec3<f64>(node.min) - rel) * inv;
-    let t1 = (vec3<f64>(node.max) - rel) * inv;
-    let lo = min(t0, t1);
-    let hi = max(t0, t1);
-    let t_near = max(max(lo.x, lo.y), max(lo.z, t_min));
-    let t_far = min(min(hi.x, hi.y), min(hi.z, t_max));
-    return select(-1.0lf, t_near, t_near <= t_far);
-}
-
-// One traversal: the REF_BATCH nearest events after (t_last, key_last) and the inside set there.
-// Nearer children first, so that the batch fills early and prunes the boxes beyond its farthest
-// event.
+// One traversal (shaders/nearest_events.wgsl; the boxes are camera-relative f32, padded outwards
+// by the approximation's layout far more than any f64 rounding here): the REF_BATCH nearest
+// events after (t_last, key_last) and the inside set there.
 fn collect(o: vec3<f64>, rel: vec3<f64>, d: vec3<f64>, t_last: f64, key_last: u32) {
-    ev_count = 0u;
     inside_count = 0u;
-    if (params.particle_count == 0u) {
-        return;
-    }
     let tiny = vec3<f64>(1.0e-300lf);
     let sign = select(vec3<f64>(1.0lf), vec3<f64>(-1.0lf), d < vec3<f64>(0.0lf));
     let inv = sign / max(abs(d), tiny);
-    let t_min = max(t_last, 0.0lf);
-    traversal_stack[0] = 0u;
-    var sp = 1u;
-    while (sp > 0u) {
-        count_iteration();
-        sp = sp - 1u;
-        let node = nodes[traversal_stack[sp]];
-        var t_max = REF_HUGE;
-        if (ev_count >= REF_BATCH) {
-            t_max = ev_t[REF_BATCH - 1u];
-        }
-        if (box_entry(rel, inv, node, t_min, t_max) < 0.0lf) {
-            continue;
-        }
-        if (node.count > 0u) {
-            for (var k = 0u; k < node.count; k = k + 1u) {
-                count_iteration();
-                visit_particle(o, d, leaf_indices[node.first + k], t_last, key_last);
-            }
-        } else if (sp + 2u <= REF_STACK_SIZE) {
-            let t_a = box_entry(rel, inv, nodes[node.first], t_min, t_max);
-            let t_b = box_entry(rel, inv, nodes[node.first + 1u], t_min, t_max);
-            // The nearer child is pushed last, to be popped first.
-            let a_first = t_b < 0.0lf || (t_a >= 0.0lf && t_a <= t_b);
-            let near = select(node.first + 1u, node.first, a_first);
-            let far = select(node.first, node.first + 1u, a_first);
-            if (max(t_a, t_b) >= 0.0lf && min(t_a, t_b) >= 0.0lf) {
-                traversal_stack[sp] = far;
-                sp = sp + 1u;
-            }
-            if (max(t_a, t_b) >= 0.0lf) {
-                traversal_stack[sp] = near;
-                sp = sp + 1u;
-            }
-        }
-    }
+    events_collect(EventRay(o, rel, d, inv), t_last, key_last, REF_BATCH, params.particle_count);
 }
 
 // What one ray carries from pass to pass (STATE_* offsets into `state`).
@@ -410,23 +329,23 @@ fn composite_interval(s: ptr<function, RayState>, t0: f64, t1: f64) -> bool {
 
 // Takes the batch's events in order. Returns whether the ray has ended.
 fn take_batch(s: ptr<function, RayState>) -> bool {
-    for (var e = 0u; e < ev_count; e = e + 1u) {
+    for (var e = 0u; e < events_count; e = e + 1u) {
         count_iteration();
-        let t = ev_t[e];
+        let t = events_t[e];
         let t_cur = max((*s).t_last, 0.0lf);
         if (t > t_cur && inside_count > 0u) {
             if (composite_interval(s, t_cur, t)) {
                 return true;
             }
         }
-        let key = ev_key[e];
+        let key = events_key[e];
         let kind = key % 4u;
         if (kind == 0u) {
             inside_insert(key / 4u);
         } else if (kind == 1u) {
             inside_remove(key / 4u);
         }
-        (*s).depth = (*s).depth + ev_depth[e];
+        (*s).depth = (*s).depth + events_value[e];
         (*s).t_last = t;
         (*s).key_last = key;
         if ((*s).transmittance < REF_T_STOP) {
@@ -473,7 +392,7 @@ fn reference_main(@builtin(global_invocation_id) gid: vec3<u32>) {
             s.status = STATUS_INSIDE_OVERFLOW;
             break;
         }
-        if (ev_count == 0u) {
+        if (events_count == 0u) {
             finish(&s, true);
             s.status = STATUS_DONE;
             break;

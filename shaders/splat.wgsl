@@ -10,8 +10,7 @@
 fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {
     let tile = pixel_tile(pixel);
     let end = tile_entries[2u * tile + 1u];
-    var radiance = vec3<f32>(0.0);
-    var transmittance = 1.0;
+    var blend = alpha_blend_start();
     for (var k = tile_entries[2u * tile]; k < end; k = k + 1u) {
         count_iteration();
         let s = splats[tile_entries[k]];
@@ -19,12 +18,9 @@ fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {
         if (alpha < frame.splat_alpha_skip) {
             continue;
         }
-        let next = transmittance * (1.0 - alpha);
-        if (splat_stops(next)) {
+        if (!alpha_blend_over(&blend, particles[s.particle].color, alpha)) {
             break;
         }
-        radiance = radiance + particles[s.particle].color * (alpha * transmittance);
-        transmittance = next;
     }
-    return radiance + transmittance * frame.background;
+    return alpha_blend_end(blend);
 }

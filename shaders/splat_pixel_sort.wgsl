@@ -25,18 +25,13 @@ fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {
         let peak = gaussian_peak(ray, particles[s.particle], 1.0);
         hit_list_insert(&pixel_splats, index, Chord(peak.t_star, alpha, true));
     }
-    var radiance = vec3<f32>(0.0);
-    var transmittance = 1.0;
+    var blend = alpha_blend_start();
     for (var k = 0u; k < pixel_splats.count; k = k + 1u) {
         count_iteration();
-        let alpha = pixel_splats.t_exit[k];
-        let next = transmittance * (1.0 - alpha);
-        if (splat_stops(next)) {
+        let p = particles[splats[pixel_splats.index[k]].particle];
+        if (!alpha_blend_over(&blend, p.color, pixel_splats.t_exit[k])) {
             break;
         }
-        let p = particles[splats[pixel_splats.index[k]].particle];
-        radiance = radiance + p.color * (alpha * transmittance);
-        transmittance = next;
     }
-    return radiance + transmittance * frame.background;
+    return alpha_blend_end(blend);
 }

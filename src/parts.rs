@@ -19,16 +19,17 @@
 //! | `pgtImageSize` | `WxH` of the whole image |
 //! | `pgtPart` | `I/N` |
 //! | `pgtRows` | `y mod N = I` (the layout, for a human reading the header) |
-//! | `pgtRenderHash` | 128-bit FNV-1a of the loaded scene (camera, render settings with the command-line overrides, lights, particles, bit for bit), the options that change pixels (`--spp`, `--integrator`, `--samples`) and pgt's version |
+//! | `pgtRenderHash` | 128-bit FNV-1a of the loaded scene (camera, render settings with the command-line overrides, lights, particles, bit for bit), the options that change pixels (`--spp`, `--integrator`, `--samples`, `--gpu` with the adapter's name) and pgt's version |
 //!
 //! Every pixel is a pure function of the scene and those options (docs/design.md §3), and a part goes
-//! through the same per-pixel code as a whole render ([`crate::reference::render_pixel`]), so
-//! the merge is bit-identical to a one-machine render, err layer included.
+//! through the same per-pixel code as a whole render ([`crate::reference::render_pixel`], or on
+//! the GPU the same per-ray program, [`crate::reference::gpu::render_rows_on`]), so the merge is
+//! bit-identical to a one-machine render on the same device, err layer included.
 
 use crate::error::{PgtError, Result};
 use crate::image_io::RgbImage;
 use crate::optics::particle::Particle;
-use crate::reference::{rows::render_rows, RenderOptions, RenderStats};
+use crate::reference::{rows::render_rows, Device, RenderOptions, RenderStats};
 use crate::scene::Scene;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
@@ -143,10 +144,21 @@ pub const RENDER_HASH_ATTRIBUTE: &str = "pgtRenderHash";
 /// warnings, so the same scene at another path on another node matches) and the options that
 /// change pixels, with pgt's version (another version may compute other bits).
 pub fn render_hash(scene: &Scene, options: &RenderOptions) -> String {
-    hash_with(
-        scene,
-        &format!("spp {} | {:?}", options.spp, options.integrator),
-    )
+    render_hash_on(scene, options, Device::Cpu)
+}
+
+/// [`render_hash`] of a render on `device`: a GPU render's hash adds the GPU and its adapter
+/// (the GPU's bits differ from the CPU's, and another adapter may compute other bits); the
+/// CPU's is [`render_hash`]'s.
+pub fn render_hash_on(scene: &Scene, options: &RenderOptions, device: Device) -> String {
+    let options_text = format!("spp {} | {:?}", options.spp, options.integrator);
+    match device {
+        Device::Cpu => hash_with(scene, &options_text),
+        Device::Gpu(ctx) => hash_with(
+            scene,
+            &format!("{options_text} | gpu reference on {}", ctx.adapter.name),
+        ),
+    }
 }
 
 /// The hash of `scene` (as [`render_hash`] sees it) with `what` computes it (the options, or a
@@ -200,10 +212,11 @@ pub struct Part {
     pub error: Option<RgbImage>,
 }
 
-/// Renders part `part` of the scene's image.
+/// Renders part `part` of the scene's image on `device`.
 pub fn render_part(
     scene: &Scene,
     options: &RenderOptions,
+    device: Device,
     part: PartOf,
 ) -> Result<(Part, RenderStats)> {
     let (width, height) = (scene.camera.width, scene.camera.height);
@@ -212,12 +225,16 @@ pub fn render_part(
             "--part {part}: at most {height} parts for an image {height} rows high (a part is a set of rows)"
         )));
     }
-    let out = render_rows(scene, options, &rows_of(part, height))?;
+    let rows = rows_of(part, height);
+    let out = match device {
+        Device::Cpu => render_rows(scene, options, &rows)?,
+        Device::Gpu(ctx) => crate::reference::gpu::render_rows_on(ctx, scene, options, &rows)?,
+    };
     let header = PartHeader {
         width,
         height,
         part,
-        hash: render_hash(scene, options),
+        hash: render_hash_on(scene, options, device),
     };
     let rendered = Part {
         header,

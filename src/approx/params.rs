@@ -113,15 +113,19 @@ impl Method {
 
     /// The complete program with the parameter slots named after `values` (in slot order).
     pub fn program(&self, values: &[(String, u32)]) -> Result<ShaderProgram> {
-        let part = match self {
-            Method::Builtin(m) => ShaderPart {
-                name: m.wgsl_path().into(),
-                text: Cow::Borrowed(m.wgsl()),
-            },
-            Method::User(path) => super::user_shader::load(path)?,
+        let (part, modules) = match self {
+            Method::Builtin(m) => (
+                ShaderPart {
+                    name: m.wgsl_path().into(),
+                    text: Cow::Borrowed(m.wgsl()),
+                },
+                m.modules(),
+            ),
+            Method::User(path) => (super::user_shader::load(path)?, &[][..]),
         };
-        Ok(ShaderProgram::with_method(
+        Ok(ShaderProgram::with_method_and_modules(
             part,
+            modules,
             values.iter().map(|(n, _)| n.as_str()),
         ))
     }

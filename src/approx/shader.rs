@@ -11,6 +11,32 @@ use std::borrow::Cow;
 pub const COMMON_WGSL: &str = include_str!("../../shaders/common.wgsl");
 /// The compute entry point `pgt_main`, appended after the method.
 pub const ENTRY_WGSL: &str = include_str!("../../shaders/entry.wgsl");
+/// A WGSL file shared by several programs and included where a program needs it (WGSL has no
+/// imports): the program declares what the module leaves to it (its header says what).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct WgslModule {
+    /// The file's path in the repository, for messages.
+    pub path: &'static str,
+    pub text: &'static str,
+}
+
+impl WgslModule {
+    /// The module as a part of a program.
+    pub fn part(&self) -> ShaderPart {
+        ShaderPart {
+            name: self.path.into(),
+            text: Cow::Borrowed(self.text),
+        }
+    }
+}
+
+/// `shaders/nearest_events.wgsl`: the batch of the nearest events along a ray and the BVH
+/// traversal that fills it (`ever`, `gauss-ray` and the GPU reference).
+pub const NEAREST_EVENTS: WgslModule = WgslModule {
+    path: "shaders/nearest_events.wgsl",
+    text: include_str!("../../shaders/nearest_events.wgsl"),
+};
+
 /// The name the entry point file has in messages.
 const ENTRY_FILE: &str = "shaders/entry.wgsl";
 /// Name of the compute entry point.
@@ -74,11 +100,21 @@ impl ShaderProgram {
         method: ShaderPart,
         param_names: impl IntoIterator<Item = &'a str>,
     ) -> ShaderProgram {
+        ShaderProgram::with_method_and_modules(method, &[], param_names)
+    }
+
+    /// [`ShaderProgram::with_method`] with the shared `modules` the method uses, before it.
+    pub fn with_method_and_modules<'a>(
+        method: ShaderPart,
+        modules: &[WgslModule],
+        param_names: impl IntoIterator<Item = &'a str>,
+    ) -> ShaderProgram {
         let mut parts = prelude_parts();
         parts.push(ShaderPart {
             name: GENERATED_PARAMS.into(),
             text: Cow::Owned(super::wgsl::param_declarations(param_names)),
         });
+        parts.extend(modules.iter().map(WgslModule::part));
         parts.push(method);
         parts.push(ShaderPart {
             name: ENTRY_FILE.into(),
@@ -261,8 +297,9 @@ mod tests {
     #[test]
     fn shipped_methods_validate() {
         for method in crate::approx::methods::METHODS {
-            let prog = ShaderProgram::with_method(
+            let prog = ShaderProgram::with_method_and_modules(
                 part(method.name(), method.wgsl()),
+                method.modules(),
                 method.params().iter().map(|p| p.name),
             );
             if let Err(e) = prog.validate() {

@@ -15,7 +15,7 @@
 //! target: ≤ 1.05), and the building's and the hash's shares of the sequence.
 
 use crate::parts::render_hash;
-use crate::reference::{self, RenderOptions};
+use crate::reference::{self, Device, RenderOptions};
 use crate::scene::{SceneFrames, SceneLoadOptions};
 use crate::sequence::render::{render_frames, write_frame, FrameDone};
 use crate::sequence::SequencePattern;
@@ -121,7 +121,15 @@ pub fn bench_frames(
         let start = Instant::now();
         let pattern = SequencePattern::parse(&dir.path().join("seq/f_%04d.exr"))?;
         let seq = load()?;
-        render_frames(&seq, &list, &pattern, &options, 0.0, &|_: &FrameDone| {})?;
+        render_frames(
+            &seq,
+            &list,
+            &pattern,
+            &options,
+            Device::Cpu,
+            0.0,
+            &|_: &FrameDone| {},
+        )?;
         let sequence = start.elapsed().as_secs_f64();
 
         let start = Instant::now();

@@ -3,9 +3,10 @@
 use super::output::{check_outputs, Output, OutputKind};
 use super::Outcome;
 use clap::{Args, ValueEnum};
+use pgt::approx::GpuContext;
 use pgt::image_io::write_image;
 use pgt::parts::PartOf;
-use pgt::reference::{self, Integrator, RenderOptions};
+use pgt::reference::{self, Device, Integrator, RenderOptions};
 use pgt::scene::{Model, RenderMode, SceneLoadOptions};
 use std::path::PathBuf;
 
@@ -71,7 +72,8 @@ pub struct RenderArgs {
     pub part: Option<PartOf>,
     /// Render on the GPU in f64 (docs/design.md §12): the same image and err as the CPU
     /// reference, within both errs. The emission model of spheres and ellipsoids; an adapter
-    /// without f64 is refused by name.
+    /// without f64 is refused by name. With --frames and --part too: a GPU render's hash names
+    /// the GPU and its adapter, so its frames and parts are never taken for the CPU's.
     #[arg(long)]
     pub gpu: bool,
     /// With --gpu: use the adapter whose name contains this (case-insensitive).
@@ -114,6 +116,20 @@ impl RenderArgs {
         })
     }
 
+    /// With --gpu, the device that renders `scene` (a scene the GPU reference cannot render is
+    /// refused by name before any adapter is opened); `None` for the CPU.
+    fn gpu_context(
+        &self,
+        scene: &pgt::scene::Scene,
+        options: &RenderOptions,
+    ) -> anyhow::Result<Option<GpuContext>> {
+        if !self.gpu {
+            return Ok(None);
+        }
+        reference::gpu::check_supported(scene, options)?;
+        Ok(Some(GpuContext::with_f64(self.adapter.as_deref())?))
+    }
+
     /// `--part`, or the deprecated `--tile` with a one-line warning.
     fn part(&self) -> Option<PartOf> {
         if self.tile.is_some() {
@@ -125,9 +141,6 @@ impl RenderArgs {
 
 pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
     let part = args.part();
-    if args.gpu && (part.is_some() || args.frames.is_some()) {
-        anyhow::bail!("--gpu renders whole single images for now: drop --part or --frames");
-    }
     if let Some(range) = args.frames {
         return render_frames(&args, range, part);
     }
@@ -138,17 +151,17 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
     check_outputs(&[Output::new("--output", &args.output, kind)])?;
     let scene = super::load_scene_for(&args.scene, &args.load_options(), args.exposure)?;
     let render_options = args.render_options()?;
+    let ctx = args.gpu_context(&scene, &render_options)?;
+    let device = ctx.as_ref().map_or(Device::Cpu, Device::Gpu);
+    let on = ctx
+        .as_ref()
+        .map_or(String::new(), |c| format!(" on {}", c.adapter));
     if let Some(part) = part {
-        return render_part(&args, &scene, &render_options, part);
+        return render_part(&args, &scene, &render_options, (device, &on), part);
     }
-    let mut on = String::new();
-    let out = if args.gpu {
-        reference::gpu::check_supported(&scene, &render_options)?;
-        let ctx = pgt::approx::GpuContext::with_f64(args.adapter.as_deref())?;
-        on = format!(" on {}", ctx.adapter);
-        reference::gpu::render_on(&ctx, &scene, &render_options)?
-    } else {
-        reference::render(&scene, &render_options)?
+    let out = match device {
+        Device::Cpu => reference::render(&scene, &render_options)?,
+        Device::Gpu(ctx) => reference::gpu::render_on(ctx, &scene, &render_options)?,
     };
     let layers: Vec<(&str, &pgt::image_io::RgbImage)> =
         out.error.iter().map(|e| ("err", e)).collect();
@@ -184,16 +197,18 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
 }
 
 /// `--part I/N`: renders and writes one part (`pgt::parts`), with a one-line summary.
+/// `on` names the GPU's adapter in the summary (empty on the CPU).
 fn render_part(
     args: &RenderArgs,
     scene: &pgt::scene::Scene,
     options: &RenderOptions,
+    (device, on): (Device, &str),
     which: PartOf,
 ) -> anyhow::Result<Outcome> {
-    let (part, s) = pgt::parts::render_part(scene, options, which)?;
+    let (part, s) = pgt::parts::render_part(scene, options, device, which)?;
     pgt::parts::write_part(&args.output, &part)?;
     eprintln!(
-        "rendered part {which} ({} of {} rows of {}x{}) into {} in {:.2} s: {} primary + {} shadow rays",
+        "rendered part {which} ({} of {} rows of {}x{}) into {}{on} in {:.2} s: {} primary + {} shadow rays",
         part.image.height,
         scene.camera.height,
         scene.camera.width,
@@ -222,12 +237,15 @@ fn render_frames(
         part,
         &args.output,
     )?;
+    let ctx = args.gpu_context(frames.first(), &render_options)?;
+    let device = ctx.as_ref().map_or(Device::Cpu, Device::Gpu);
     let progress = super::frames::FrameProgress::new("render", list.len());
     let summary = pgt::sequence::render::render_frames(
         &frames,
         &list,
         &pattern,
         &render_options,
+        device,
         args.exposure,
         &progress,
     );
@@ -236,11 +254,13 @@ fn render_frames(
     let (rendered, skipped) = summary.counts();
     let t = summary.totals();
     eprintln!(
-        "rendered {rendered} frame(s) of {} into {} ({}x{}){}: {:.2} s of rendering, {} primary + {} shadow rays",
+        "rendered {rendered} frame(s) of {} into {} ({}x{}){}{}: {:.2} s of rendering, {} primary + {} shadow rays",
         args.scene.display(),
         args.output.display(),
         frames.first().camera.width,
         frames.first().camera.height,
+        ctx.as_ref()
+            .map_or(String::new(), |c| format!(" on {}", c.adapter)),
         if skipped > 0 {
             format!(", skipped {skipped} already rendered")
         } else {

@@ -78,6 +78,16 @@ impl Default for RenderOptions {
     }
 }
 
+/// Where a reference render is computed: on the CPU's cores, or on a GPU in f64
+/// ([`gpu`], docs/design.md §12). Both give the same image within both errs, not the same bits,
+/// so a render's hash (`crate::parts::render_hash_on`) names which.
+#[derive(Clone, Copy)]
+pub enum Device<'a> {
+    Cpu,
+    /// A device opened with f64 ([`crate::approx::GpuContext::with_f64`]).
+    Gpu(&'a crate::approx::GpuContext),
+}
+
 /// Figures for the one-line summary (docs/design.md §7).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RenderStats {

@@ -11,7 +11,9 @@
 //!
 //! The reference renders small frames side by side (one worker each) and large frames one after
 //! the other with all workers on the frame's pixels ([`frames_side_by_side`]); either way one
-//! frame's scene is held per worker, never the whole sequence.
+//! frame's scene is held per worker, never the whole sequence. The GPU reference (`--gpu`,
+//! [`Device::Gpu`]) renders the frames one after the other; its frames' hash names the GPU
+//! ([`crate::parts::render_hash_on`]), so a CPU frame is never taken for a GPU one.
 //!
 //! A [`FrameWatch`] follows the work: each frame as it starts (with the [`RenderControl`] that
 //! counts its blocks, or its GPU passes) and as it ends; the CLI draws its progress from it.
@@ -21,7 +23,7 @@ use crate::approx::dispatch::PassProgress;
 use crate::approx::{ApproxParams, ApproxPipeline, GpuContext, Method};
 use crate::error::{PgtError, Result};
 use crate::image_io::{write_exr_with_header, write_image, ImageFormat, RgbImage};
-use crate::reference::{self, RenderControl, RenderOptions, RenderStats};
+use crate::reference::{self, Device, RenderControl, RenderOptions, RenderStats};
 use crate::scene::{Scene, SceneFrames};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -65,8 +67,8 @@ impl FrameDone {
 /// What a sequence render tells its caller as it goes (the CLI's progress). Calls come from any
 /// worker, several frames at a time where frames render side by side.
 pub trait FrameWatch: Sync {
-    /// Frame `frame` starts: the reference's with the `control` that counts its blocks until it
-    /// ends, a GPU method's with none (its passes follow).
+    /// Frame `frame` starts: the CPU reference's with the `control` that counts its blocks until
+    /// it ends, a GPU method's (its passes follow) or the GPU reference's with none.
     fn started(&self, _frame: usize, _control: Option<&Arc<RenderControl>>) {}
     /// A GPU method ended a pass of frame `frame`.
     fn pass(&self, _frame: usize, _progress: PassProgress) {}
@@ -188,14 +190,17 @@ fn in_frame(frame: usize) -> impl Fn(PgtError) -> PgtError {
     move |e| e.context(format!("frame {frame}"))
 }
 
-/// Renders the reference of each frame of `list` into `pattern`'s files, telling `watch` as each
-/// frame starts and ends (from any worker). Frames start in the order of `list`; the first error, by frame
-/// order, ends the sequence: frames not yet started are not started, frames written stay.
+/// Renders the reference of each frame of `list` on `device` into `pattern`'s files, telling
+/// `watch` as each frame starts and ends (from any worker). Frames start in the order of `list`;
+/// the first error, by frame order, ends the sequence: frames not yet started are not started,
+/// frames written stay. On the GPU the frames render one after the other, each with the whole
+/// device, and a scene the GPU reference cannot render is refused before the first frame.
 pub fn render_frames(
     frames: &SceneFrames,
     list: &[usize],
     pattern: &SequencePattern,
     options: &RenderOptions,
+    device: Device,
     exposure: f32,
     watch: &dyn FrameWatch,
 ) -> Result<SequenceSummary> {
@@ -203,7 +208,11 @@ pub fn render_frames(
         .threads
         .unwrap_or_else(rayon::current_num_threads)
         .max(1);
-    let side_by_side = frames_side_by_side(frames.first(), workers);
+    if let Device::Gpu(_) = device {
+        reference::gpu::check_supported(frames.first(), options)?;
+    }
+    let side_by_side =
+        matches!(device, Device::Cpu) && frames_side_by_side(frames.first(), workers);
     let failed = AtomicBool::new(false);
     let one = |frame: usize| -> Option<Result<FrameDone>> {
         if failed.load(Ordering::Relaxed) {
@@ -214,7 +223,7 @@ pub fn render_frames(
             frame,
             pattern,
             options,
-            side_by_side,
+            (device, side_by_side),
             exposure,
             watch,
         );
@@ -256,19 +265,20 @@ pub fn render_frames(
     Ok(summary)
 }
 
+/// One frame on `device`; `side_by_side`: with other frames, on one worker.
 fn render_one(
     frames: &SceneFrames,
     frame: usize,
     pattern: &SequencePattern,
     options: &RenderOptions,
-    side_by_side: bool,
+    (device, side_by_side): (Device, bool),
     exposure: f32,
     watch: &dyn FrameWatch,
 ) -> Result<FrameDone> {
     // The frame sources' errors name the frame already.
     let scene = frames.frame(frame)?;
     let path = output_path(pattern, frame)?;
-    let hash = crate::parts::render_hash(&scene, options);
+    let hash = crate::parts::render_hash_on(&scene, options, device);
     if already_rendered(&path, &hash) {
         return Ok(FrameDone::Skipped { frame, path });
     }
@@ -281,10 +291,18 @@ fn render_one(
         progress: false,
         ..*options
     };
-    let control = Arc::new(RenderControl::default());
-    watch.started(frame, Some(&control));
-    let out =
-        reference::render_controlled(&scene, &frame_options, &control).map_err(in_frame(frame))?;
+    let out = match device {
+        Device::Cpu => {
+            let control = Arc::new(RenderControl::default());
+            watch.started(frame, Some(&control));
+            reference::render_controlled(&scene, &frame_options, &control)
+        }
+        Device::Gpu(ctx) => {
+            watch.started(frame, None);
+            reference::gpu::render_on(ctx, &scene, &frame_options)
+        }
+    }
+    .map_err(in_frame(frame))?;
     write_frame(
         &path,
         frame,

@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 /// A context with f64, or `None` outside CI where there is none (a failure under `CI=true`).
-fn gpu64() -> Option<&'static GpuContext> {
+pub(super) fn gpu64() -> Option<&'static GpuContext> {
     static CTX: OnceLock<Result<GpuContext, String>> = OnceLock::new();
     let ctx = CTX.get_or_init(|| GpuContext::with_f64(None).map_err(|e| e.to_string()));
     match ctx {
@@ -535,8 +535,10 @@ fn pgt_render_gpu_refuses_what_it_cannot_render_with_exit_2_and_no_file() {
             "riemann",
         ),
         (
-            vec!["render", "--gpu", "--part", "0/2", scene, "-o", out_s],
-            "--part",
+            vec![
+                "render", "--gpu", "--model", "lit", "--part", "0/2", scene, "-o", out_s,
+            ],
+            "lit",
         ),
     ]
     .into_iter()

@@ -23,6 +23,7 @@
 //! pgt approx scene.toml --method ever --model emission -o ever.exr
 //! ```
 
+use crate::approx::shader::{WgslModule, NEAREST_EVENTS};
 use super::{ApproxMethod, Computes};
 use crate::approx::contract::EVER_MAX_BATCH;
 use crate::approx::param_spec::ParamSpec;
@@ -74,6 +75,9 @@ impl ApproxMethod for Ever {
     }
     fn params(&self) -> &'static [ParamSpec] {
         PARAMS
+    }
+    fn modules(&self) -> &'static [WgslModule] {
+        &[NEAREST_EVENTS]
     }
     fn computes(&self) -> Computes {
         Computes::Volume(&[models::EMISSION])

@@ -20,6 +20,7 @@
 //! pgt approx gaussians.toml --method gauss-ray -o gauss_ray.exr
 //! ```
 
+use crate::approx::shader::{WgslModule, NEAREST_EVENTS};
 use super::{ApproxMethod, Computes, Preparation};
 use crate::approx::contract::GAUSSIAN_TRACE_SIGMAS;
 use crate::optics::models;
@@ -39,6 +40,9 @@ impl ApproxMethod for GaussRay {
     }
     fn wgsl(&self) -> &'static str {
         include_str!("../../../shaders/gauss_ray.wgsl")
+    }
+    fn modules(&self) -> &'static [WgslModule] {
+        &[NEAREST_EVENTS]
     }
     fn computes(&self) -> Computes {
         Computes::Volume(&[models::EMISSION])

@@ -9,6 +9,7 @@
 //! they are [`super::Method::User`].
 
 use super::param_spec::ParamSpec;
+use super::shader::WgslModule;
 use crate::error::{PgtError, Result};
 use crate::scene::{Model, RenderMode, Scene};
 use std::fmt::Write as _;
@@ -71,6 +72,10 @@ pub trait ApproxMethod: Sync {
     /// given only Gaussian scenes, the others only constant-density ones.
     fn draws_gaussians(&self) -> bool {
         false
+    }
+    /// The shared WGSL modules its file uses, included before it.
+    fn modules(&self) -> &'static [WgslModule] {
+        &[]
     }
     /// What it needs made on the CPU before the dispatch ([`Preparation`]).
     fn preparation(&self) -> Preparation {

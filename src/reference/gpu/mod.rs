@@ -32,6 +32,7 @@ mod run;
 
 pub use run::{trace, RaySample, Traced};
 
+use super::rows::RowsOutput;
 use super::{stored_pixel, RenderOptions, RenderOutput, RenderStats};
 use crate::approx::GpuContext;
 use crate::error::{PgtError, Result};
@@ -91,12 +92,41 @@ pub fn render(
 
 /// [`render`] on an open device (opened with [`GpuContext::with_f64`]).
 pub fn render_on(ctx: &GpuContext, scene: &Scene, options: &RenderOptions) -> Result<RenderOutput> {
+    let rows: Vec<u32> = (0..scene.camera.height).collect();
+    let RowsOutput {
+        image,
+        error,
+        stats,
+    } = render_rows_on(ctx, scene, options, &rows)?;
+    Ok(RenderOutput {
+        image,
+        error,
+        stats,
+    })
+}
+
+/// The image rows `rows` (0 = top) of [`render_on`]'s image, stacked in the order asked for: a
+/// part of a cluster render (`crate::parts`). Every ray is a pure function of the scene and its
+/// direction, so these rows hold the bits the whole image holds there.
+pub fn render_rows_on(
+    ctx: &GpuContext,
+    scene: &Scene,
+    options: &RenderOptions,
+    rows: &[u32],
+) -> Result<RowsOutput> {
     check_supported(scene, options)?;
     let start = Instant::now();
     let camera = &scene.camera;
-    let (w, h, k) = (camera.width, camera.height, options.spp.max(1));
+    let (w, k) = (camera.width, options.spp.max(1));
+    if let Some(&bad) = rows.iter().find(|&&y| y >= camera.height) {
+        return Err(PgtError::Usage(format!(
+            "row {bad} is outside the image of height {}",
+            camera.height
+        )));
+    }
+    let h = rows.len() as u32;
     let mut directions = Vec::with_capacity((w * h * k * k) as usize);
-    for py in 0..h {
+    for &py in rows {
         for px in 0..w {
             for sy in 0..k {
                 for sx in 0..k {
@@ -125,7 +155,7 @@ pub fn render_on(ctx: &GpuContext, scene: &Scene, options: &RenderOptions) -> Re
     let pixels = w as u64 * h as u64;
     let values = err_image.pixels.iter().flatten().map(|&v| v as f64);
     let (max, sum) = values.fold((0.0f64, 0.0f64), |(m, s), v| (m.max(v), s + v));
-    Ok(RenderOutput {
+    Ok(RowsOutput {
         image,
         error: Some(err_image),
         stats: RenderStats {
@@ -134,7 +164,7 @@ pub fn render_on(ctx: &GpuContext, scene: &Scene, options: &RenderOptions) -> Re
             shadow_rays: 0,
             seconds: start.elapsed().as_secs_f64(),
             max_error: Some(max),
-            mean_error: Some(sum / (3 * pixels) as f64),
+            mean_error: Some(sum / (3 * pixels).max(1) as f64),
             unconverged: 0,
             worst_unconverged: None,
         },

@@ -1,12 +1,13 @@
 //! The WGSL of the GPU reference and the layout it shares with Rust (docs/design.md §12): the
 //! constants, the buffers' strides and offsets, the structs and the bindings are generated here
-//! and prepended to `shaders/f64_math.wgsl` and `shaders/reference_emission.wgsl`, so the host
+//! and prepended to `shaders/f64_math.wgsl`, `shaders/nearest_events.wgsl` (the batch and its
+//! traversal, shared with the approximations) and `shaders/reference_emission.wgsl`, so the host
 //! code below and the shader read one definition.
 
 use super::math::{EXPM1_ULPS, EXP_ULPS, F64_MATH_WGSL};
 use crate::approx::contract::STACK_SIZE;
 use crate::approx::layout::GpuBvhNode;
-use crate::approx::shader::{ShaderPart, ShaderProgram};
+use crate::approx::shader::{ShaderPart, ShaderProgram, NEAREST_EVENTS};
 use crate::approx::wgsl::struct_declaration;
 use bytemuck::{Pod, Zeroable};
 use std::borrow::Cow;
@@ -116,7 +117,7 @@ pub fn declarations() -> String {
         ("REF_BATCH", BATCH),
         ("REF_INSIDE_MAX", INSIDE_MAX),
         ("REF_WORKGROUP", WORKGROUP),
-        ("REF_STACK_SIZE", STACK_SIZE),
+        ("STACK_SIZE", STACK_SIZE),
         ("REF_PARTICLE_STRIDE", PARTICLE_STRIDE as u32),
         ("REF_P_RADIUS", P_RADIUS as u32),
         ("REF_P_SIGMA", P_SIGMA as u32),
@@ -182,6 +183,7 @@ pub fn program() -> ShaderProgram {
             name: "shaders/f64_math.wgsl".into(),
             text: Cow::Borrowed(F64_MATH_WGSL),
         },
+        NEAREST_EVENTS.part(),
         ShaderPart {
             name: "shaders/reference_emission.wgsl".into(),
             text: Cow::Borrowed(EMISSION_WGSL),
