@@ -17,5 +17,6 @@ mod layout;
 mod methods;
 mod raster;
 mod reference;
+mod reference_gaussian;
 mod sorted_blend;
 mod view_color;

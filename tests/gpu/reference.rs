@@ -15,7 +15,7 @@ use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
 
 /// A context with f64, or `None` outside CI where there is none (a failure under `CI=true`).
-fn gpu64() -> Option<&'static GpuContext> {
+pub(super) fn gpu64() -> Option<&'static GpuContext> {
     static CTX: OnceLock<Result<GpuContext, String>> = OnceLock::new();
     let ctx = CTX.get_or_init(|| GpuContext::with_f64(None).map_err(|e| e.to_string()));
     match ctx {
@@ -235,6 +235,10 @@ fn the_gpu_reference_calls_no_transcendental_builtin() {
     for (what, source) in [
         ("reference", gpu::program::program().source().to_string()),
         ("math harness", math::harness_program().source().to_string()),
+        (
+            "Gaussian reference",
+            gpu::gaussian::program().source().to_string(),
+        ),
     ] {
         let calls = transcendental_calls(&source);
         assert!(calls.is_empty(), "the {what} program calls {calls:?}");
@@ -246,7 +250,7 @@ fn the_gpu_reference_calls_no_transcendental_builtin() {
 
 /// Every pixel channel: |gpu − cpu| ≤ err_gpu + err_cpu; the worst ratio of the difference to
 /// that sum.
-fn within_both_errs(what: &str, gpu: &RenderOutput, cpu: &RenderOutput) -> f64 {
+pub(super) fn within_both_errs(what: &str, gpu: &RenderOutput, cpu: &RenderOutput) -> f64 {
     let (ge, ce) = (gpu.error.as_ref().unwrap(), cpu.error.as_ref().unwrap());
     let mut worst = 0.0f64;
     for i in 0..gpu.image.pixels.len() {
@@ -268,7 +272,7 @@ fn within_both_errs(what: &str, gpu: &RenderOutput, cpu: &RenderOutput) -> f64 {
     worst
 }
 
-fn same_bits(a: &RgbImage, b: &RgbImage) -> bool {
+pub(super) fn same_bits(a: &RgbImage, b: &RgbImage) -> bool {
     a.pixels
         .iter()
         .flatten()
@@ -324,7 +328,7 @@ fn check_scene(ctx: &GpuContext, what: &str, scene: &Scene, spp: u32) {
     );
 }
 
-fn emission_at(path: &Path, size: (u32, u32)) -> pgt::Result<Scene> {
+pub(super) fn emission_at(path: &Path, size: (u32, u32)) -> pgt::Result<Scene> {
     Scene::load(
         path,
         &SceneLoadOptions {
@@ -336,7 +340,7 @@ fn emission_at(path: &Path, size: (u32, u32)) -> pgt::Result<Scene> {
     )
 }
 
-fn repo(rel: &str) -> PathBuf {
+pub(super) fn repo(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
 }
 
@@ -357,7 +361,7 @@ fn examples_agree_with_the_cpu_reference_within_both_errs() {
             .iter()
             .any(|p| p.profile != Profile::Constant)
         {
-            continue; // Gaussians: not yet on the GPU reference
+            continue; // Gaussians: tests/gpu/reference_gaussian.rs
         }
         check_scene(ctx, &path.display().to_string(), &scene, 1);
         checked += 1;
