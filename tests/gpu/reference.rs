@@ -547,7 +547,7 @@ color  = [0.1, 0.6, 1.0]
 opacity = 1.0
 "#;
 
-fn pgt(args: &[&str]) -> std::process::Output {
+pub(super) fn pgt(args: &[&str]) -> std::process::Output {
     std::process::Command::new(env!("CARGO_BIN_EXE_pgt"))
         .args(args)
         .output()

@@ -4,7 +4,7 @@
 //! the donut splat file; the same bits on every run; err_gpu within a small factor of the
 //! CPU's; the refusals by name.
 
-use super::reference::{emission_at, gpu64, repo, same_bits, within_both_errs};
+use super::reference::{emission_at, gpu64, pgt, repo, same_bits, within_both_errs};
 use super::support::volume::{self, Rng};
 use glam::{DQuat, DVec3};
 use pgt::approx::GpuContext;
@@ -249,4 +249,56 @@ fn gaussian_scenes_it_cannot_render_are_refused_by_name() {
     scene.particles[2].sigma = f64::INFINITY;
     let e = gpu::render_on(ctx, &scene, &RenderOptions::default()).unwrap_err();
     assert!(e.to_string().contains("infinite peak density"), "{e}");
+}
+
+/// `pgt render --gpu` on the Gaussian example writes the library's image and err bit for bit;
+/// a scene mixing Gaussian and constant density exits 2 naming why, and writes nothing.
+#[test]
+fn pgt_render_gpu_renders_the_gaussian_example_as_the_library_does() {
+    let Some(ctx) = gpu64() else { return };
+    let dir = tempfile::tempdir().unwrap();
+    let path = repo("examples/gaussians.toml");
+    let out = dir.path().join("out.exr");
+    let run = pgt(&[
+        "render",
+        "--gpu",
+        path.to_str().unwrap(),
+        "--size",
+        "12x10",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(run.status.success(), "{stderr}");
+    let scene = Scene::load(
+        &path,
+        &SceneLoadOptions {
+            size: Some((12, 10)),
+            ..SceneLoadOptions::default()
+        },
+    )
+    .unwrap();
+    let want = gpu::render_on(ctx, &scene, &RenderOptions::default()).unwrap();
+    let image = pgt::image_io::read_image(&out).unwrap();
+    let err = pgt::image_io::read_exr_layer(&out, "err").unwrap();
+    assert!(same_bits(&image, &want.image));
+    assert!(same_bits(&err, want.error.as_ref().unwrap()));
+    let mixed = dir.path().join("mixed.toml");
+    std::fs::write(
+        &mixed,
+        "[camera]\nposition = [0.0, 0.0, -6.0]\nlook_at = [0.0, 0.0, 0.0]\nwidth = 8\nheight = 8\n\n[render]\nmodel = \"emission\"\n\n[[particles]]\ncenter = [0.0, 0.0, 0.0]\nradius = 0.5\ndensity = \"gaussian\"\n\n[[particles]]\ncenter = [0.5, 0.0, 0.0]\nradius = 0.5\n",
+    )
+    .unwrap();
+    let refused = dir.path().join("mixed.exr");
+    let run = pgt(&[
+        "render",
+        "--gpu",
+        mixed.to_str().unwrap(),
+        "-o",
+        refused.to_str().unwrap(),
+    ]);
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert_eq!(run.status.code(), Some(2), "{stderr}");
+    assert!(stderr.contains("Gaussian"), "{stderr}");
+    assert!(!refused.exists());
 }
