@@ -109,6 +109,41 @@ fn random_flat_and_round_gaussians_agree_with_the_cpu_reference_within_both_errs
     }
 }
 
+/// err_gpu alone against the truth: a CPU render at tol/100 stands for it (its err, about
+/// 100 times smaller, added), and the GPU's err at tol 1e-5 covers the distance at ≥ 99.9 % of
+/// pixel channels, as the CPU's err does in tests/reference/gaussians.rs.
+#[test]
+fn err_gpu_covers_a_hundred_times_tighter_cpu_render() {
+    let Some(ctx) = gpu64() else { return };
+    let scene = flat_and_round(4805, 30, 16);
+    let mut tight = scene.clone();
+    tight.render.tol = 1e-7;
+    let options = RenderOptions::default();
+    let g = gpu::render_on(ctx, &scene, &options).unwrap();
+    let t = reference::render(&tight, &options).unwrap();
+    let (ge, te) = (g.error.as_ref().unwrap(), t.error.as_ref().unwrap());
+    let (mut covered, mut total, mut off) = (0, 0, 0.0f64);
+    for i in 0..g.image.pixels.len() {
+        for c in 0..3 {
+            let d = (g.image.pixels[i][c] as f64 - t.image.pixels[i][c] as f64).abs();
+            let e = ge.pixels[i][c] as f64;
+            assert!(
+                d <= e + te.pixels[i][c] as f64,
+                "pixel {i} channel {c}: {d:e} > {e:e}"
+            );
+            covered += usize::from(d <= e);
+            total += 1;
+            off = off.max(d);
+        }
+    }
+    eprintln!("err_gpu covers {covered} of {total} channels; largest distance {off:.3e}");
+    assert!(
+        covered as f64 >= 0.999 * total as f64,
+        "{covered} of {total}"
+    );
+    assert!(off > 1e-8, "the renders agree exactly: nothing is tested");
+}
+
 /// The `n` Gaussians of the donut splat file nearest to one of its particles, framed: flat,
 /// hair-like splats crossing one another.
 fn donut_crop(n: usize, size: u32) -> Option<Scene> {
