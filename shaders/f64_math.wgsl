@@ -195,3 +195,110 @@ fn f64_log1p(x: f64) -> f64 {
     let lo = kf * F64_LN2_LO + c / y;
     return kf * F64_LN2_HI + (f64_log1p_reduced(split.m - 1.0lf) + lo);
 }
+
+// erfc in FreeBSD's form (s_erf.c, as the `libm` crate ports it; its coefficients): a rational
+// approximation of erf on |x| < 0.84375, of erf(1 + s) − c on [0.84375, 1.25], and of
+// log(x·erfc x) + x² − 0.5625 in 1/x² on [1.25, 1/0.35] and [1/0.35, 28]; erfc(−x) = 2 − erfc x.
+// The e^{−x²} of the tails as e^{−z² − 0.5625}·e^{(z − x)(z + x) + R/S} with z = x rounded to
+// f32, whose square is exact in f64. Its error in ulps is math.rs's ERFC_ULPS.
+const F64_ERX: f64 = 8.45062911510467529297e-01lf;
+const F64_PP0: f64 = 1.28379167095512558561e-01lf;
+const F64_PP1: f64 = -3.25042107247001499370e-01lf;
+const F64_PP2: f64 = -2.84817495755985104766e-02lf;
+const F64_PP3: f64 = -5.77027029648944159157e-03lf;
+const F64_PP4: f64 = -2.37630166566501626084e-05lf;
+const F64_QQ1: f64 = 3.97917223959155352819e-01lf;
+const F64_QQ2: f64 = 6.50222499887672944485e-02lf;
+const F64_QQ3: f64 = 5.08130628187576562776e-03lf;
+const F64_QQ4: f64 = 1.32494738004321644526e-04lf;
+const F64_QQ5: f64 = -3.96022827877536812320e-06lf;
+const F64_PA0: f64 = -2.36211856075265944077e-03lf;
+const F64_PA1: f64 = 4.14856118683748331666e-01lf;
+const F64_PA2: f64 = -3.72207876035701323847e-01lf;
+const F64_PA3: f64 = 3.18346619901161753674e-01lf;
+const F64_PA4: f64 = -1.10894694282396677476e-01lf;
+const F64_PA5: f64 = 3.54783043256182359371e-02lf;
+const F64_PA6: f64 = -2.16637559486879084300e-03lf;
+const F64_QA1: f64 = 1.06420880400844228286e-01lf;
+const F64_QA2: f64 = 5.40397917702171048937e-01lf;
+const F64_QA3: f64 = 7.18286544141962662868e-02lf;
+const F64_QA4: f64 = 1.26171219808761642112e-01lf;
+const F64_QA5: f64 = 1.36370839120290507362e-02lf;
+const F64_QA6: f64 = 1.19844998467991074170e-02lf;
+const F64_RA0: f64 = -9.86494403484714822705e-03lf;
+const F64_RA1: f64 = -6.93858572707181764372e-01lf;
+const F64_RA2: f64 = -1.05586262253232909814e+01lf;
+const F64_RA3: f64 = -6.23753324503260060396e+01lf;
+const F64_RA4: f64 = -1.62396669462573470355e+02lf;
+const F64_RA5: f64 = -1.84605092906711035994e+02lf;
+const F64_RA6: f64 = -8.12874355063065934246e+01lf;
+const F64_RA7: f64 = -9.81432934416914548592e+00lf;
+const F64_SA1: f64 = 1.96512716674392571292e+01lf;
+const F64_SA2: f64 = 1.37657754143519042600e+02lf;
+const F64_SA3: f64 = 4.34565877475229228821e+02lf;
+const F64_SA4: f64 = 6.45387271733267880336e+02lf;
+const F64_SA5: f64 = 4.29008140027567833386e+02lf;
+const F64_SA6: f64 = 1.08635005541779435134e+02lf;
+const F64_SA7: f64 = 6.57024977031928170135e+00lf;
+const F64_SA8: f64 = -6.04244152148580987438e-02lf;
+const F64_RB0: f64 = -9.86494292470009928597e-03lf;
+const F64_RB1: f64 = -7.99283237680523006574e-01lf;
+const F64_RB2: f64 = -1.77579549177547519889e+01lf;
+const F64_RB3: f64 = -1.60636384855821916062e+02lf;
+const F64_RB4: f64 = -6.37566443368389627722e+02lf;
+const F64_RB5: f64 = -1.02509513161107724954e+03lf;
+const F64_RB6: f64 = -4.83519191608651397019e+02lf;
+const F64_SB1: f64 = 3.03380607434824582924e+01lf;
+const F64_SB2: f64 = 3.25792512996573918826e+02lf;
+const F64_SB3: f64 = 1.53672958608443695994e+03lf;
+const F64_SB4: f64 = 3.19985821950859553908e+03lf;
+const F64_SB5: f64 = 2.55305040643316442583e+03lf;
+const F64_SB6: f64 = 4.74528541206955367215e+02lf;
+const F64_SB7: f64 = -2.24409524465858183362e+01lf;
+
+// erfc(|x|) for 0.84375 ≤ |x| < 28.
+fn f64_erfc_far(x: f64) -> f64 {
+    let a = abs(x);
+    if (a < 1.25lf) {
+        let s = a - 1.0lf;
+        let p = F64_PA0 + s * (F64_PA1 + s * (F64_PA2 + s * (F64_PA3 + s * (F64_PA4 + s * (F64_PA5 + s * F64_PA6)))));
+        let q = 1.0lf + s * (F64_QA1 + s * (F64_QA2 + s * (F64_QA3 + s * (F64_QA4 + s * (F64_QA5 + s * F64_QA6)))));
+        return 1.0lf - F64_ERX - p / q;
+    }
+    let s = 1.0lf / (a * a);
+    var r: f64;
+    var big_s: f64;
+    if (a < 2.8571414947509766lf) {
+        r = F64_RA0 + s * (F64_RA1 + s * (F64_RA2 + s * (F64_RA3 + s * (F64_RA4 + s * (F64_RA5 + s * (F64_RA6 + s * F64_RA7))))));
+        big_s = 1.0lf + s * (F64_SA1 + s * (F64_SA2 + s * (F64_SA3 + s * (F64_SA4 + s * (F64_SA5 + s * (F64_SA6 + s * (F64_SA7 + s * F64_SA8)))))));
+    } else {
+        r = F64_RB0 + s * (F64_RB1 + s * (F64_RB2 + s * (F64_RB3 + s * (F64_RB4 + s * (F64_RB5 + s * F64_RB6)))));
+        big_s = 1.0lf + s * (F64_SB1 + s * (F64_SB2 + s * (F64_SB3 + s * (F64_SB4 + s * (F64_SB5 + s * (F64_SB6 + s * F64_SB7))))));
+    }
+    let z = f64(f32(a));
+    return f64_exp(-z * z - 0.5625lf) * f64_exp((z - a) * (z + a) + r / big_s) / a;
+}
+
+// erfc x = 1 − erf x, with the digits of small results for large x: 0 from x ≥ 28 (below
+// 2^−1074 from 27.3), 2 from x ≤ −6 (within half an ulp of 2).
+fn f64_erfc(x: f64) -> f64 {
+    let a = abs(x);
+    if (a < 0.84375lf) {
+        if (a < 1.3877787807814457e-17lf) {
+            return 1.0lf - x;
+        }
+        let z = x * x;
+        let r = F64_PP0 + z * (F64_PP1 + z * (F64_PP2 + z * (F64_PP3 + z * F64_PP4)));
+        let s = 1.0lf + z * (F64_QQ1 + z * (F64_QQ2 + z * (F64_QQ3 + z * (F64_QQ4 + z * F64_QQ5))));
+        let y = r / s;
+        if (x < 0.25lf) {
+            return 1.0lf - (x + x * y);
+        }
+        return 0.5lf - (x - 0.5lf + x * y);
+    }
+    if (a < 28.0lf) {
+        let far = f64_erfc_far(x);
+        return select(far, 2.0lf - far, x < 0.0lf);
+    }
+    return select(0.0lf, 2.0lf, x < 0.0lf);
+}

@@ -246,8 +246,9 @@ def render(
       progress    None (silent), True (a tqdm bar if tqdm is installed, else a line on
                   stderr) or a callable(done, total) called with tiles done from this thread.
       gpu         render on the GPU in f64 (``pgt render --gpu``): the same image and err
-                  within both errs; the emission model of spheres and ellipsoids, an adapter
-                  with f64 (others are refused with a GpuError) [False].
+                  within both errs; the emission model of spheres and ellipsoids or of
+                  Gaussian particles, an adapter with f64 (others are refused with a
+                  GpuError) [False].
       adapter     with gpu=True: the adapter whose name contains this [the first hardware
                   adapter, else lavapipe].
 

@@ -192,6 +192,21 @@ def test_render_on_the_gpu_is_the_cli_s_and_within_both_errs_of_the_cpu(example,
     assert (difference <= gpu.err.astype(np.float64) + cpu.err).all()
 
 
+def test_render_on_the_gpu_renders_gaussians_within_both_errs_of_the_cpu(example):
+    """Gaussian particles take the same path (docs/design.md §12)."""
+    scene = pgt.load_scene(example("gaussians.toml"), size=(12, 10), model="emission")
+    try:
+        gpu = pgt.render(scene, gpu=True)
+    except pgt.NoAdapterError as e:
+        if in_ci():
+            pytest.fail(f"CI=true and no GPU adapter: {e}")
+        pytest.skip(f"no GPU adapter ({e})")
+    cpu = pgt.render(scene)
+    difference = np.abs(gpu.image.astype(np.float64) - cpu.image)
+    assert (difference <= gpu.err.astype(np.float64) + cpu.err).all()
+    assert gpu.unconverged == 0
+
+
 def test_render_on_the_gpu_refuses_a_lit_scene_by_name(example):
     scene = pgt.load_scene(example("ellipsoids.toml"), size=(8, 8), model="lit")
     with pytest.raises(pgt.GpuError, match="lit"):

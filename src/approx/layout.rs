@@ -296,7 +296,7 @@ fn sigma_f32(sigma: f64) -> f32 {
 
 /// Rounds a camera-relative box outwards by a relative margin so that the f32 box still contains
 /// the f32 sphere: rounding the corners to nearest could cull a grazing ray.
-fn widen(min: DVec3, max: DVec3, origin: DVec3) -> ([f32; 3], [f32; 3]) {
+pub(crate) fn widen(min: DVec3, max: DVec3, origin: DVec3) -> ([f32; 3], [f32; 3]) {
     let (lo, hi) = (min - origin, max - origin);
     let pad = (hi - lo).max_element().max(0.0) * 1e-6 + lo.abs().max(hi.abs()).max_element() * 1e-6;
     (

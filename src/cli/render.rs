@@ -71,9 +71,9 @@ pub struct RenderArgs {
     #[arg(long, value_parser = pgt::parts::parse_part, value_name = "I/N")]
     pub part: Option<PartOf>,
     /// Render on the GPU in f64 (docs/design.md §12): the same image and err as the CPU
-    /// reference, within both errs. The emission model of spheres and ellipsoids; an adapter
-    /// without f64 is refused by name. With --frames and --part too: a GPU render's hash names
-    /// the GPU and its adapter, so its frames and parts are never taken for the CPU's.
+    /// reference, within both errs. The emission model of spheres, ellipsoids and Gaussians;
+    /// an adapter without f64 is refused by name. With --frames and --part too: a GPU render's
+    /// hash names the GPU and its adapter, so its frames and parts are never taken for the CPU's.
     #[arg(long)]
     pub gpu: bool,
     /// With --gpu: use the adapter whose name contains this (case-insensitive).

@@ -88,30 +88,30 @@ const MIN_AUTO_CUTOFF: f64 = 3.0;
 
 /// One Gaussian as the renderer keeps it: the shape holds its standard deviations.
 #[derive(Debug, Clone, Copy)]
-struct Gaussian {
-    center: DVec3,
-    shape: Ellipsoid,
-    sigma: f64,
+pub(crate) struct Gaussian {
+    pub(crate) center: DVec3,
+    pub(crate) shape: Ellipsoid,
+    pub(crate) sigma: f64,
     /// k·Cᵢ, the colour of the model's constant part k·E (k = 1 in the emission model, a in
     /// single-scatter).
-    emitted: DVec3,
+    pub(crate) emitted: DVec3,
     color: DVec3,
     albedo: DVec3,
 }
 
 /// The renderer of a scene whose particles all have Gaussian density.
 pub struct GaussianRenderer {
-    gaussians: Vec<Gaussian>,
+    pub(crate) gaussians: Vec<Gaussian>,
     /// Over the k-σ ellipsoids of `gaussians` (indices into it).
-    bvh: Bvh,
-    background: DVec3,
+    pub(crate) bvh: Bvh,
+    pub(crate) background: DVec3,
     /// Per channel, max(maxᵢ k·Cᵢ, L_bg): M where no light scatters.
-    bound: DVec3,
-    tol: f64,
+    pub(crate) bound: DVec3,
+    pub(crate) tol: f64,
+    /// The cut-off k: the BVH holds the k-σ ellipsoids.
+    pub(crate) cutoff: f64,
     /// The bound on the depth of the Gaussians a ray does not meet within k σ.
-    far_depth: f64,
-    /// k, the cut-off of the ellipsoids in `bvh`.
-    cutoff: f64,
+    pub(crate) far_depth: f64,
     model: &'static dyn OpticalModel,
     params: SourceParams,
     /// The lights whose part of Q is integrated: empty where the model has none.
@@ -312,8 +312,8 @@ impl GaussianRenderer {
             background,
             bound,
             tol,
-            far_depth: 0.0,
             cutoff: 0.0,
+            far_depth: 0.0,
             model,
             params,
             lights,
@@ -325,8 +325,8 @@ impl GaussianRenderer {
         let cutoff = scene.render.gaussian_cutoff.unwrap_or_else(|| {
             auto_cutoff(line_depth, renderer.typical_bound().max_element(), tol)
         });
-        let gaussians = &renderer.gaussians;
         renderer.cutoff = cutoff;
+        let gaussians = &renderer.gaussians;
         renderer.far_depth = line_depth * (-0.5 * cutoff * cutoff).exp();
         renderer.bvh = Bvh::build_shapes(
             gaussians.iter().map(|g| g.center).collect(),

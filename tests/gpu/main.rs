@@ -18,5 +18,6 @@ mod methods;
 mod raster;
 mod reference;
 mod reference_frames;
+mod reference_gaussian;
 mod sorted_blend;
 mod view_color;

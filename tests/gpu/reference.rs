@@ -113,6 +113,74 @@ fn f64_exp_expm1_log1p_are_within_their_ulp_bounds() {
     );
 }
 
+/// Dense grids over erfc's range (−6 to 28, where it underflows, and its seams), the small
+/// arguments, and uniform random ones.
+fn erfc_arguments() -> Vec<f64> {
+    let mut xs = Vec::new();
+    let n = 200_000;
+    for k in 0..=n {
+        xs.push(-7.0 + 36.0 * k as f64 / n as f64);
+    }
+    for seam in [0.25, 0.84375, 1.25, 2.8571414947509766, 6.0, 28.0] {
+        for sign in [1.0, -1.0] {
+            for k in -2000..=2000 {
+                xs.push(sign * seam * (1.0 + k as f64 * 1e-13));
+                xs.push(sign * seam * (1.0 + k as f64 * 1e-6));
+            }
+        }
+    }
+    for k in 0..=6000 {
+        let m = 10f64.powf(-300.0 + 300.0 * k as f64 / 6000.0);
+        xs.extend([m, -m]);
+    }
+    let mut rng = Rng::new(4748);
+    for _ in 0..200_000 {
+        xs.push(rng.range(-8.0, 30.0));
+        xs.push(rng.range(-1.0, 1.0) * 10f64.powf(rng.range(-20.0, 0.0)));
+    }
+    xs
+}
+
+#[test]
+fn f64_erfc_is_within_its_ulp_bound() {
+    let Some(ctx) = gpu64() else { return };
+    let xs = erfc_arguments();
+    let got = math::evaluate(ctx, &xs).expect("the math harness runs");
+    let mut worst = (0.0f64, 0.0);
+    let mut worst_small = (0.0f64, 0.0);
+    for (&x, g) in xs.iter().zip(&got) {
+        let want = libm::erfc(x);
+        if want >= math::ERFC_NORMAL {
+            let u = ulps(g[3], want);
+            if u > worst.0 {
+                worst = (u, x);
+            }
+        } else {
+            let d = (g[3] - want).abs();
+            if d > worst_small.0 {
+                worst_small = (d, x);
+            }
+        }
+    }
+    eprintln!(
+        "f64 erfc on {} over {} arguments: {:.3} ulp (at {:e}); below 2^-1000 {:e} absolute (at {:e})",
+        ctx.adapter,
+        xs.len(),
+        worst.0,
+        worst.1,
+        worst_small.0,
+        worst_small.1
+    );
+    // libm's erfc is within an ulp of the truth: the bound carries that ulp on top.
+    assert!(worst.0 + 1.0 <= math::ERFC_ULPS, "erfc: {worst:?}");
+    assert!(worst_small.0 <= math::ERFC_NORMAL, "erfc: {worst_small:?}");
+    // The tails are there: erfc(26) is about 5.7e-296, erfc(−6) rounds to 2.
+    let at = |x: f64| math::evaluate(ctx, &[x]).unwrap()[0][3];
+    assert!(at(26.0) > 0.0 && at(26.0) < 1e-295);
+    assert_eq!(at(-6.5), 2.0);
+    assert_eq!(at(30.0), 0.0);
+}
+
 /// Every `MathFunction` that Vulkan defines for 16- and 32-bit floats only.
 fn transcendental(fun: naga::MathFunction) -> bool {
     use naga::MathFunction as F;
@@ -167,6 +235,10 @@ fn the_gpu_reference_calls_no_transcendental_builtin() {
     for (what, source) in [
         ("reference", gpu::program::program().source().to_string()),
         ("math harness", math::harness_program().source().to_string()),
+        (
+            "Gaussian reference",
+            gpu::gaussian::program().source().to_string(),
+        ),
     ] {
         let calls = transcendental_calls(&source);
         assert!(calls.is_empty(), "the {what} program calls {calls:?}");
@@ -178,7 +250,7 @@ fn the_gpu_reference_calls_no_transcendental_builtin() {
 
 /// Every pixel channel: |gpu − cpu| ≤ err_gpu + err_cpu; the worst ratio of the difference to
 /// that sum.
-fn within_both_errs(what: &str, gpu: &RenderOutput, cpu: &RenderOutput) -> f64 {
+pub(super) fn within_both_errs(what: &str, gpu: &RenderOutput, cpu: &RenderOutput) -> f64 {
     let (ge, ce) = (gpu.error.as_ref().unwrap(), cpu.error.as_ref().unwrap());
     let mut worst = 0.0f64;
     for i in 0..gpu.image.pixels.len() {
@@ -200,7 +272,7 @@ fn within_both_errs(what: &str, gpu: &RenderOutput, cpu: &RenderOutput) -> f64 {
     worst
 }
 
-fn same_bits(a: &RgbImage, b: &RgbImage) -> bool {
+pub(super) fn same_bits(a: &RgbImage, b: &RgbImage) -> bool {
     a.pixels
         .iter()
         .flatten()
@@ -256,7 +328,7 @@ fn check_scene(ctx: &GpuContext, what: &str, scene: &Scene, spp: u32) {
     );
 }
 
-fn emission_at(path: &Path, size: (u32, u32)) -> pgt::Result<Scene> {
+pub(super) fn emission_at(path: &Path, size: (u32, u32)) -> pgt::Result<Scene> {
     Scene::load(
         path,
         &SceneLoadOptions {
@@ -268,7 +340,7 @@ fn emission_at(path: &Path, size: (u32, u32)) -> pgt::Result<Scene> {
     )
 }
 
-fn repo(rel: &str) -> PathBuf {
+pub(super) fn repo(rel: &str) -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)
 }
 
@@ -289,7 +361,7 @@ fn examples_agree_with_the_cpu_reference_within_both_errs() {
             .iter()
             .any(|p| p.profile != Profile::Constant)
         {
-            continue; // Gaussians: not yet on the GPU reference
+            continue; // Gaussians: tests/gpu/reference_gaussian.rs
         }
         check_scene(ctx, &path.display().to_string(), &scene, 1);
         checked += 1;
@@ -475,7 +547,7 @@ color  = [0.1, 0.6, 1.0]
 opacity = 1.0
 "#;
 
-fn pgt(args: &[&str]) -> std::process::Output {
+pub(super) fn pgt(args: &[&str]) -> std::process::Output {
     std::process::Command::new(env!("CARGO_BIN_EXE_pgt"))
         .args(args)
         .output()

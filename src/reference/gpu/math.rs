@@ -1,11 +1,13 @@
-//! f64 exp, expm1 and log1p on the GPU (`shaders/f64_math.wgsl`, docs/design.md §12) and their
-//! error bounds.
+//! f64 exp, expm1, log1p and erfc on the GPU (`shaders/f64_math.wgsl`, docs/design.md §12) and
+//! their error bounds.
 //!
 //! Vulkan's extended instructions have exp and log for 16- and 32-bit floats only, so the GPU
 //! reference computes them from +, −, ×, ÷, fma and ldexp: Cody–Waite range reduction
 //! x = k·ln 2 + r, |r| ≤ ln2/2, a Taylor polynomial for expm1(r) whose first omitted term is
 //! below 3e-19 of the result, and a scaling by 2^k that is exact for normal results; log1p
-//! splits 1 + x = 2^k·m and takes log(m) = 2·atanh(f/(2 + f)) in fdlibm's form.
+//! splits 1 + x = 2^k·m and takes log(m) = 2·atanh(f/(2 + f)) in fdlibm's form; erfc is
+//! FreeBSD's (the `libm` crate's) rational approximations on four ranges, its e^{−x²} from
+//! `f64_exp` with x split so that the square is exact.
 //!
 //! The bounds below are what `tests/gpu/reference.rs` measures against the CPU's libm (glibc,
 //! within an ulp of the truth) over dense and random arguments, tails included, plus that ulp:
@@ -31,6 +33,12 @@ pub const EXP_ULPS: f64 = 3.0;
 pub const EXPM1_ULPS: f64 = 3.0;
 /// The error of `f64_log1p` on the GPU in ulps of the result, bound.
 pub const LOG1P_ULPS: f64 = 3.0;
+/// The error of `f64_erfc` on the GPU in ulps of the result, bound, for results of at least
+/// [`ERFC_NORMAL`]; below it, within [`ERFC_NORMAL`] in absolute terms (the results there are
+/// subnormal or nearly, and the two exponentials of the far tail lose their last digits).
+pub const ERFC_ULPS: f64 = 7.0;
+/// The smallest erfc result to which [`ERFC_ULPS`] applies: 2^−1000.
+pub const ERFC_NORMAL: f64 = 9.332636185032189e-302;
 
 const HARNESS_WGSL: &str = "
 @group(0) @binding(0) var<storage, read> math_in: array<f64>;
@@ -43,17 +51,18 @@ fn math_main(@builtin(global_invocation_id) gid: vec3<u32>) {
         return;
     }
     let x = math_in[i];
-    math_out[3u * i] = f64_exp(x);
-    math_out[3u * i + 1u] = f64_expm1(x);
+    math_out[4u * i] = f64_exp(x);
+    math_out[4u * i + 1u] = f64_expm1(x);
     var l = 0.0lf;
     if (x > -1.0lf) {
         l = f64_log1p(x);
     }
-    math_out[3u * i + 2u] = l;
+    math_out[4u * i + 2u] = l;
+    math_out[4u * i + 3u] = f64_erfc(x);
 }
 ";
 
-/// The program that evaluates the three functions over an array (the test harness).
+/// The program that evaluates the four functions over an array (the test harness).
 pub fn harness_program() -> ShaderProgram {
     ShaderProgram::from_parts(vec![
         ShaderPart {
@@ -67,9 +76,9 @@ pub fn harness_program() -> ShaderProgram {
     ])
 }
 
-/// (exp x, expm1 x, log1p x) for every x, computed on the GPU by `shaders/f64_math.wgsl`
-/// (log1p: 0 where x ≤ −1). At most 65535·64 arguments a call.
-pub fn evaluate(ctx: &GpuContext, xs: &[f64]) -> Result<Vec<[f64; 3]>> {
+/// (exp x, expm1 x, log1p x, erfc x) for every x, computed on the GPU by
+/// `shaders/f64_math.wgsl` (log1p: 0 where x ≤ −1). At most 65535·64 arguments a call.
+pub fn evaluate(ctx: &GpuContext, xs: &[f64]) -> Result<Vec<[f64; 4]>> {
     if !ctx.f64 {
         return Err(PgtError::Gpu(format!(
             "{} was opened without f64 (GpuContext::with_f64)",
@@ -86,7 +95,7 @@ pub fn evaluate(ctx: &GpuContext, xs: &[f64]) -> Result<Vec<[f64; 3]>> {
     let program = harness_program();
     program.validate_with(naga::valid::Capabilities::FLOAT64)?;
     let device = &ctx.device;
-    let out_bytes = (xs.len() * 3 * 8) as u64;
+    let out_bytes = (xs.len() * 4 * 8) as u64;
     let (pipeline, bind_group, output, read) = ctx.checked("the f64 math harness", || {
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
             label: Some("pgt f64 math"),
@@ -146,5 +155,8 @@ pub fn evaluate(ctx: &GpuContext, xs: &[f64]) -> Result<Vec<[f64; 3]>> {
     })?;
     let data = read_back(ctx, &read, out_bytes)?;
     let values: Vec<f64> = bytemuck::pod_collect_to_vec(&data);
-    Ok(values.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect())
+    Ok(values
+        .chunks_exact(4)
+        .map(|c| [c[0], c[1], c[2], c[3]])
+        .collect())
 }

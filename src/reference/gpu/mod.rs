@@ -1,6 +1,7 @@
 //! The exact reference on the GPU in f64 (docs/design.md §12): `pgt render --gpu`.
 //!
-//! The emission model of spheres and ellipsoids, closed form per interval as on the CPU
+//! Gaussian particles take their own program ([`gaussian`]). For spheres and ellipsoids:
+//! the emission model, closed form per interval as on the CPU
 //! (`optics::emission`), computed by `shaders/reference_emission.wgsl` one invocation per camera
 //! ray, over the approximations' BVH (`approx::layout`). The CPU makes the rays
 //! (`Camera::ray_at`, the sub-pixel samples of `reference::render_pixel`), so both renderers trace
@@ -26,6 +27,7 @@
 //! `approx::contract::LOOP_BUDGET`): a ray stops after a batch once it has used half the budget
 //! and goes on in the next pass, from the last event it took.
 
+pub mod gaussian;
 pub mod math;
 pub mod program;
 mod run;
@@ -44,12 +46,13 @@ use glam::DVec3;
 use std::time::Instant;
 
 /// Why the GPU reference cannot render `scene` with `options`, if it cannot: what it does today
-/// is the emission model (a model without lights) of spheres and ellipsoids of constant density
-/// in the volume mode, with the adaptive integrator's meaning of err.
+/// is the emission model (a model without lights) of spheres and ellipsoids of constant density,
+/// or of Gaussian particles (a scene of one kind), in the volume mode, with the adaptive
+/// integrator's meaning of err.
 pub fn check_supported(scene: &Scene, options: &RenderOptions) -> Result<()> {
     let refuse = |what: String| {
         Err(PgtError::Gpu(format!(
-            "the GPU reference (--gpu) renders the emission model of spheres and ellipsoids of constant density; {what}: render it on the CPU (without --gpu)"
+            "the GPU reference (--gpu) renders the emission model of spheres and ellipsoids of constant density or of Gaussian particles; {what}: render it on the CPU (without --gpu)"
         )))
     };
     if scene.render.mode != RenderMode::Volume {
@@ -59,12 +62,15 @@ pub fn check_supported(scene: &Scene, options: &RenderOptions) -> Result<()> {
     if model.light_need() != LightNeed::None {
         return refuse(format!("this scene's model is {}", model.name()));
     }
-    if scene
+    let gaussians = scene
         .particles
         .iter()
-        .any(|p| p.profile != Profile::Constant)
-    {
-        return refuse("this scene has Gaussian particles".into());
+        .filter(|p| p.profile == Profile::Gaussian)
+        .count();
+    if gaussians > 0 && gaussians < scene.particles.len() {
+        return refuse(
+            "this scene mixes Gaussian particles and particles of constant density".into(),
+        );
     }
     if options.integrator != super::Integrator::Adaptive {
         return refuse("--integrator riemann is a CPU integrator".into());
@@ -137,20 +143,40 @@ pub fn render_rows_on(
             }
         }
     }
-    let samples = trace(
-        ctx,
-        scene,
-        camera.position,
-        &directions,
-        direction_error(camera),
-    )?
-    .samples;
+    let (samples, unconverged_rays) = if scene.has_gaussians() {
+        let traced = gaussian::trace(
+            ctx,
+            scene,
+            camera.position,
+            &directions,
+            direction_error(camera),
+        )?;
+        (traced.samples, traced.unconverged)
+    } else {
+        let traced = trace(
+            ctx,
+            scene,
+            camera.position,
+            &directions,
+            direction_error(camera),
+        )?;
+        let none = vec![false; traced.samples.len()];
+        (traced.samples, none)
+    };
     let n = (k * k) as usize;
     let mut image = RgbImage::new(w, h);
     let mut err_image = RgbImage::new(w, h);
+    let mut unconverged = 0;
+    let mut worst_unconverged = None;
     for (i, pixel) in samples.chunks_exact(n).enumerate() {
         let (radiance, error) = pixel_mean(pixel);
         (image.pixels[i], err_image.pixels[i]) = stored_pixel(radiance, error);
+        if unconverged_rays[i * n..(i + 1) * n].iter().any(|&u| u) {
+            unconverged += 1;
+            let (px, py) = (i as u32 % w, i as u32 / w);
+            worst_unconverged =
+                super::worse_unconverged(worst_unconverged, (px, py, error.max_element()));
+        }
     }
     let pixels = w as u64 * h as u64;
     let values = err_image.pixels.iter().flatten().map(|&v| v as f64);
@@ -165,8 +191,8 @@ pub fn render_rows_on(
             seconds: start.elapsed().as_secs_f64(),
             max_error: Some(max),
             mean_error: Some(sum / (3 * pixels).max(1) as f64),
-            unconverged: 0,
-            worst_unconverged: None,
+            unconverged,
+            worst_unconverged,
         },
     })
 }

@@ -1,0 +1,556 @@
+//! The GPU reference for Gaussian particles (docs/design.md §12, §9 "Gaussian density"): the
+//! emission model of `reference::gaussian` computed in f64 by `shaders/reference_gaussian.wgsl`,
+//! one invocation per camera ray, with the CPU renderer's k (`gaussian_cutoff`), far depth,
+//! windows, pieces and shares of tol (`reference::budget::gaussian`), without its optimisations
+//! (series polynomials, the front-to-back narrowing gather).
+//!
+//! **err** has the CPU's meaning, a bound on |stored − true| per pixel channel, and the CPU's
+//! parts ([`ray_error`]): the ray stop, the deviations bounded in closed form, the quadrature's
+//! estimate, M·(1 − e^{−Δ}) for the depth Δ left out (far, faint, tails); and the device's own:
+//! the profiles' and the pieces' depth uncertainty as M per unit of depth, and the composite's
+//! rounding, doubled for the second-order terms. A ray the program cannot finish (more
+//! Gaussians in reach than it holds, [`WINDOWS_MAX`]; a piece beyond the loop budget of a
+//! pass) is not converged with err = +∞; a ray whose quadrature could not meet its share keeps
+//! its estimate in err and is counted not converged, as on the CPU.
+
+use super::math::{ERFC_NORMAL, ERFC_ULPS, EXPM1_ULPS, EXP_ULPS, F64_MATH_WGSL, U};
+use super::program::SAFETY;
+use super::run::RaySample;
+use crate::approx::contract::{LOOP_BUDGET, STACK_SIZE};
+use crate::approx::dispatch::{read_back, storage_limit};
+use crate::approx::layout::{widen, GpuBvhNode};
+use crate::approx::shader::{ShaderPart, ShaderProgram};
+use crate::approx::wgsl::struct_declaration;
+use crate::approx::GpuContext;
+use crate::error::{PgtError, Result};
+use crate::reference::budget::gaussian as share;
+use crate::reference::gaussian::GaussianRenderer;
+use crate::reference::Integrator;
+use crate::scene::Scene;
+use bytemuck::{Pod, Zeroable};
+use glam::DVec3;
+use std::borrow::Cow;
+use std::fmt::Write;
+use wgpu::util::DeviceExt;
+use wgpu::BufferUsages as Usage;
+
+/// `shaders/reference_gaussian.wgsl`.
+pub const GAUSSIAN_WGSL: &str = include_str!("../../../shaders/reference_gaussian.wgsl");
+
+/// The entry point of the Gaussian GPU reference.
+pub const ENTRY_POINT: &str = "gaussian_main";
+
+/// The most Gaussians one ray may have within reach (their k-σ ellipsoid met in front of the
+/// eye, or a leaf box of the BVH met, whichever is larger); a ray with more is not converged.
+pub const WINDOWS_MAX: u32 = 256;
+/// Segments the quadrature's stack holds (a piece halved this many times at most, less one).
+pub const QSTACK: u32 = 48;
+/// Invocations per workgroup (one ray each, 1D).
+pub const WORKGROUP: u32 = 64;
+/// A t beyond every cut.
+const HUGE: f64 = 1e300;
+
+/// `gauss_data`: per Gaussian its centre (3), the rows of M = S⁻¹Rᵀ (9, S the standard
+/// deviations), σᵢ, the emitted colour (3) and M's Frobenius norm, as f64.
+pub const GAUSS_STRIDE: usize = 17;
+pub const G_MATRIX: usize = 3;
+pub const G_SIGMA: usize = 12;
+pub const G_COLOR: usize = 13;
+pub const G_FROBENIUS: usize = 16;
+
+/// `scene_data`: the rays' origin, that origin relative to the camera (the BVH boxes are
+/// camera-relative), the background, M (per channel max(max k·Cᵢ, L_bg)), tol, the cut-off k and
+/// how far the rays' computed unit directions may lie from the exact ones.
+pub const GS_ORIGIN: usize = 0;
+pub const GS_RELATIVE_ORIGIN: usize = 3;
+pub const GS_BACKGROUND: usize = 6;
+pub const GS_BOUND: usize = 9;
+pub const GS_TOL: usize = 12;
+pub const GS_CUTOFF: usize = 13;
+pub const GS_DIRECTION_ERROR: usize = 14;
+pub const GS_LEN: usize = 15;
+
+/// `state`, per ray: radiance (3), its rounding bound (3), the bounded deviations' half-widths
+/// (3), the quadrature's estimate (3), the ray stop's half (3), T, T's relative error bound,
+/// the start of the next piece, the pieces' depth uncertainty, the status, whether the
+/// quadrature fell short, the depth left out, the profiles' uncertainty.
+pub const GST_STRIDE: usize = 24;
+pub const GST_RADIANCE: usize = 0;
+pub const GST_ROUNDING: usize = 3;
+pub const GST_BOUNDED: usize = 6;
+pub const GST_QUADRATURE: usize = 9;
+pub const GST_RAY_STOP: usize = 12;
+pub const GST_TRANSMITTANCE: usize = 15;
+pub const GST_TRANSMITTANCE_REL: usize = 16;
+pub const GST_A: usize = 17;
+pub const GST_DEPTH: usize = 18;
+pub const GST_STATUS: usize = 19;
+pub const GST_UNCONVERGED: usize = 20;
+pub const GST_LEFT_OUT: usize = 21;
+pub const GST_PERT: usize = 22;
+
+/// A ray's status in `state`.
+pub const GSTATUS_RUNNING: u32 = 0;
+pub const GSTATUS_DONE: u32 = 1;
+pub const GSTATUS_OVERFLOW: u32 = 2;
+pub const GSTATUS_LOOP_LIMITED: u32 = 3;
+
+const _: () = assert!(G_FROBENIUS < GAUSS_STRIDE && GS_DIRECTION_ERROR < GS_LEN);
+const _: () = assert!(GST_PERT < GST_STRIDE);
+
+/// The uniform `params`.
+#[repr(C)]
+#[derive(Debug, Clone, Copy, PartialEq, Default, Pod, Zeroable)]
+pub struct GaussParams {
+    /// Rays in this dispatch.
+    pub ray_count: u32,
+    pub gaussian_count: u32,
+    /// Loop iterations after which a ray stops at the end of a piece and waits for the next
+    /// pass.
+    pub pass_yield: u32,
+    /// Loop iterations of one pass beyond which a ray is reported (lavapipe's loop limit).
+    pub loop_budget: u32,
+}
+
+/// (binding, name, address space, WGSL type) of group 0.
+pub const BINDINGS: [(u32, &str, &str, &str); 8] = [
+    (0, "params", "uniform", "GaussParams"),
+    (1, "scene_data", "storage, read", "array<f64>"),
+    (2, "gauss_data", "storage, read", "array<f64>"),
+    (3, "nodes", "storage, read", "array<BvhNode>"),
+    (4, "leaf_indices", "storage, read", "array<u32>"),
+    (5, "rays", "storage, read", "array<f64>"),
+    (6, "state", "storage, read_write", "array<f64>"),
+    (7, "counters", "storage, read_write", "GaussCounters"),
+];
+
+fn f64_literal(v: f64) -> String {
+    format!("{v:e}lf")
+}
+
+/// The declarations the shader takes from Rust.
+pub fn declarations() -> String {
+    let mut out = String::from(
+        "// Generated by pgt from src/reference/gpu/gaussian.rs and math.rs (docs there).\n\n",
+    );
+    let u32s: [(&str, usize); 34] = [
+        ("GR_WINDOWS_MAX", WINDOWS_MAX as usize),
+        ("GR_QSTACK", QSTACK as usize),
+        ("GR_WORKGROUP", WORKGROUP as usize),
+        ("GR_STACK_SIZE", STACK_SIZE as usize),
+        ("GR_GAUSS_STRIDE", GAUSS_STRIDE),
+        ("GR_G_MATRIX", G_MATRIX),
+        ("GR_G_SIGMA", G_SIGMA),
+        ("GR_G_COLOR", G_COLOR),
+        ("GR_G_FROBENIUS", G_FROBENIUS),
+        ("GS_ORIGIN", GS_ORIGIN),
+        ("GS_RELATIVE_ORIGIN", GS_RELATIVE_ORIGIN),
+        ("GS_BACKGROUND", GS_BACKGROUND),
+        ("GS_BOUND", GS_BOUND),
+        ("GS_TOL", GS_TOL),
+        ("GS_CUTOFF", GS_CUTOFF),
+        ("GS_DIRECTION_ERROR", GS_DIRECTION_ERROR),
+        ("GST_STRIDE", GST_STRIDE),
+        ("GST_RADIANCE", GST_RADIANCE),
+        ("GST_ROUNDING", GST_ROUNDING),
+        ("GST_BOUNDED", GST_BOUNDED),
+        ("GST_QUADRATURE", GST_QUADRATURE),
+        ("GST_RAY_STOP", GST_RAY_STOP),
+        ("GST_TRANSMITTANCE", GST_TRANSMITTANCE),
+        ("GST_TRANSMITTANCE_REL", GST_TRANSMITTANCE_REL),
+        ("GST_A", GST_A),
+        ("GST_DEPTH", GST_DEPTH),
+        ("GST_STATUS", GST_STATUS),
+        ("GST_UNCONVERGED", GST_UNCONVERGED),
+        ("GST_LEFT_OUT", GST_LEFT_OUT),
+        ("GST_PERT", GST_PERT),
+        ("GSTATUS_RUNNING", GSTATUS_RUNNING as usize),
+        ("GSTATUS_DONE", GSTATUS_DONE as usize),
+        ("GSTATUS_OVERFLOW", GSTATUS_OVERFLOW as usize),
+        ("GSTATUS_LOOP_LIMITED", GSTATUS_LOOP_LIMITED as usize),
+    ];
+    for (name, v) in u32s {
+        let _ = writeln!(out, "const {name}: u32 = {v}u;");
+    }
+    let f64s: [(&str, f64); 11] = [
+        ("GR_SAFETY", SAFETY),
+        ("REF_HUGE_G", HUGE),
+        ("GR_EXP_ULPS", EXP_ULPS),
+        ("GR_EXPM1_ULPS", EXPM1_ULPS),
+        ("GR_ERFC_ULPS", ERFC_ULPS),
+        ("GR_ERFC_NORMAL", ERFC_NORMAL),
+        ("GR_FAINT", share::FAINT),
+        ("GR_TAILS", share::TAILS),
+        ("GR_BOUNDED", share::BOUNDED),
+        ("GR_QUADRATURE", share::QUADRATURE),
+        ("GR_RAY_STOP", share::RAY_STOP),
+    ];
+    for (name, v) in f64s {
+        let _ = writeln!(out, "const {name}: f64 = {};", f64_literal(v));
+    }
+    out.push('\n');
+    struct_declaration::<GpuBvhNode>(&mut out);
+    out.push_str(
+        "struct GaussParams {\n    ray_count: u32,\n    gaussian_count: u32,\n    pass_yield: u32,\n    loop_budget: u32,\n}\n\n\
+         struct GaussCounters {\n    running: atomic<u32>,\n}\n\n",
+    );
+    for (index, name, space, ty) in BINDINGS {
+        let _ = writeln!(
+            out,
+            "@group(0) @binding({index}) var<{space}> {name}: {ty};"
+        );
+    }
+    out
+}
+
+/// The Gaussian GPU reference's program: the declarations, the f64 functions, the renderer.
+pub fn program() -> ShaderProgram {
+    ShaderProgram::from_parts(vec![
+        ShaderPart {
+            name: "<generated from src/reference/gpu/gaussian.rs>".into(),
+            text: Cow::Owned(declarations()),
+        },
+        ShaderPart {
+            name: "shaders/f64_math.wgsl".into(),
+            text: Cow::Borrowed(F64_MATH_WGSL),
+        },
+        ShaderPart {
+            name: "shaders/reference_gaussian.wgsl".into(),
+            text: Cow::Borrowed(GAUSSIAN_WGSL),
+        },
+    ])
+}
+
+/// The scene as the program reads it.
+struct GaussData {
+    scene: Vec<f64>,
+    gaussians: Vec<f64>,
+    nodes: Vec<GpuBvhNode>,
+    indices: Vec<u32>,
+    bound: DVec3,
+    far_depth: f64,
+    count: u32,
+}
+
+fn gauss_data(scene: &Scene, origin: DVec3, direction_error: f64) -> Result<GaussData> {
+    let renderer = GaussianRenderer::new(scene, Integrator::Adaptive)?;
+    let mut gaussians = vec![0.0; renderer.gaussians.len().max(1) * GAUSS_STRIDE];
+    for (row, g) in gaussians
+        .chunks_exact_mut(GAUSS_STRIDE)
+        .zip(&renderer.gaussians)
+    {
+        row[..3].copy_from_slice(&g.center.to_array());
+        let m = g.shape.to_unit_matrix();
+        let rows = [m.row(0), m.row(1), m.row(2)];
+        for (k, r) in rows.iter().enumerate() {
+            row[G_MATRIX + 3 * k..G_MATRIX + 3 * k + 3].copy_from_slice(&r.to_array());
+        }
+        row[G_SIGMA] = g.sigma;
+        row[G_COLOR..G_COLOR + 3].copy_from_slice(&g.emitted.to_array());
+        let frobenius = rows.iter().map(|r| r.length_squared()).sum::<f64>().sqrt();
+        row[G_FROBENIUS] = frobenius * (1.0 + 1e-12);
+    }
+    let camera = scene.camera.position;
+    let nodes = renderer
+        .bvh
+        .nodes
+        .iter()
+        .map(|n| {
+            let (min, max) = if n.min.x <= n.max.x {
+                widen(n.min, n.max, camera)
+            } else {
+                ([f32::MAX; 3], [f32::MIN; 3])
+            };
+            GpuBvhNode {
+                min,
+                first: n.first,
+                max,
+                count: n.count,
+            }
+        })
+        .collect();
+    let mut data = vec![0.0; GS_LEN];
+    data[GS_ORIGIN..GS_ORIGIN + 3].copy_from_slice(&origin.to_array());
+    let relative = origin - camera;
+    data[GS_RELATIVE_ORIGIN..GS_RELATIVE_ORIGIN + 3].copy_from_slice(&relative.to_array());
+    data[GS_BACKGROUND..GS_BACKGROUND + 3].copy_from_slice(&renderer.background.to_array());
+    data[GS_BOUND..GS_BOUND + 3].copy_from_slice(&renderer.bound.to_array());
+    data[GS_TOL] = renderer.tol;
+    data[GS_CUTOFF] = renderer.cutoff;
+    data[GS_DIRECTION_ERROR] = direction_error;
+    let indices = if renderer.bvh.indices.is_empty() {
+        vec![0]
+    } else {
+        renderer.bvh.indices.clone()
+    };
+    Ok(GaussData {
+        scene: data,
+        gaussians,
+        nodes,
+        indices,
+        bound: renderer.bound,
+        far_depth: renderer.far_depth,
+        count: renderer.gaussians.len() as u32,
+    })
+}
+
+/// A ray's err from its state (docs/design.md §12): the CPU's parts (ray stop, bounded
+/// deviations, quadrature, M·(1 − e^{−Δ}) for the depth left out) plus M per unit of the
+/// profiles' and pieces' depth uncertainty and twice the composite's rounding; +∞ where the ray
+/// did not finish.
+pub fn ray_error(ray: &[f64], bound: DVec3, far_depth: f64) -> DVec3 {
+    if ray[GST_STATUS] as u32 != GSTATUS_DONE {
+        return DVec3::INFINITY;
+    }
+    let v = |at: usize| DVec3::new(ray[at], ray[at + 1], ray[at + 2]);
+    let delta = (far_depth + ray[GST_LEFT_OUT]) * (1.0 + 1e-10);
+    let left_out = bound * -(-delta).exp_m1() * (1.0 + 1e-12);
+    let uncertain = 2.0 * SAFETY * (ray[GST_DEPTH] + ray[GST_PERT]);
+    let device = bound * uncertain + 2.0 * v(GST_ROUNDING);
+    let total = v(GST_RAY_STOP) + v(GST_BOUNDED) + v(GST_QUADRATURE) + left_out + device;
+    total * (1.0 + 16.0 * U)
+}
+
+/// One ray's answer and whether it converged.
+pub struct GaussTraced {
+    pub samples: Vec<RaySample>,
+    /// Per ray, whether it fell short (err +∞, or a quadrature over its share).
+    pub unconverged: Vec<bool>,
+    pub passes: u32,
+}
+
+/// Passes after which rays still unfinished are reported not converged.
+const MAX_PASSES: u32 = 100_000;
+
+/// The rays from `origin` along `directions` through the Gaussian `scene` with the GPU
+/// reference (as `run::trace` for spheres).
+pub fn trace(
+    ctx: &GpuContext,
+    scene: &Scene,
+    origin: DVec3,
+    directions: &[DVec3],
+    direction_error: f64,
+) -> Result<GaussTraced> {
+    if !ctx.f64 {
+        return Err(PgtError::Gpu(format!(
+            "{} was opened without f64 (GpuContext::with_f64)",
+            ctx.adapter
+        )));
+    }
+    let data = gauss_data(scene, origin, direction_error)?;
+    let program = program();
+    program.validate_with(naga::valid::Capabilities::FLOAT64)?;
+    let pipeline = ctx.checked("compiling the Gaussian GPU reference", || {
+        let module = ctx
+            .device
+            .create_shader_module(wgpu::ShaderModuleDescriptor {
+                label: Some("pgt gaussian reference"),
+                source: wgpu::ShaderSource::Wgsl(program.source().into()),
+            });
+        ctx.device
+            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some("pgt gaussian reference"),
+                layout: None,
+                module: &module,
+                entry_point: Some(ENTRY_POINT),
+                compilation_options: Default::default(),
+                cache: None,
+            })
+    })?;
+    let limit = storage_limit(ctx);
+    let sizes = [
+        ("the Gaussians", std::mem::size_of_val(&data.gaussians[..])),
+        ("the BVH", std::mem::size_of_val(&data.nodes[..])),
+    ];
+    for (what, bytes) in sizes {
+        if bytes as u64 > limit {
+            return Err(PgtError::Gpu(format!(
+                "{what} of this scene take {bytes} bytes in f64, more than the {limit} bytes {} binds: render it on the CPU (without --gpu)",
+                ctx.adapter.name
+            )));
+        }
+    }
+    let per_ray = (GST_STRIDE * 8) as u64;
+    let chunk = (limit / per_ray).min(65535 * WORKGROUP as u64) as usize;
+    let buffers = ctx.checked("uploading the scene to the Gaussian GPU reference", || {
+        SceneGpu::new(ctx, &data)
+    })?;
+    let mut out = GaussTraced {
+        samples: Vec::with_capacity(directions.len()),
+        unconverged: Vec::with_capacity(directions.len()),
+        passes: 0,
+    };
+    for part in directions.chunks(chunk.max(WORKGROUP as usize)) {
+        let (state, passes) = run_chunk(ctx, &pipeline, &buffers, part)?;
+        out.passes = out.passes.max(passes);
+        for ray in state.chunks_exact(GST_STRIDE) {
+            let radiance = DVec3::new(
+                ray[GST_RADIANCE],
+                ray[GST_RADIANCE + 1],
+                ray[GST_RADIANCE + 2],
+            );
+            let error = ray_error(ray, data.bound, data.far_depth);
+            out.unconverged
+                .push(!error.is_finite() || ray[GST_UNCONVERGED] != 0.0);
+            out.samples.push(RaySample { radiance, error });
+        }
+    }
+    Ok(out)
+}
+
+/// The buffers every chunk of rays shares.
+struct SceneGpu {
+    scene: wgpu::Buffer,
+    gaussians: wgpu::Buffer,
+    nodes: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    gaussian_count: u32,
+}
+
+fn storage_init<T: Pod>(ctx: &GpuContext, label: &str, data: &[T], usage: Usage) -> wgpu::Buffer {
+    ctx.device
+        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some(label),
+            contents: bytemuck::cast_slice(data),
+            usage,
+        })
+}
+
+impl SceneGpu {
+    fn new(ctx: &GpuContext, data: &GaussData) -> SceneGpu {
+        let s = Usage::STORAGE;
+        SceneGpu {
+            scene: storage_init(ctx, "pgt gaussian scene", &data.scene, s),
+            gaussians: storage_init(ctx, "pgt gaussian data", &data.gaussians, s),
+            nodes: storage_init(ctx, "pgt gaussian nodes", &data.nodes, s),
+            indices: storage_init(ctx, "pgt gaussian leaf indices", &data.indices, s),
+            gaussian_count: data.count,
+        }
+    }
+}
+
+/// The per-ray state a chunk starts with: T = 1, at t = 0, running.
+fn initial_state(rays: usize) -> Vec<f64> {
+    let mut state = vec![0.0; rays * GST_STRIDE];
+    for ray in state.chunks_exact_mut(GST_STRIDE) {
+        ray[GST_TRANSMITTANCE] = 1.0;
+    }
+    state
+}
+
+/// Runs passes over one chunk of rays until every ray has finished (or `MAX_PASSES`); the
+/// final state and the number of passes.
+fn run_chunk(
+    ctx: &GpuContext,
+    pipeline: &wgpu::ComputePipeline,
+    gpu: &SceneGpu,
+    directions: &[DVec3],
+) -> Result<(Vec<f64>, u32)> {
+    let device = &ctx.device;
+    let rays: Vec<f64> = directions.iter().flat_map(|d| d.to_array()).collect();
+    let (pass_yield, loop_budget) = if ctx.adapter.is_cpu {
+        (LOOP_BUDGET / 2, LOOP_BUDGET)
+    } else {
+        (1 << 20, u32::MAX)
+    };
+    let params = GaussParams {
+        ray_count: directions.len() as u32,
+        gaussian_count: gpu.gaussian_count,
+        pass_yield,
+        loop_budget,
+    };
+    let state_bytes = (directions.len() * GST_STRIDE * 8) as u64;
+    let (bind_group, state, counters, counters_read, state_read) =
+        ctx.checked("uploading the Gaussian GPU reference's rays", || {
+            let params = storage_init(ctx, "pgt gaussian params", &[params], Usage::UNIFORM);
+            let rays = storage_init(ctx, "pgt gaussian rays", &rays, Usage::STORAGE);
+            let state = storage_init(
+                ctx,
+                "pgt gaussian state",
+                &initial_state(directions.len()),
+                Usage::STORAGE | Usage::COPY_SRC,
+            );
+            let counters = storage_init(
+                ctx,
+                "pgt gaussian counters",
+                &[0u32; 4],
+                Usage::STORAGE | Usage::COPY_SRC | Usage::COPY_DST,
+            );
+            let read = |label, size| {
+                device.create_buffer(&wgpu::BufferDescriptor {
+                    label: Some(label),
+                    size,
+                    usage: Usage::MAP_READ | Usage::COPY_DST,
+                    mapped_at_creation: false,
+                })
+            };
+            let buffers = [
+                &params,
+                &gpu.scene,
+                &gpu.gaussians,
+                &gpu.nodes,
+                &gpu.indices,
+                &rays,
+                &state,
+                &counters,
+            ];
+            let entries: Vec<wgpu::BindGroupEntry> = buffers
+                .iter()
+                .enumerate()
+                .map(|(i, b)| wgpu::BindGroupEntry {
+                    binding: i as u32,
+                    resource: b.as_entire_binding(),
+                })
+                .collect();
+            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("pgt gaussian reference"),
+                layout: &pipeline.get_bind_group_layout(0),
+                entries: &entries,
+            });
+            let counters_read = read("pgt gaussian counters read-back", 16);
+            let state_read = read("pgt gaussian state read-back", state_bytes);
+            (bind_group, state, counters, counters_read, state_read)
+        })?;
+    let groups = (directions.len() as u32).div_ceil(WORKGROUP);
+    let mut pass = 0;
+    while pass < MAX_PASSES {
+        pass += 1;
+        ctx.checked("running the Gaussian GPU reference", || {
+            ctx.queue
+                .write_buffer(&counters, 0, bytemuck::cast_slice(&[0u32; 4]));
+            let mut encoder = device.create_command_encoder(&Default::default());
+            {
+                let mut cpass = encoder.begin_compute_pass(&Default::default());
+                cpass.set_pipeline(pipeline);
+                cpass.set_bind_group(0, &bind_group, &[]);
+                cpass.dispatch_workgroups(groups, 1, 1);
+            }
+            encoder.copy_buffer_to_buffer(&counters, 0, &counters_read, 0, 16);
+            ctx.queue.submit([encoder.finish()]);
+        })?;
+        let running: Vec<u32> = bytemuck::pod_collect_to_vec(&read_back(ctx, &counters_read, 16)?);
+        if running[0] == 0 {
+            break;
+        }
+    }
+    ctx.checked("reading the Gaussian GPU reference back", || {
+        let mut encoder = device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(&state, 0, &state_read, 0, state_bytes);
+        ctx.queue.submit([encoder.finish()]);
+    })?;
+    let state = bytemuck::pod_collect_to_vec(&read_back(ctx, &state_read, state_bytes)?);
+    Ok((state, pass))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_gaussian_program_validates_with_f64() {
+        let caps = naga::valid::Capabilities::FLOAT64;
+        if let Err(e) = program().validate_with(caps) {
+            panic!("{e}");
+        }
+    }
+}
