@@ -598,15 +598,7 @@ impl GaussianRenderer {
                 if w.hi <= a {
                     return false;
                 }
-                // On long pieces a window open on the piece counts on all of it: its
-                // Gaussian's tail beyond the window's ends only brings the rendered medium
-                // nearer the true one (what is left out stays within Δ), and the window is
-                // summed as a polynomial on a piece it only partly covers.
-                let (x0, x1) = if long {
-                    (a, b)
-                } else {
-                    (w.lo.max(a), w.hi.min(b))
-                };
+                let (x0, x1) = member_span(w, a, b, long);
                 // The erfc at x0 is the one the last piece computed at its end, where the
                 // window goes on.
                 let from = match w.tail_at {
@@ -1042,6 +1034,17 @@ fn cut_pieces(s: &mut Scratch, lights: &[Light], ray: &Ray) {
     s.long_pieces = false;
     if lights.is_empty() {
         choose_long_pieces(s);
+    }
+}
+
+/// The part [x0, x1] of the piece [a, b] on which the window `w` open on it counts: all of it
+/// on long pieces (the Gaussian's tail beyond the window only brings the rendered medium nearer
+/// the true one; what is left out stays within Δ), else where the two overlap.
+fn member_span(w: &Window, a: f64, b: f64, long: bool) -> (f64, f64) {
+    if long {
+        (a, b)
+    } else {
+        (w.lo.max(a), w.hi.min(b))
     }
 }
 
