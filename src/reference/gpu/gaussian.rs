@@ -15,9 +15,9 @@
 
 use super::math::{ERFC_NORMAL, ERFC_ULPS, EXPM1_ULPS, EXP_ULPS, F64_MATH_WGSL, U};
 use super::program::SAFETY;
-use super::run::RaySample;
-use crate::approx::contract::{LOOP_BUDGET, STACK_SIZE};
-use crate::approx::dispatch::{read_back, storage_limit};
+use super::run::{pass_limits, storage_init, Passes, RaySample};
+use crate::approx::contract::STACK_SIZE;
+use crate::approx::dispatch::storage_limit;
 use crate::approx::layout::{widen, GpuBvhNode};
 use crate::approx::shader::{ShaderPart, ShaderProgram};
 use crate::approx::wgsl::struct_declaration;
@@ -31,7 +31,6 @@ use bytemuck::{Pod, Zeroable};
 use glam::DVec3;
 use std::borrow::Cow;
 use std::fmt::Write;
-use wgpu::util::DeviceExt;
 use wgpu::BufferUsages as Usage;
 
 /// `shaders/reference_gaussian.wgsl`.
@@ -319,9 +318,6 @@ pub struct GaussTraced {
     pub passes: u32,
 }
 
-/// Passes after which rays still unfinished are reported not converged.
-const MAX_PASSES: u32 = 100_000;
-
 /// The rays from `origin` along `directions` through the Gaussian `scene` with the GPU
 /// reference (as `run::trace` for spheres).
 pub fn trace(
@@ -407,15 +403,6 @@ struct SceneGpu {
     gaussian_count: u32,
 }
 
-fn storage_init<T: Pod>(ctx: &GpuContext, label: &str, data: &[T], usage: Usage) -> wgpu::Buffer {
-    ctx.device
-        .create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: Some(label),
-            contents: bytemuck::cast_slice(data),
-            usage,
-        })
-}
-
 impl SceneGpu {
     fn new(ctx: &GpuContext, data: &GaussData) -> SceneGpu {
         let s = Usage::STORAGE;
@@ -438,108 +425,29 @@ fn initial_state(rays: usize) -> Vec<f64> {
     state
 }
 
-/// Runs passes over one chunk of rays until every ray has finished (or `MAX_PASSES`); the
-/// final state and the number of passes.
+/// Runs passes over one chunk of rays until every ray has finished (or the passes run out: the
+/// state is then taken as it stands); the final state and the number of passes.
 fn run_chunk(
     ctx: &GpuContext,
     pipeline: &wgpu::ComputePipeline,
     gpu: &SceneGpu,
     directions: &[DVec3],
 ) -> Result<(Vec<f64>, u32)> {
-    let device = &ctx.device;
-    let rays: Vec<f64> = directions.iter().flat_map(|d| d.to_array()).collect();
-    let (pass_yield, loop_budget) = if ctx.adapter.is_cpu {
-        (LOOP_BUDGET / 2, LOOP_BUDGET)
-    } else {
-        (1 << 20, u32::MAX)
-    };
+    let (pass_yield, loop_budget) = pass_limits(ctx);
     let params = GaussParams {
         ray_count: directions.len() as u32,
         gaussian_count: gpu.gaussian_count,
         pass_yield,
         loop_budget,
     };
-    let state_bytes = (directions.len() * GST_STRIDE * 8) as u64;
-    let (bind_group, state, counters, counters_read, state_read) =
-        ctx.checked("uploading the Gaussian GPU reference's rays", || {
-            let params = storage_init(ctx, "pgt gaussian params", &[params], Usage::UNIFORM);
-            let rays = storage_init(ctx, "pgt gaussian rays", &rays, Usage::STORAGE);
-            let state = storage_init(
-                ctx,
-                "pgt gaussian state",
-                &initial_state(directions.len()),
-                Usage::STORAGE | Usage::COPY_SRC,
-            );
-            let counters = storage_init(
-                ctx,
-                "pgt gaussian counters",
-                &[0u32; 4],
-                Usage::STORAGE | Usage::COPY_SRC | Usage::COPY_DST,
-            );
-            let read = |label, size| {
-                device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some(label),
-                    size,
-                    usage: Usage::MAP_READ | Usage::COPY_DST,
-                    mapped_at_creation: false,
-                })
-            };
-            let buffers = [
-                &params,
-                &gpu.scene,
-                &gpu.gaussians,
-                &gpu.nodes,
-                &gpu.indices,
-                &rays,
-                &state,
-                &counters,
-            ];
-            let entries: Vec<wgpu::BindGroupEntry> = buffers
-                .iter()
-                .enumerate()
-                .map(|(i, b)| wgpu::BindGroupEntry {
-                    binding: i as u32,
-                    resource: b.as_entire_binding(),
-                })
-                .collect();
-            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("pgt gaussian reference"),
-                layout: &pipeline.get_bind_group_layout(0),
-                entries: &entries,
-            });
-            let counters_read = read("pgt gaussian counters read-back", 16);
-            let state_read = read("pgt gaussian state read-back", state_bytes);
-            (bind_group, state, counters, counters_read, state_read)
-        })?;
-    let groups = (directions.len() as u32).div_ceil(WORKGROUP);
-    let mut pass = 0;
-    while pass < MAX_PASSES {
-        pass += 1;
-        ctx.checked("running the Gaussian GPU reference", || {
-            ctx.queue
-                .write_buffer(&counters, 0, bytemuck::cast_slice(&[0u32; 4]));
-            let mut encoder = device.create_command_encoder(&Default::default());
-            {
-                let mut cpass = encoder.begin_compute_pass(&Default::default());
-                cpass.set_pipeline(pipeline);
-                cpass.set_bind_group(0, &bind_group, &[]);
-                cpass.dispatch_workgroups(groups, 1, 1);
-            }
-            encoder.copy_buffer_to_buffer(&counters, 0, &counters_read, 0, 16);
-            ctx.queue.submit([encoder.finish()]);
-        })?;
-        let running: Vec<u32> = bytemuck::pod_collect_to_vec(&read_back(ctx, &counters_read, 16)?);
-        if running[0] == 0 {
-            break;
-        }
-    }
-    ctx.checked("reading the Gaussian GPU reference back", || {
-        let mut encoder = device.create_command_encoder(&Default::default());
-        encoder.copy_buffer_to_buffer(&state, 0, &state_read, 0, state_bytes);
-        ctx.queue.submit([encoder.finish()]);
-    })?;
-    let state = bytemuck::pod_collect_to_vec(&read_back(ctx, &state_read, state_bytes)?);
-    Ok((state, pass))
+    let scene = [&gpu.scene, &gpu.gaussians, &gpu.nodes, &gpu.indices];
+    let run = Passes {
+        what: "Gaussian GPU reference",
+        pipeline,
+        scene: &scene,
+    };
+    let (state, passes, _) = run.run(ctx, params, directions, initial_state(directions.len()))?;
+    Ok((state, passes))
 }
 
 #[cfg(test)]

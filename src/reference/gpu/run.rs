@@ -39,7 +39,7 @@ pub struct Traced {
 /// Passes after which a ray that has not finished is an error (each pass takes at least one
 /// batch of events of every unfinished ray, so only a scene with very many events per ray
 /// reaches it).
-const MAX_PASSES: u32 = 100_000;
+pub(super) const MAX_PASSES: u32 = 100_000;
 
 /// The scene as the GPU reference reads it: f64 particles and ellipsoids, the approximations'
 /// BVH, and the per-scene values.
@@ -228,7 +228,7 @@ struct SceneGpu {
     particle_count: u32,
 }
 
-fn storage_init<T: bytemuck::Pod>(
+pub(super) fn storage_init<T: bytemuck::Pod>(
     ctx: &GpuContext,
     label: &str,
     data: &[T],
@@ -279,99 +279,138 @@ fn run_chunk(
     gpu: &SceneGpu,
     directions: &[DVec3],
 ) -> Result<(Vec<f64>, u32)> {
-    let device = &ctx.device;
-    let rays: Vec<f64> = directions.iter().flat_map(|d| d.to_array()).collect();
-    let (pass_yield, loop_budget) = if ctx.adapter.is_cpu {
-        (LOOP_BUDGET / 2, LOOP_BUDGET)
-    } else {
-        (1 << 20, u32::MAX)
-    };
+    let (pass_yield, loop_budget) = pass_limits(ctx);
     let params = RefParams {
         ray_count: directions.len() as u32,
         particle_count: gpu.particle_count,
         pass_yield,
         loop_budget,
     };
-    let state_bytes = (directions.len() * STATE_STRIDE * 8) as u64;
-    let (bind_group, state, counters, counters_read, state_read) =
-        ctx.checked("uploading the GPU reference's rays", || {
-            let params = storage_init(ctx, "pgt reference params", &[params], Usage::UNIFORM);
-            let rays = storage_init(ctx, "pgt reference rays", &rays, Usage::STORAGE);
-            let state = storage_init(
-                ctx,
-                "pgt reference state",
-                &initial_state(directions.len()),
-                Usage::STORAGE | Usage::COPY_SRC,
-            );
-            let counters = storage_init(
-                ctx,
-                "pgt reference counters",
-                &[0u32; 4],
-                Usage::STORAGE | Usage::COPY_SRC | Usage::COPY_DST,
-            );
-            let read = |label, size| {
-                device.create_buffer(&wgpu::BufferDescriptor {
-                    label: Some(label),
-                    size,
-                    usage: Usage::MAP_READ | Usage::COPY_DST,
-                    mapped_at_creation: false,
-                })
-            };
-            let buffers = [
-                &params,
-                &gpu.scene,
-                &gpu.particles,
-                &gpu.ellipsoids,
-                &gpu.nodes,
-                &gpu.indices,
-                &rays,
-                &state,
-                &counters,
-            ];
-            let entries: Vec<wgpu::BindGroupEntry> = buffers
-                .iter()
-                .enumerate()
-                .map(|(i, b)| wgpu::BindGroupEntry {
-                    binding: i as u32,
-                    resource: b.as_entire_binding(),
-                })
-                .collect();
-            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("pgt reference"),
-                layout: &pipeline.get_bind_group_layout(0),
-                entries: &entries,
-            });
-            let counters_read = read("pgt reference counters read-back", 16);
-            let state_read = read("pgt reference state read-back", state_bytes);
-            (bind_group, state, counters, counters_read, state_read)
-        })?;
-    let groups = (directions.len() as u32).div_ceil(WORKGROUP);
-    for pass in 1..=MAX_PASSES {
-        ctx.checked("running the GPU reference", || {
-            ctx.queue
-                .write_buffer(&counters, 0, bytemuck::cast_slice(&[0u32; 4]));
-            let mut encoder = device.create_command_encoder(&Default::default());
-            {
-                let mut pass = encoder.begin_compute_pass(&Default::default());
-                pass.set_pipeline(pipeline);
-                pass.set_bind_group(0, &bind_group, &[]);
-                pass.dispatch_workgroups(groups, 1, 1);
-            }
-            encoder.copy_buffer_to_buffer(&counters, 0, &counters_read, 0, 16);
-            ctx.queue.submit([encoder.finish()]);
-        })?;
-        let running: Vec<u32> = bytemuck::pod_collect_to_vec(&read_back(ctx, &counters_read, 16)?);
-        if running[0] == 0 {
-            ctx.checked("reading the GPU reference back", || {
+    let scene = [
+        &gpu.scene,
+        &gpu.particles,
+        &gpu.ellipsoids,
+        &gpu.nodes,
+        &gpu.indices,
+    ];
+    let run = Passes {
+        what: "GPU reference",
+        pipeline,
+        scene: &scene,
+    };
+    match run.run(ctx, params, directions, initial_state(directions.len()))? {
+        (state, passes, true) => Ok((state, passes)),
+        _ => Err(PgtError::Gpu(format!(
+            "rays of the GPU reference still unfinished after {MAX_PASSES} passes"
+        ))),
+    }
+}
+
+/// A pass's yield (the loop iterations after which a ray stops for the pass) and loop budget:
+/// lavapipe's loop limit on a CPU adapter, none elsewhere.
+pub(super) fn pass_limits(ctx: &GpuContext) -> (u32, u32) {
+    if ctx.adapter.is_cpu {
+        (LOOP_BUDGET / 2, LOOP_BUDGET)
+    } else {
+        (1 << 20, u32::MAX)
+    }
+}
+
+/// A GPU reference program run in passes over chunks of rays: its bindings are the params
+/// (uniform), the `scene` buffers in order, then the rays, the per-ray state (f64) and four
+/// counters, the first of which a pass sets while rays are still running.
+pub(super) struct Passes<'a> {
+    /// The program's name in messages.
+    pub what: &'a str,
+    pub pipeline: &'a wgpu::ComputePipeline,
+    pub scene: &'a [&'a wgpu::Buffer],
+}
+
+impl Passes<'_> {
+    /// Runs passes over `directions` from the per-ray state `initial` until every ray has
+    /// finished or [`MAX_PASSES`]: the final state, the passes and whether every ray finished.
+    pub fn run<P: bytemuck::Pod>(
+        &self,
+        ctx: &GpuContext,
+        params: P,
+        directions: &[DVec3],
+        initial: Vec<f64>,
+    ) -> Result<(Vec<f64>, u32, bool)> {
+        let what = self.what;
+        let device = &ctx.device;
+        let rays: Vec<f64> = directions.iter().flat_map(|d| d.to_array()).collect();
+        let state_bytes = (initial.len() * 8) as u64;
+        let (bind_group, state, counters, counters_read, state_read) =
+            ctx.checked(&format!("uploading the {what}'s rays"), || {
+                let params = storage_init(ctx, "pgt reference params", &[params], Usage::UNIFORM);
+                let rays = storage_init(ctx, "pgt reference rays", &rays, Usage::STORAGE);
+                let state = storage_init(
+                    ctx,
+                    "pgt reference state",
+                    &initial,
+                    Usage::STORAGE | Usage::COPY_SRC,
+                );
+                let counters = storage_init(
+                    ctx,
+                    "pgt reference counters",
+                    &[0u32; 4],
+                    Usage::STORAGE | Usage::COPY_SRC | Usage::COPY_DST,
+                );
+                let read = |label, size| {
+                    device.create_buffer(&wgpu::BufferDescriptor {
+                        label: Some(label),
+                        size,
+                        usage: Usage::MAP_READ | Usage::COPY_DST,
+                        mapped_at_creation: false,
+                    })
+                };
+                let mut buffers = vec![&params];
+                buffers.extend(self.scene);
+                buffers.extend([&rays, &state, &counters]);
+                let entries: Vec<wgpu::BindGroupEntry> = buffers
+                    .iter()
+                    .enumerate()
+                    .map(|(i, b)| wgpu::BindGroupEntry {
+                        binding: i as u32,
+                        resource: b.as_entire_binding(),
+                    })
+                    .collect();
+                let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("pgt reference"),
+                    layout: &self.pipeline.get_bind_group_layout(0),
+                    entries: &entries,
+                });
+                let counters_read = read("pgt reference counters read-back", 16);
+                let state_read = read("pgt reference state read-back", state_bytes);
+                (bind_group, state, counters, counters_read, state_read)
+            })?;
+        let groups = (directions.len() as u32).div_ceil(WORKGROUP);
+        let (mut passes, mut finished) = (0, false);
+        while passes < MAX_PASSES && !finished {
+            passes += 1;
+            ctx.checked(&format!("running the {what}"), || {
+                ctx.queue
+                    .write_buffer(&counters, 0, bytemuck::cast_slice(&[0u32; 4]));
                 let mut encoder = device.create_command_encoder(&Default::default());
-                encoder.copy_buffer_to_buffer(&state, 0, &state_read, 0, state_bytes);
+                {
+                    let mut pass = encoder.begin_compute_pass(&Default::default());
+                    pass.set_pipeline(self.pipeline);
+                    pass.set_bind_group(0, &bind_group, &[]);
+                    pass.dispatch_workgroups(groups, 1, 1);
+                }
+                encoder.copy_buffer_to_buffer(&counters, 0, &counters_read, 0, 16);
                 ctx.queue.submit([encoder.finish()]);
             })?;
-            let state = bytemuck::pod_collect_to_vec(&read_back(ctx, &state_read, state_bytes)?);
-            return Ok((state, pass));
+            let running: Vec<u32> =
+                bytemuck::pod_collect_to_vec(&read_back(ctx, &counters_read, 16)?);
+            finished = running[0] == 0;
         }
+        ctx.checked(&format!("reading the {what} back"), || {
+            let mut encoder = device.create_command_encoder(&Default::default());
+            encoder.copy_buffer_to_buffer(&state, 0, &state_read, 0, state_bytes);
+            ctx.queue.submit([encoder.finish()]);
+        })?;
+        let state = bytemuck::pod_collect_to_vec(&read_back(ctx, &state_read, state_bytes)?);
+        Ok((state, passes, finished))
     }
-    Err(PgtError::Gpu(format!(
-        "rays of the GPU reference still unfinished after {MAX_PASSES} passes"
-    )))
 }
