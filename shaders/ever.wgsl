@@ -18,6 +18,7 @@ alias EventT = f32;
 alias EventValue = u32;
 const EVENT_CAPACITY: u32 = EVER_MAX_BATCH;
 const EVENT_T_FAR: f32 = T_FAR;
+const EVENT_IN_BOX: bool = true;
 
 // Particle i's entry and exit after (t_after, key_after). An entry behind the camera (a camera
 // inside the particle) is an event at t = 0; a particle wholly behind it has none.

@@ -13,6 +13,7 @@ alias EventT = f32;
 alias EventValue = f32;
 const EVENT_CAPACITY: u32 = GAUSS_RAY_BATCH;
 const EVENT_T_FAR: f32 = T_FAR;
+const EVENT_IN_BOX: bool = true;
 
 // Gaussian i's hit, if its t* comes after (t_after, index_after). A hit's t* lies in its chord,
 // so the boxes the traversal prunes (ending before t_after, starting beyond a full batch's

@@ -11,6 +11,10 @@
 //     alias EventValue = …;            what an event carries besides (t, key)
 //     const EVENT_CAPACITY: u32;       the most events a batch holds
 //     const EVENT_T_FAR: EventT;       beyond every event
+//     const EVENT_IN_BOX: bool;        whether every event of a particle lies on the ray's chord
+//                                      of its BVH box (then boxes before the cursor or beyond
+//                                      a full batch are pruned; else every box the ray meets
+//                                      in front of the eye is visited)
 // and defines the work at a leaf:
 //     fn event_visit(ray: EventRay, i: u32, t_after: EventT, key_after: u32, capacity: u32)
 // which puts particle i's events after (t_after, key_after) into the batch with event_insert.
@@ -82,7 +86,7 @@ fn events_collect(ray: EventRay, t_after: EventT, key_after: u32, capacity: u32,
     if (particle_count == 0u) {
         return;
     }
-    let t_min = max(t_after, EventT(0.0));
+    let t_min = select(EventT(0.0), max(t_after, EventT(0.0)), EVENT_IN_BOX);
     traversal_stack[0] = 0u;
     var sp = 1u;
     while (sp > 0u) {
@@ -91,7 +95,7 @@ fn events_collect(ray: EventRay, t_after: EventT, key_after: u32, capacity: u32,
         let node = nodes[traversal_stack[sp]];
         // A full batch prunes boxes that start beyond its farthest event.
         var t_max = EVENT_T_FAR;
-        if (events_count >= capacity) {
+        if (EVENT_IN_BOX && events_count >= capacity) {
             t_max = events_t[capacity - 1u];
         }
         if (event_box_entry(ray, node, t_min, t_max) < EventT(0.0)) {

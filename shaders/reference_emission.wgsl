@@ -13,7 +13,7 @@
 // the work was split into passes). Between two events the set is fixed, and the interval adds
 // T·E·(1 − e^{−σΔ}) with σ = Σσᵢ and E = Σσᵢ·Cᵢ/σ summed afresh (docs/design.md §2, §3).
 //
-// Error bound, carried per ray (src/reference/gpu/bound.rs turns it into err):
+// Error bound, carried per ray (`ray_error` in src/reference/gpu/mod.rs turns it into err):
 // * each chord end's distance from the exact one (the ray's direction, the subtraction o − c and
 //   every rounding of the stable intersection), as optical depth σᵢ·δt: moving one chord end by
 //   δt changes L by at most σᵢ·δt·Cmax (a sliver of gas of that depth in front of radiance at
@@ -37,6 +37,7 @@ alias EventT = f64;
 alias EventValue = f64;
 const EVENT_CAPACITY: u32 = REF_BATCH;
 const EVENT_T_FAR: f64 = REF_HUGE;
+const EVENT_IN_BOX: bool = true;
 
 // The particles the ray is inside at the last event taken, sorted by index.
 var<private> inside: array<u32, REF_INSIDE_MAX>;
