@@ -2,22 +2,28 @@
 // (docs/design.md §12, §9 "Gaussian density"): one invocation per camera ray, the method of
 // src/reference/gaussian.rs without its optimisations, with a bound on its own rounding.
 //
-// The constants GR_*, GS_*, GST_*, GSTATUS_*, the struct BvhNode and the bindings are generated
-// from src/reference/gpu/gaussian.rs and prepended, with shaders/f64_math.wgsl (no
-// transcendental builtin is ever called on f64).
+// The constants GR_*, GS_*, GST_*, GSTATUS_*, GPHASE_*, STACK_SIZE, the struct BvhNode and the
+// bindings are generated from src/reference/gpu/gaussian.rs and prepended, with
+// shaders/f64_math.wgsl (no transcendental builtin is ever called on f64) and
+// shaders/nearest_events.wgsl (the BVH traversal and the batch).
 //
-// Per ray and pass: `gauss_gather` traverses the BVH of the k-σ ellipsoids and keeps every
-// Gaussian whose k-σ ellipsoid the ray may meet in front of the eye; the faint ones (depth in
-// front ≤ FAINT·tol/M over their count) are left out whole, the rest get windows
-// |t − t*| ≤ w·s whose tails fit TAILS·tol/M over their count. The ray is cut at every window's
-// ends and centre; on each piece [a, b] the closed form T(a)·C_ref·(1 − e^{−τ(a,b)}) with C_ref
-// the colour of the Gaussian with the most depth there, and the colour deviation
+// Per ray, three phases, each a traversal of the BVH of the k-σ ellipsoids over every Gaussian
+// whose k-σ ellipsoid the ray may meet in front of the eye (the candidates): GPHASE_COUNT counts
+// them (n); GPHASE_SUM leaves out the faint ones (depth in front ≤ FAINT·tol/M/n) whole, gives
+// the rest windows |t − t*| ≤ w·s whose tails fit TAILS·tol/M/n, and sums the depth left out and
+// the windows' span; GPHASE_PIECES takes the windows in batches: the GR_WINDOWS_MAX kept windows
+// still open at the cursor that start first (nearest_events.wgsl keyed by (start, Gaussian)),
+// valid up to the start of the first one left out. The ray is cut at every window's ends and
+// centre; on each piece [a, b] the closed form T(a)·C_ref·(1 − e^{−τ(a,b)}) with C_ref the colour
+// of the Gaussian with the most depth there, and the colour deviation
 // ∫ e^{−τ(a,t)}·Σ σᵢ(t)(Cᵢ − C_ref) dt bounded in closed form (the CPU's `deviation_bounds`)
 // while the half-widths fit BOUNDED·tol, else integrated by adaptive G7–K15 with a fixed stack,
 // each segment to QUADRATURE·tol times its share of the windows' span, its estimate
-// (src/reference/quadrature.rs's `pair_estimate` for K15 against G7) into err. A ray goes on
-// in the next pass from the end of the last piece it finished (the gather is redone: the same
-// windows, the same pieces), so the answer does not depend on how passes split the work.
+// (src/reference/quadrature.rs's `pair_estimate` for K15 against G7) into err. A piece's
+// members are the batch's windows that overlap it, in the batch's order, whichever batch holds
+// them, so the pieces and their values do not depend on where batches or passes end. A ray goes
+// on in the next pass from its phase and the end of the last piece it finished. A ray with more
+// than GR_WINDOWS_MAX windows open at one depth is not converged (err = |L| + M).
 //
 // Error bound, carried per ray and turned into err by gaussian.rs (`ray_error`): the parts of
 // the CPU (ray stop, bounded deviations, quadrature, the depth left out) and the device's own:
@@ -34,18 +40,25 @@ fn count_iteration() {
     loop_iterations = loop_iterations + 1u;
 }
 
-var<private> traversal_stack: array<u32, GR_STACK_SIZE>;
+var<private> traversal_stack: array<u32, STACK_SIZE>;
 
-// The candidates, then (compacted) the kept windows: profile, window, colour index.
+// The batch of shaders/nearest_events.wgsl: the kept windows still open at the ray's cursor,
+// keyed by (start, Gaussian), one more than a ray holds (the first left out bounds the batch's
+// reach). A window may reach beyond its Gaussian's k-σ ellipsoid and so beyond its BVH box.
+alias EventT = f64;
+alias EventValue = u32;
+const EVENT_CAPACITY: u32 = GR_WINDOWS_MAX + 1u;
+const EVENT_T_FAR: f64 = REF_HUGE_G;
+const EVENT_IN_BOX: bool = false;
+
+// The batch's windows: profile, window, Gaussian, in the batch's order.
 var<private> w_tstar: array<f64, GR_WINDOWS_MAX>;
 var<private> w_s: array<f64, GR_WINDOWS_MAX>;
 var<private> w_peak: array<f64, GR_WINDOWS_MAX>;
-var<private> w_front: array<f64, GR_WINDOWS_MAX>;
 var<private> w_lo: array<f64, GR_WINDOWS_MAX>;
 var<private> w_hi: array<f64, GR_WINDOWS_MAX>;
 var<private> w_index: array<u32, GR_WINDOWS_MAX>;
 var<private> w_count: u32;
-var<private> w_overflowed: bool;
 
 // The members of the current piece (indices into the windows) and erfc(|z|) at its start.
 var<private> m_window: array<u32, GR_WINDOWS_MAX>;
@@ -160,137 +173,142 @@ fn erf_between_error(factor: f64, ta: f64, tb: f64, result: f64) -> f64 {
 
 // peak·s·√(π/2): the optical depth of window w per unit of erf difference.
 fn w_factor(w: u32) -> f64 {
-    return w_peak[w] * w_s[w] * GR_SQRT_HALF_PI;
+    return depth_factor(w_peak[w], w_s[w]);
 }
 
 fn w_z(w: u32, t: f64) -> f64 {
     return (t - w_tstar[w]) / (GR_SQRT2 * w_s[w]);
 }
 
-// What the gather found: the depth left out of the kept windows (faint Gaussians, tails), the
-// profiles' uncertainty as depth, and the windows' span.
-struct Gathered {
-    left_out: f64,
-    pert: f64,
-    span: f64,
+// What a traversal does at each Gaussian (`gauss_visit`): count the candidates, sum what the
+// ray's windows leave out, or put the kept windows open after the cursor into the batch.
+const GV_COUNT: u32 = 0u;
+const GV_SUM: u32 = 1u;
+const GV_BATCH: u32 = 2u;
+var<private> gv_mode: u32;
+// A candidate whose depth in front of the eye is at most gv_faint is left out whole; a kept
+// window's two tails hold at most gv_tail of depth.
+var<private> gv_faint: f64;
+var<private> gv_tail: f64;
+// GV_COUNT's and GV_SUM's sums.
+var<private> gv_count: u32;
+var<private> gv_left_out: f64;
+var<private> gv_pert: f64;
+var<private> gv_first: f64;
+var<private> gv_last: f64;
+
+// peak·s·√(π/2): a profile's optical depth per unit of erf difference.
+fn depth_factor(peak: f64, s: f64) -> f64 {
+    return peak * s * GR_SQRT_HALF_PI;
 }
 
-// Candidate i into the windows, if the ray may meet its k-σ ellipsoid in front of the eye.
-fn gauss_visit(o: vec3<f64>, d: vec3<f64>, i: u32, pert: ptr<function, f64>) {
-    let p = gauss_profile(o, d, i);
+// The half-width of a kept window in units of s: its tails, total·erfc(w/√2) ≤
+// total·e^{−w²/2}, within gv_tail (0 where the whole depth is).
+fn window_reach(total: f64) -> f64 {
+    if (total > gv_tail) {
+        return sqrt(2.0lf * g_ln(total / gv_tail));
+    }
+    return 0.0lf;
+}
+
+// Gaussian i, if the ray may meet its k-σ ellipsoid in front of the eye (the same test and
+// numbers on every traversal): counted, summed, or its window batched.
+fn event_visit(ray: EventRay, i: u32, t_after: f64, key_after: u32, capacity: u32) {
+    let p = gauss_profile(ray.origin, ray.direction, i);
     let k = scene_data[GS_CUTOFF];
     let reach = k * p.s * (1.0lf + 1.0e-9lf) + p.e_t;
     if (p.m2 - p.e_m2 > k * k * (1.0lf + 1.0e-12lf) || p.t_star + reach < 0.0lf) {
         return;
     }
-    if (w_count >= GR_WINDOWS_MAX) {
-        w_overflowed = true;
+    if (gv_mode == GV_COUNT) {
+        gv_count = gv_count + 1u;
         return;
     }
-    let n = w_count;
-    w_count = n + 1u;
-    w_tstar[n] = p.t_star;
-    w_s[n] = p.s;
-    w_peak[n] = p.peak;
-    w_index[n] = i;
     // The depth over [0, ∞): factor·(1 + erf(t*/(√2 s))) = factor·erfc(−t*/(√2 s)).
-    let front = w_factor(n) * f64_erfc(w_z(n, 0.0lf));
-    w_front[n] = front;
-    *pert = *pert + p.pert + front * (2.0lf * GR_ERFC_ULPS * GR_U + 4.0lf * GR_U) + w_factor(n) * 12.0lf * GR_U;
+    let factor = depth_factor(p.peak, p.s);
+    let front = factor * f64_erfc(-p.t_star / (GR_SQRT2 * p.s));
+    if (gv_mode == GV_SUM) {
+        gv_pert = gv_pert + p.pert + front * (2.0lf * GR_ERFC_ULPS * GR_U + 4.0lf * GR_U) + factor * 12.0lf * GR_U;
+    }
+    if (front <= gv_faint) {
+        if (gv_mode == GV_SUM) {
+            gv_left_out = gv_left_out + front;
+        }
+        return;
+    }
+    let total = 2.0lf * factor;
+    let w = window_reach(total);
+    let lo = max(p.t_star - w * p.s, 0.0lf);
+    let hi = max(p.t_star + w * p.s, 0.0lf);
+    if (gv_mode == GV_SUM) {
+        gv_left_out = gv_left_out + total * f64_exp(-0.5lf * w * w) * (1.0lf + 16.0lf * GR_U);
+        if (hi > lo) {
+            gv_first = min(gv_first, lo);
+            gv_last = max(gv_last, hi);
+        }
+    } else if (hi > lo && hi > t_after) {
+        event_insert(lo, i, 0u, capacity);
+    }
 }
 
-// Slab test of the camera-relative f32 box (padded outwards by the layout) against the ray from
-// the camera-relative origin `rel`: whether the ray meets it at t ≥ 0.
-fn g_box_hit(rel: vec3<f64>, inv: vec3<f64>, node: BvhNode) -> bool {
-    let t0 = (vec3<f64>(node.min) - rel) * inv;
-    let t1 = (vec3<f64>(node.max) - rel) * inv;
-    let lo = min(t0, t1);
-    let hi = max(t0, t1);
-    let t_near = max(max(lo.x, lo.y), max(lo.z, 0.0lf));
-    let t_far = min(min(hi.x, hi.y), hi.z);
-    return t_near <= t_far;
+// The thresholds of a ray whose candidates number `count`: each faint one within FAINT·tol/M,
+// each kept window's tails within TAILS·tol/M, over the count (src/reference/gaussian.rs
+// `gather` divides the tails' share among the kept windows; here among all candidates, which
+// the first traversal counts: the windows are a little wider).
+fn set_thresholds(count: u32, depth_per_tol: f64) {
+    let n = f64(max(count, 1u));
+    gv_faint = GR_FAINT * depth_per_tol / n;
+    gv_tail = GR_TAILS * depth_per_tol / n;
 }
 
-// The BVH traversal of the Gaussian reference (its own loop, to be replaced by the shared one
-// of issue 48 item 4): every Gaussian of a leaf whose box the ray meets is visited.
-fn gauss_traverse(o: vec3<f64>, rel: vec3<f64>, d: vec3<f64>) -> f64 {
-    var pert = 0.0lf;
-    let tiny = vec3<f64>(1.0e-300lf);
-    let sign = select(vec3<f64>(1.0lf), vec3<f64>(-1.0lf), d < vec3<f64>(0.0lf));
-    let inv = sign / max(abs(d), tiny);
-    traversal_stack[0] = 0u;
-    var sp = 1u;
-    while (sp > 0u) {
-        count_iteration();
-        sp = sp - 1u;
-        let node = nodes[traversal_stack[sp]];
-        if (!g_box_hit(rel, inv, node)) {
-            continue;
-        }
-        if (node.count > 0u) {
-            for (var j = 0u; j < node.count; j = j + 1u) {
-                count_iteration();
-                gauss_visit(o, d, leaf_indices[node.first + j], &pert);
-            }
-        } else if (sp + 2u <= GR_STACK_SIZE) {
-            traversal_stack[sp] = node.first;
-            traversal_stack[sp + 1u] = node.first + 1u;
-            sp = sp + 2u;
-        } else {
-            w_overflowed = true;
-        }
-    }
-    return pert;
+// The candidates of the ray (shaders/nearest_events.wgsl's traversal, every box the ray meets
+// in front of the eye).
+fn gauss_count(ray: EventRay) -> u32 {
+    gv_mode = GV_COUNT;
+    gv_count = 0u;
+    events_collect(ray, 0.0lf, 0u, 1u, params.gaussian_count);
+    return gv_count;
 }
 
-// The gather (src/reference/gaussian.rs `gather`, without the front-to-back narrowing): the
-// faint candidates left out while each is within FAINT·tol/M over their count, the kept ones
-// compacted in the order found, each with its window.
-fn gauss_gather(o: vec3<f64>, rel: vec3<f64>, d: vec3<f64>, depth_per_tol: f64) -> Gathered {
-    w_count = 0u;
-    w_overflowed = false;
-    var g = Gathered(0.0lf, 0.0lf, 0.0lf);
-    if (params.gaussian_count == 0u) {
-        return g;
+// What the ray's windows leave out (faint Gaussians, tails), the profiles' uncertainty as depth
+// and the windows' span, into the state.
+fn gauss_sum(ray: EventRay, s: ptr<function, GState>) {
+    gv_mode = GV_SUM;
+    gv_left_out = 0.0lf;
+    gv_pert = 0.0lf;
+    gv_first = REF_HUGE_G;
+    gv_last = 0.0lf;
+    events_collect(ray, 0.0lf, 0u, 1u, params.gaussian_count);
+    (*s).left_out = gv_left_out;
+    (*s).pert = gv_pert;
+    (*s).span = max(gv_last - gv_first, 0.0lf);
+}
+
+// The batch at cursor a: the GR_WINDOWS_MAX kept windows open after a that start first, into
+// w_*; returns where the batch ends (every window it leaves out starts there or later), +HUGE
+// where it holds them all.
+fn gauss_batch(ray: EventRay, a: f64) -> f64 {
+    gv_mode = GV_BATCH;
+    events_collect(ray, a, 0u, GR_WINDOWS_MAX + 1u, params.gaussian_count);
+    var end = REF_HUGE_G;
+    var n = events_count;
+    if (n > GR_WINDOWS_MAX) {
+        end = events_t[GR_WINDOWS_MAX];
+        n = GR_WINDOWS_MAX;
     }
-    g.pert = gauss_traverse(o, rel, d);
-    let n = w_count;
-    let faint = GR_FAINT * depth_per_tol / f64(max(n, 1u));
-    var kept = 0u;
-    for (var c = 0u; c < n; c = c + 1u) {
+    for (var j = 0u; j < n; j = j + 1u) {
         count_iteration();
-        if (w_front[c] <= faint) {
-            g.left_out = g.left_out + w_front[c];
-            continue;
-        }
-        w_tstar[kept] = w_tstar[c];
-        w_s[kept] = w_s[c];
-        w_peak[kept] = w_peak[c];
-        w_index[kept] = w_index[c];
-        kept = kept + 1u;
+        let i = events_key[j];
+        let p = gauss_profile(ray.origin, ray.direction, i);
+        w_tstar[j] = p.t_star;
+        w_s[j] = p.s;
+        w_peak[j] = p.peak;
+        w_lo[j] = events_t[j];
+        w_hi[j] = max(p.t_star + window_reach(2.0lf * depth_factor(p.peak, p.s)) * p.s, 0.0lf);
+        w_index[j] = i;
     }
-    w_count = kept;
-    let tail_budget = GR_TAILS * depth_per_tol / f64(max(kept, 1u));
-    var first = REF_HUGE_G;
-    var last = 0.0lf;
-    for (var c = 0u; c < kept; c = c + 1u) {
-        count_iteration();
-        let total = w_peak[c] * w_s[c] * 2.0lf * GR_SQRT_HALF_PI;
-        var w = 0.0lf;
-        if (total > tail_budget) {
-            w = sqrt(2.0lf * g_ln(total / tail_budget));
-        }
-        // The depth outside the window is total·erfc(w/√2) ≤ total·e^{−w²/2}.
-        g.left_out = g.left_out + total * f64_exp(-0.5lf * w * w) * (1.0lf + 16.0lf * GR_U);
-        w_lo[c] = max(w_tstar[c] - w * w_s[c], 0.0lf);
-        w_hi[c] = max(w_tstar[c] + w * w_s[c], 0.0lf);
-        if (w_hi[c] > w_lo[c]) {
-            first = min(first, w_lo[c]);
-            last = max(last, w_hi[c]);
-        }
-    }
-    g.span = max(last - first, 0.0lf);
-    return g;
+    w_count = n;
+    return end;
 }
 
 // The next cut after a: the smallest window end or centre beyond it (+HUGE: none).
@@ -334,6 +352,13 @@ struct GState {
     depth: f64,
     status: u32,
     unconverged: u32,
+    // The gather's sums (`gauss_sum`): the depth left out of the windows, the profiles'
+    // uncertainty as depth, the windows' span; the candidates' count; the ray's phase.
+    left_out: f64,
+    pert: f64,
+    span: f64,
+    count: u32,
+    phase: u32,
 }
 
 fn st_vec(b: u32) -> vec3<f64> {
@@ -360,6 +385,11 @@ fn load_gstate(r: u32) -> GState {
         state[b + GST_DEPTH],
         u32(state[b + GST_STATUS]),
         u32(state[b + GST_UNCONVERGED]),
+        state[b + GST_LEFT_OUT],
+        state[b + GST_PERT],
+        state[b + GST_SPAN],
+        u32(state[b + GST_COUNT]),
+        u32(state[b + GST_PHASE]),
     );
 }
 
@@ -376,6 +406,11 @@ fn store_gstate(r: u32, s: GState) {
     state[b + GST_DEPTH] = s.depth;
     state[b + GST_STATUS] = f64(s.status);
     state[b + GST_UNCONVERGED] = f64(s.unconverged);
+    state[b + GST_LEFT_OUT] = s.left_out;
+    state[b + GST_PERT] = s.pert;
+    state[b + GST_SPAN] = s.span;
+    state[b + GST_COUNT] = f64(s.count);
+    state[b + GST_PHASE] = f64(s.phase);
 }
 
 // Adds a term c (any sign) with relative error ≤ rel to the radiance, with its rounding.
@@ -533,7 +568,7 @@ fn integrate_piece(s: ptr<function, GState>, a: f64, b: f64, c_ref: vec3<f64>, t
 
 // The piece [a, b]: members, closed form, deviation; returns whether the ray has ended (a stop
 // behind nearly opaque gas). src/reference/gaussian.rs `sweep`, one piece.
-fn take_piece(s: ptr<function, GState>, a: f64, b: f64, g: Gathered, bound: vec3<f64>) -> bool {
+fn take_piece(s: ptr<function, GState>, a: f64, b: f64, bound: vec3<f64>) -> bool {
     m_count = 0u;
     for (var w = 0u; w < w_count; w = w + 1u) {
         count_iteration();
@@ -612,7 +647,7 @@ fn take_piece(s: ptr<function, GState>, a: f64, b: f64, g: Gathered, bound: vec3
             g_add(s, t * middle, (*s).transmittance_rel + 3.0lf * GR_U);
             (*s).bounded = bounded;
         } else {
-            let tol_per_length = GR_QUADRATURE * tol / max(g.span, 1.0e-300lf);
+            let tol_per_length = GR_QUADRATURE * tol / max((*s).span, 1.0e-300lf);
             let node_rel = node_tau + 2.0lf * (GR_EXP_ULPS + 1.0lf) * GR_U * n + 8.0lf * n * GR_U;
             integrate_piece(s, a, b, c_ref, tol_per_length, node_rel);
         }
@@ -620,14 +655,6 @@ fn take_piece(s: ptr<function, GState>, a: f64, b: f64, g: Gathered, bound: vec3
     (*s).transmittance = t * f64_exp(-tau);
     (*s).transmittance_rel = (*s).transmittance_rel + 2.0lf * GR_EXP_ULPS * GR_U + GR_U;
     return false;
-}
-
-// What the host needs of a finished ray besides the state: the depth left out and the
-// profiles' uncertainty (the gather's, the same on every pass).
-fn store_gathered(r: u32, g: Gathered) {
-    let b = r * GST_STRIDE;
-    state[b + GST_LEFT_OUT] = g.left_out;
-    state[b + GST_PERT] = g.pert;
 }
 
 @compute @workgroup_size(GR_WORKGROUP, 1, 1)
@@ -648,36 +675,64 @@ fn gaussian_main(@builtin(global_invocation_id) gid: vec3<u32>) {
         store_gstate(r, s);
         return;
     }
-    let o = scene_vec(GS_ORIGIN);
-    let rel = scene_vec(GS_RELATIVE_ORIGIN);
     let d = vec3<f64>(rays[3u * r], rays[3u * r + 1u], rays[3u * r + 2u]);
+    let sign = select(vec3<f64>(1.0lf), vec3<f64>(-1.0lf), d < vec3<f64>(0.0lf));
+    let inv = sign / max(abs(d), vec3<f64>(1.0e-300lf));
+    let ray = EventRay(scene_vec(GS_ORIGIN), scene_vec(GS_RELATIVE_ORIGIN), d, inv);
     let depth_per_tol = scene_data[GS_TOL] / m_max;
-    let g = gauss_gather(o, rel, d, depth_per_tol);
-    if (w_overflowed) {
-        s.status = GSTATUS_OVERFLOW;
-    } else {
-        loop {
-            count_iteration();
-            let b = next_cut(s.a);
+    // Where the batch in w_* ends (< 0: none gathered in this pass).
+    var end = -1.0lf;
+    // A pass makes one traversal (a phase's, or a batch's) and then takes pieces up to the
+    // yield, so that a piece starts with the loop budget less one traversal at most.
+    var traversed = false;
+    loop {
+        count_iteration();
+        let needs_traversal = s.phase != GPHASE_PIECES || end < 0.0lf;
+        if (needs_traversal && traversed) {
+            break;
+        }
+        if (s.phase == GPHASE_COUNT) {
+            s.count = gauss_count(ray);
+            s.phase = GPHASE_SUM;
+            traversed = true;
+        } else if (s.phase == GPHASE_SUM) {
+            set_thresholds(s.count, depth_per_tol);
+            gauss_sum(ray, &s);
+            s.phase = GPHASE_PIECES;
+            traversed = true;
+        } else {
+            if (end < 0.0lf) {
+                set_thresholds(s.count, depth_per_tol);
+                end = gauss_batch(ray, s.a);
+                traversed = true;
+                if (end <= s.a) {
+                    // More windows open at the cursor than a ray holds.
+                    s.status = GSTATUS_OVERFLOW;
+                    break;
+                }
+            }
+            let b = min(next_cut(s.a), end);
             if (b >= REF_HUGE_G) {
                 g_add(&s, s.transmittance * scene_vec(GS_BACKGROUND), s.transmittance_rel + GR_U);
                 s.status = GSTATUS_DONE;
                 break;
             }
-            if (take_piece(&s, s.a, b, g, bound)) {
+            if (take_piece(&s, s.a, b, bound)) {
                 s.status = GSTATUS_DONE;
                 break;
             }
             s.a = b;
-            if (loop_iterations >= params.pass_yield) {
-                break;
+            if (b >= end) {
+                end = -1.0lf;
             }
+        }
+        if (loop_iterations >= params.pass_yield) {
+            break;
         }
     }
     if (loop_iterations >= params.loop_budget) {
         s.status = GSTATUS_LOOP_LIMITED;
     }
-    store_gathered(r, g);
     store_gstate(r, s);
     if (s.status == GSTATUS_RUNNING) {
         atomicAdd(&counters.running, 1u);

@@ -216,20 +216,19 @@ fn a_crop_of_the_donut_agrees_with_the_cpu_reference_within_both_errs() {
     }
 }
 
-/// A row of Gaussians along the line of sight, more than a ray holds: those rays are reported
-/// not converged with err = +∞, never a value with a small err; the rays beside the row are
-/// rendered.
-#[test]
-fn a_ray_with_more_gaussians_than_it_holds_is_not_converged() {
-    let Some(ctx) = gpu64() else { return };
-    let n = gpu::gaussian::WINDOWS_MAX as usize + 20;
+/// `n` Gaussians of standard deviation `std` along the line of sight from `start` to `end` in z,
+/// seen by a 5×5 camera whose centre ray runs along the row.
+fn row_scene(n: usize, start: f64, end: f64, std: f64) -> Scene {
     let particles = (0..n)
         .map(|k| {
+            let z = start + (end - start) * k as f64 / n as f64;
+            // A little colour change along the row, so that pieces deviate.
+            let c = DVec3::new(0.5, 0.7 - 0.3 * (k % 3) as f64, 0.2);
             gaussian(
-                DVec3::new(0.0, 0.0, -3.0 + 6.0 * k as f64 / n as f64),
-                DVec3::splat(0.05),
+                DVec3::new(0.0, 0.0, z),
+                DVec3::splat(std),
                 DQuat::IDENTITY,
-                DVec3::new(0.5, 0.7, 0.2),
+                c,
                 0.02,
             )
         })
@@ -243,10 +242,40 @@ fn a_ray_with_more_gaussians_than_it_holds_is_not_converged() {
         5,
         5,
     );
+    scene
+}
+
+/// A row of Gaussians along the line of sight, more than twice as many as a batch holds but
+/// never many open at once: the centre ray takes them batch by batch and agrees with the CPU
+/// within both errs.
+#[test]
+fn a_ray_through_more_gaussians_than_a_batch_holds_takes_them_batch_by_batch() {
+    let Some(ctx) = gpu64() else { return };
+    let n = 2 * gpu::gaussian::WINDOWS_MAX as usize + 40;
+    let scene = row_scene(n, -3.0, 3.0, 0.05);
+    let g = check_gaussian_scene(ctx, "a row of 552 Gaussians", &scene);
+    let err = g.error.as_ref().unwrap();
+    assert!(err.pixels[2 * 5 + 2].iter().all(|e| e.is_finite()));
+}
+
+/// More Gaussians open at one depth than a ray holds: those rays are reported not converged with
+/// err = |L| + M (M the largest colour or background per channel), never a value with a small
+/// err; the rays beside them are rendered.
+#[test]
+fn a_ray_with_more_gaussians_open_at_once_than_it_holds_is_not_converged() {
+    let Some(ctx) = gpu64() else { return };
+    let n = gpu::gaussian::WINDOWS_MAX as usize + 20;
+    let scene = row_scene(n, -0.01, 0.01, 0.05);
     let out = gpu::render_on(ctx, &scene, &RenderOptions::default()).unwrap();
     let err = out.error.as_ref().unwrap();
-    let centre = err.pixels[2 * 5 + 2];
-    assert!(centre.iter().all(|e| e.is_infinite()), "{centre:?}");
+    let (centre, value) = (err.pixels[2 * 5 + 2], out.image.pixels[2 * 5 + 2]);
+    let m = [0.5f32, 0.7, 0.2];
+    for c in 0..3 {
+        assert!(
+            centre[c] >= (value[c].abs() + m[c]) * (1.0 - 1e-6),
+            "{centre:?} for {value:?}"
+        );
+    }
     assert!(out.stats.unconverged >= 1);
     let (x, y, _) = out.stats.worst_unconverged.unwrap();
     assert_eq!((x, y), (2, 2));
