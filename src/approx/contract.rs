@@ -66,11 +66,12 @@ pub const PROFILE_CONSTANT: u32 = 0;
 /// `Particle.profile`: Gaussian density σ·exp(−½m²), the shape's axes its standard deviations.
 pub const PROFILE_GAUSSIAN: u32 = 1;
 
-/// 3D Gaussian splatting's per-pixel constants (graphdeco-inria `forward.cu` `renderCUDA`), the
-/// one definition of each: the `splat` method's parameters take them as defaults (in the
-/// parameters' integer units, below), and the frame gives their f32 values to every other
-/// program (`layout::GpuFrame`; `gauss-ray` blends with them, as 3DGRT keeps 3DGS's).
-///
+// 3D Gaussian splatting's per-pixel constants (graphdeco-inria `forward.cu` `renderCUDA`), each
+// defined once here: the `splat` method's parameters take them as defaults in the parameters'
+// integer units, and their f32 values reach the shaders as the frame's splat_* of every method
+// but `splat`, which sets its parameters there (`layout::GpuFrame`), and as the generated WGSL
+// constants SPLAT_* (`gauss-ray`'s α cap; it blends as 3DGS does, as 3DGRT keeps it).
+
 /// The most opacity one splat gives a pixel, in millionths: `min(0.99f, con_o.w * exp(power))`.
 pub const SPLAT_ALPHA_MAX_MILLIONTHS: u32 = 990_000;
 /// A splat whose opacity at a pixel is below 1/this is skipped: `alpha < 1.0f / 255.0f`.
