@@ -186,14 +186,11 @@ fn safe_inverse(d: vec3<f32>) -> vec3<f32> {
     return s / m;
 }
 
+// Whether the ray meets a BVH box within [t_min, t_max] (box_span, the slab test shared with
+// shaders/nearest_events.wgsl, is generated: src/approx/wgsl_generic.rs).
 fn ray_box(origin: vec3<f32>, inv_dir: vec3<f32>, bmin: vec3<f32>, bmax: vec3<f32>, t_min: f32, t_max: f32) -> bool {
-    let t0 = (bmin - origin) * inv_dir;
-    let t1 = (bmax - origin) * inv_dir;
-    let lo = min(t0, t1);
-    let hi = max(t0, t1);
-    let t_near = max(max(lo.x, lo.y), max(lo.z, t_min));
-    let t_far = min(min(hi.x, hi.y), min(hi.z, t_max));
-    return t_near <= t_far;
+    let span = box_span(origin, inv_dir, bmin, bmax, t_min, t_max);
+    return span.x <= span.y;
 }
 
 // The particles a ray crosses, sorted by entry (ties by index, as the CPU BVH sorts them).
@@ -212,41 +209,12 @@ struct HitList {
 var<private> camera_hits: HitList;
 var<private> shadow_hits: HitList;
 
-fn hit_before(t_a: f32, i_a: u32, t_b: f32, i_b: u32) -> bool {
-    return t_a < t_b || (t_a == t_b && i_a < i_b);
-}
-
-// Inserts by insertion sort; a full list keeps its nearest MAX_HITS entries.
+// Inserts a particle's chord, keyed by (entry, index); a full list keeps its nearest MAX_HITS
+// entries and is flagged as overflowed (hit_list_sorted_insert and the order hit_before are
+// generated from the sorted insert that shaders/nearest_events.wgsl's batch also uses:
+// src/approx/wgsl_generic.rs).
 fn hit_list_insert(list: ptr<private, HitList>, index: u32, chord: Chord) {
-    var slot = (*list).count;
-    if (slot >= MAX_HITS) {
-        (*list).overflowed = true;
-        pixel_overflowed = true;
-        let last = MAX_HITS - 1u;
-        if (!hit_before(chord.t_enter, index, (*list).t_enter[last], (*list).index[last])) {
-            return;
-        }
-        slot = last;
-    } else {
-        (*list).count = slot + 1u;
-    }
-    loop {
-        count_iteration();
-        if (slot == 0u) {
-            break;
-        }
-        let prev = slot - 1u;
-        if (!hit_before(chord.t_enter, index, (*list).t_enter[prev], (*list).index[prev])) {
-            break;
-        }
-        (*list).t_enter[slot] = (*list).t_enter[prev];
-        (*list).t_exit[slot] = (*list).t_exit[prev];
-        (*list).index[slot] = (*list).index[prev];
-        slot = prev;
-    }
-    (*list).t_enter[slot] = chord.t_enter;
-    (*list).t_exit[slot] = chord.t_exit;
-    (*list).index[slot] = index;
+    hit_list_sorted_insert(list, chord.t_enter, index, chord.t_exit, MAX_HITS);
 }
 
 // The nearest surface crossing with t in (t_min, t_max): which particle, where, and whether the

@@ -35,48 +35,17 @@ var<private> events_key: array<u32, EVENT_CAPACITY>;
 var<private> events_value: array<EventValue, EVENT_CAPACITY>;
 var<private> events_count: u32;
 
-// Whether event (t_a, key_a) comes before (t_b, key_b).
-fn event_before(t_a: EventT, key_a: u32, t_b: EventT, key_b: u32) -> bool {
-    return t_a < t_b || (t_a == t_b && key_a < key_b);
-}
-
-// Inserts an event into the batch of `capacity` (at most EVENT_CAPACITY), keeping the nearest.
-fn event_insert(t: EventT, key: u32, value: EventValue, capacity: u32) {
-    var slot = events_count;
-    if (slot >= capacity) {
-        let last = capacity - 1u;
-        if (!event_before(t, key, events_t[last], events_key[last])) {
-            return;
-        }
-        slot = last;
-    } else {
-        events_count = slot + 1u;
-    }
-    loop {
-        count_iteration();
-        if (slot == 0u || !event_before(t, key, events_t[slot - 1u], events_key[slot - 1u])) {
-            break;
-        }
-        events_t[slot] = events_t[slot - 1u];
-        events_key[slot] = events_key[slot - 1u];
-        events_value[slot] = events_value[slot - 1u];
-        slot = slot - 1u;
-    }
-    events_t[slot] = t;
-    events_key[slot] = key;
-    events_value[slot] = value;
-}
+// event_before(t_a, key_a, t_b, key_b), whether event (t_a, key_a) comes before (t_b, key_b),
+// and event_insert(t, key, value, capacity), which inserts an event into the batch of
+// `capacity` (at most EVENT_CAPACITY) keeping the nearest, are generated after this file from
+// the order and the sorted insert that the prelude's hit lists also use; so is
+// event_box_span, the prelude's slab test in EventT (src/approx/wgsl_generic.rs).
 
 // Slab test of a BVH node's box: where the ray enters it within [t_min, t_max] (t_min ≥ 0), or
 // −1 where it does not.
 fn event_box_entry(ray: EventRay, node: BvhNode, t_min: EventT, t_max: EventT) -> EventT {
-    let t0 = (vec3<EventT>(node.min) - ray.box_origin) * ray.inv;
-    let t1 = (vec3<EventT>(node.max) - ray.box_origin) * ray.inv;
-    let lo = min(t0, t1);
-    let hi = max(t0, t1);
-    let t_near = max(max(lo.x, lo.y), max(lo.z, t_min));
-    let t_far = min(min(hi.x, hi.y), min(hi.z, t_max));
-    return select(EventT(-1.0), t_near, t_near <= t_far);
+    let span = event_box_span(ray.box_origin, ray.inv, node.min, node.max, t_min, t_max);
+    return select(EventT(-1.0), span.x, span.x <= span.y);
 }
 
 // One traversal: the batch becomes the `capacity` nearest events after (t_after, key_after) of

@@ -66,15 +66,34 @@ pub const PROFILE_CONSTANT: u32 = 0;
 /// `Particle.profile`: Gaussian density σ·exp(−½m²), the shape's axes its standard deviations.
 pub const PROFILE_GAUSSIAN: u32 = 1;
 
-/// The most opacity one splat gives a pixel (3D Gaussian splatting, `forward.cu` `renderCUDA`:
-/// `min(0.99f, con_o.w * exp(power))`; also `gauss-ray`'s, as 3DGRT keeps it).
-pub const SPLAT_ALPHA_MAX: f32 = 0.99;
-/// A splat whose opacity at a pixel is below this is skipped (3DGS `renderCUDA`:
-/// `alpha < 1.0f / 255.0f`).
-pub const SPLAT_ALPHA_MIN: f32 = 1.0 / 255.0;
-/// A pixel stops at the first splat that would take its transmittance below this; that splat
-/// is not added (3DGS `renderCUDA`: `test_T < 0.0001f`, tested before the colour is added).
-pub const SPLAT_T_MIN: f32 = 1.0e-4;
+// 3D Gaussian splatting's per-pixel constants (graphdeco-inria `forward.cu` `renderCUDA`), each
+// defined once here: the `splat` method's parameters take them as defaults in the parameters'
+// integer units, and their f32 values reach the shaders as the frame's splat_* of every method
+// but `splat`, which sets its parameters there (`layout::GpuFrame`), and as the generated WGSL
+// constants SPLAT_* (`gauss-ray`'s α cap; it blends as 3DGS does, as 3DGRT keeps it).
+
+/// The most opacity one splat gives a pixel, in millionths: `min(0.99f, con_o.w * exp(power))`.
+pub const SPLAT_ALPHA_MAX_MILLIONTHS: u32 = 990_000;
+/// A splat whose opacity at a pixel is below 1/this is skipped: `alpha < 1.0f / 255.0f`.
+pub const SPLAT_ALPHA_SKIP_DENOMINATOR: u32 = 255;
+/// A pixel stops at the first splat that would take its transmittance below this, in
+/// millionths; that splat is not added: `test_T < 0.0001f`, tested before the colour is added.
+pub const SPLAT_T_MIN_MILLIONTHS: u32 = 100;
+
+/// [`SPLAT_ALPHA_MAX_MILLIONTHS`] as a fraction.
+pub const SPLAT_ALPHA_MAX: f32 = ratio_f32(SPLAT_ALPHA_MAX_MILLIONTHS, 1e6);
+/// 1/[`SPLAT_ALPHA_SKIP_DENOMINATOR`].
+pub const SPLAT_ALPHA_MIN: f32 = ratio_f32(1, SPLAT_ALPHA_SKIP_DENOMINATOR as f64);
+/// [`SPLAT_T_MIN_MILLIONTHS`] as a fraction.
+pub const SPLAT_T_MIN: f32 = ratio_f32(SPLAT_T_MIN_MILLIONTHS, 1e6);
+
+/// A parameter's value in its unit, `value/unit`, as the f32 a decimal literal of it would be
+/// (a correctly rounded f64 division, then rounded to f32): how the `splat` method's integer
+/// parameters become the frame's f32 constants.
+pub const fn ratio_f32(value: u32, unit: f64) -> f32 {
+    (value as f64 / unit) as f32
+}
+
 /// The standard deviations at which `gauss-ray` cuts each Gaussian: it traces the 3-σ
 /// ellipsoids (3DGRT's bounding primitives; 3DGS's footprint radius is also 3σ).
 pub const GAUSSIAN_TRACE_SIGMAS: f32 = 3.0;
@@ -205,6 +224,13 @@ pub const BINDINGS: [Binding; 10] = [
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn splat_constants_are_the_f32s_of_3dgs_literals() {
+        assert_eq!(SPLAT_ALPHA_MAX, 0.99_f32);
+        assert_eq!(SPLAT_ALPHA_MIN, 1.0_f32 / 255.0_f32);
+        assert_eq!(SPLAT_T_MIN, 0.0001_f32);
+    }
 
     #[test]
     fn bindings_are_numbered_in_order() {

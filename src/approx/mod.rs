@@ -28,6 +28,7 @@ pub mod shader;
 pub mod splat_tiles;
 pub mod user_shader;
 pub mod wgsl;
+pub mod wgsl_generic;
 
 pub use context::{GpuContext, NO_ADAPTER};
 pub use contract::{MAX_HITS, STACK_DEPTH};

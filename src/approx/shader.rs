@@ -13,19 +13,22 @@ pub const COMMON_WGSL: &str = include_str!("../../shaders/common.wgsl");
 pub const ENTRY_WGSL: &str = include_str!("../../shaders/entry.wgsl");
 /// A WGSL file shared by several programs and included where a program needs it (WGSL has no
 /// imports): the program declares what the module leaves to it (its header says what).
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy)]
 pub struct WgslModule {
     /// The file's path in the repository, for messages.
     pub path: &'static str,
     pub text: &'static str,
+    /// The functions generated for the file (`approx::wgsl_generic`), appended to its text.
+    pub generated: fn() -> String,
 }
 
 impl WgslModule {
-    /// The module as a part of a program.
+    /// The module as a part of a program: the file, then its generated functions (the file's
+    /// lines keep their numbers in messages).
     pub fn part(&self) -> ShaderPart {
         ShaderPart {
             name: self.path.into(),
-            text: Cow::Borrowed(self.text),
+            text: Cow::Owned(format!("{}{}", self.text, (self.generated)())),
         }
     }
 }
@@ -35,6 +38,7 @@ impl WgslModule {
 pub const NEAREST_EVENTS: WgslModule = WgslModule {
     path: "shaders/nearest_events.wgsl",
     text: include_str!("../../shaders/nearest_events.wgsl"),
+    generated: super::wgsl_generic::nearest_events_functions,
 };
 
 /// The name the entry point file has in messages.
@@ -44,10 +48,13 @@ pub const ENTRY_POINT: &str = "pgt_main";
 
 /// How messages name the generated declarations (an error there is pgt's bug, not the user's).
 pub const GENERATED_CONTRACT: &str = "<generated from src/approx/contract.rs>";
+/// How messages name the prelude's generated functions.
+pub const GENERATED_FUNCTIONS: &str = "<generated from src/approx/wgsl_generic.rs>";
 /// How messages name the generated parameter slot constants.
 pub const GENERATED_PARAMS: &str = "<generated parameter slots>";
 
-/// The generated contract followed by `shaders/common.wgsl`: everything a method can use.
+/// The generated contract, `shaders/common.wgsl` and the functions generated for it: everything
+/// a method can use.
 pub fn prelude_parts() -> Vec<ShaderPart> {
     vec![
         ShaderPart {
@@ -57,6 +64,10 @@ pub fn prelude_parts() -> Vec<ShaderPart> {
         ShaderPart {
             name: "shaders/common.wgsl".into(),
             text: Cow::Borrowed(COMMON_WGSL),
+        },
+        ShaderPart {
+            name: GENERATED_FUNCTIONS.into(),
+            text: Cow::Owned(super::wgsl_generic::prelude_functions()),
         },
     ]
 }

@@ -26,7 +26,7 @@
 //! pixel centres at integers; its `getRect` is applied here to the same point in its
 //! coordinates (x − 0.5), so a splat touches the same tiles as in 3DGS.
 
-use super::contract::{PROFILE_GAUSSIAN, TILE_SIDE};
+use super::contract::{ratio_f32, PROFILE_GAUSSIAN, TILE_SIDE};
 use super::layout::{GpuFrame, GpuSplat, SceneBuffers};
 use glam::{Mat3, Vec3};
 
@@ -87,8 +87,7 @@ impl SplatConstants {
                 })
                 .unwrap_or(0)
         };
-        // Correctly rounded divisions: the f32 nearest each decimal, as a literal would be.
-        let ratio = |name: &str, unit: f64| (get(name) as f64 / unit) as f32;
+        let ratio = |name: &str, unit: f64| ratio_f32(get(name), unit);
         SplatConstants {
             footprint: match get("footprint") {
                 0 => Footprint::Radius3dgs,
@@ -98,7 +97,7 @@ impl SplatConstants {
             near: ratio("near", 1e6),
             jacobian_clamp: ratio("jacobian_clamp", 100.0),
             dilation: ratio("dilation", 1000.0),
-            alpha_skip: (1.0 / get("skip_denominator").max(1) as f64) as f32,
+            alpha_skip: ratio_f32(1, get("skip_denominator").max(1) as f64),
             stop_below: ratio("stop_below", 1e6),
             stop_inclusive: get("stop_inclusive") != 0,
         }

@@ -252,6 +252,57 @@ fn a_crowded_ray_reports_hit_list_overflow() {
 }
 
 #[test]
+fn a_full_hit_list_keeps_its_nearest_entries_sorted() {
+    let Some(ctx) = gpu() else { return };
+    // 200 spheres in a row along the view axis, particle i entered at t ≈ 4.5 + 0.1·i: a ray
+    // near the axis crosses all of them, in the order of their indices, while the BVH hands
+    // them to the sorted insert in its own order. A full list keeps the nearest MAX_HITS (128):
+    // particles 0..=127, sorted by entry, flagged as overflowed. The shader returns (count,
+    // index of the last entry, 1 if sorted and flagged).
+    let dir = tempfile::tempdir().unwrap();
+    let shader = dir.path().join("hit_list.wgsl");
+    std::fs::write(
+        &shader,
+        "fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {
+    collect_hits(ray, 0.0, T_FAR, &camera_hits);
+    let n = camera_hits.count;
+    if (n == 0u) {
+        return vec3<f32>(0.0, -1.0, 0.0);
+    }
+    var sorted = camera_hits.overflowed;
+    for (var k = 1u; k < n; k = k + 1u) {
+        count_iteration();
+        sorted = sorted && camera_hits.t_enter[k - 1u] < camera_hits.t_enter[k]
+            && camera_hits.index[k - 1u] < camera_hits.index[k];
+    }
+    return vec3<f32>(f32(n), f32(camera_hits.index[n - 1u]), select(0.0, 1.0, sorted));
+}
+",
+    )
+    .unwrap();
+    let ps: Vec<_> = (0..200)
+        .map(|i| {
+            particle(
+                [0.0, 0.0, -5.0 + 0.1 * i as f64],
+                0.5,
+                [1.0, 1.0, 1.0],
+                0.01,
+            )
+        })
+        .collect();
+    let s = scene(ps, vec![], RenderMode::Volume, models::EMISSION);
+    let out = render_approx_with(ctx, &s, &user(shader, 1, 0)).unwrap();
+    let centre = (SIDE / 2 * SIDE + SIDE / 2) as usize;
+    assert_eq!(out.image.pixels[centre], [128.0, 127.0, 1.0]);
+    assert!(out.hit_overflow_pixels > 0);
+    assert_eq!(
+        out.image.pixels[0],
+        [0.0, -1.0, 0.0],
+        "a corner ray misses them all"
+    );
+}
+
+#[test]
 fn a_point_light_inside_no_particle_lights_the_gas() {
     let Some(ctx) = gpu() else { return };
     // One sphere, one point light: the lit source must vary with the light's position.

@@ -53,13 +53,17 @@
 //! ```
 
 use super::{ApproxMethod, Computes, Preparation};
+use crate::approx::contract::{
+    SPLAT_ALPHA_MAX_MILLIONTHS, SPLAT_ALPHA_SKIP_DENOMINATOR, SPLAT_T_MIN_MILLIONTHS,
+};
 use crate::approx::param_spec::ParamSpec;
 use crate::optics::models;
 
 /// The `splat` method (see the module docs).
 pub struct Splat;
 
-/// The parameters, in slot order; the defaults are 3DGS's constants.
+/// The parameters, in slot order; the defaults are 3DGS's constants (the per-pixel ones from
+/// `approx::contract`, their one definition).
 pub const PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "footprint",
@@ -72,7 +76,7 @@ pub const PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "alpha_cap",
         quiet_default: true,
-        default: 990_000,
+        default: SPLAT_ALPHA_MAX_MILLIONTHS,
         min: 1,
         max: 1_000_000,
         doc: "the most opacity one splat gives a pixel, in millionths (3DGS 0.99, gsplat 0.999)",
@@ -104,7 +108,7 @@ pub const PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "skip_denominator",
         quiet_default: true,
-        default: 255,
+        default: SPLAT_ALPHA_SKIP_DENOMINATOR,
         min: 1,
         max: 1_000_000,
         doc: "splats with α below 1/this at a pixel are skipped (255 in both)",
@@ -112,7 +116,7 @@ pub const PARAMS: &[ParamSpec] = &[
     ParamSpec {
         name: "stop_below",
         quiet_default: true,
-        default: 100,
+        default: SPLAT_T_MIN_MILLIONTHS,
         min: 0,
         max: 1_000_000,
         doc: "a pixel stops before the splat that takes its transmittance below this, in millionths (1e-4 in both)",
