@@ -13,7 +13,8 @@
 // the rest windows |t − t*| ≤ w·s whose tails fit TAILS·tol/M/n, and sums the depth left out and
 // the windows' span; GPHASE_PIECES takes the windows in batches: the GR_WINDOWS_MAX kept windows
 // still open at the cursor that start first (nearest_events.wgsl keyed by (start, Gaussian)),
-// valid up to the start of the first one left out. The ray is cut at every window's ends and
+// valid up to the start of the first one left out; a ray whose kept windows fit one batch takes
+// them in the traversal's order, unsorted. The ray is cut at every window's ends and
 // centre; on each piece [a, b] the closed form T(a)·C_ref·(1 − e^{−τ(a,b)}) with C_ref the colour
 // of the Gaussian with the most depth there, and the colour deviation
 // ∫ e^{−τ(a,t)}·Σ σᵢ(t)(Cᵢ − C_ref) dt bounded in closed form (the CPU's `deviation_bounds`)
@@ -21,7 +22,7 @@
 // each segment to QUADRATURE·tol times its share of the windows' span, its estimate
 // (src/reference/quadrature.rs's `pair_estimate` for K15 against G7) into err. A piece's
 // members are the batch's windows that overlap it, in the batch's order, whichever batch holds
-// them, so the pieces and their values do not depend on where batches or passes end. A ray goes
+// them (the order of the traversal or of (start, Gaussian), the ray's choice), so the pieces and their values do not depend on where batches or passes end. A ray goes
 // on in the next pass from its phase and the end of the last piece it finished. A ray with more
 // than GR_WINDOWS_MAX windows open at one depth is not converged (err = |L| + M).
 //
@@ -190,6 +191,9 @@ var<private> gv_mode: u32;
 // window's two tails hold at most gv_tail of depth.
 var<private> gv_faint: f64;
 var<private> gv_tail: f64;
+// Whether GV_BATCH appends the windows in the traversal's order (the ray's kept windows fit one
+// batch) instead of keeping the ones that start first.
+var<private> gv_append: bool;
 // GV_COUNT's and GV_SUM's sums.
 var<private> gv_count: u32;
 var<private> gv_left_out: f64;
@@ -243,11 +247,18 @@ fn event_visit(ray: EventRay, i: u32, t_after: f64, key_after: u32, capacity: u3
     if (gv_mode == GV_SUM) {
         gv_left_out = gv_left_out + total * f64_exp(-0.5lf * w * w) * (1.0lf + 16.0lf * GR_U);
         if (hi > lo) {
+            gv_count = gv_count + 1u;
             gv_first = min(gv_first, lo);
             gv_last = max(gv_last, hi);
         }
     } else if (hi > lo && hi > t_after) {
-        event_insert(lo, i, 0u, capacity);
+        if (gv_append) {
+            events_t[events_count] = lo;
+            events_key[events_count] = i;
+            events_count = events_count + 1u;
+        } else {
+            event_insert(lo, i, 0u, capacity);
+        }
     }
 }
 
@@ -270,10 +281,11 @@ fn gauss_count(ray: EventRay) -> u32 {
     return gv_count;
 }
 
-// What the ray's windows leave out (faint Gaussians, tails), the profiles' uncertainty as depth
-// and the windows' span, into the state.
+// What the ray's windows leave out (faint Gaussians, tails), the profiles' uncertainty as depth,
+// the windows' span and how many are kept, into the state.
 fn gauss_sum(ray: EventRay, s: ptr<function, GState>) {
     gv_mode = GV_SUM;
+    gv_count = 0u;
     gv_left_out = 0.0lf;
     gv_pert = 0.0lf;
     gv_first = REF_HUGE_G;
@@ -282,13 +294,17 @@ fn gauss_sum(ray: EventRay, s: ptr<function, GState>) {
     (*s).left_out = gv_left_out;
     (*s).pert = gv_pert;
     (*s).span = max(gv_last - gv_first, 0.0lf);
+    (*s).kept = gv_count;
 }
 
-// The batch at cursor a: the GR_WINDOWS_MAX kept windows open after a that start first, into
-// w_*; returns where the batch ends (every window it leaves out starts there or later), +HUGE
-// where it holds them all.
-fn gauss_batch(ray: EventRay, a: f64) -> f64 {
+// The batch at cursor a into w_*: where the ray's `kept` windows fit one batch, those open
+// after a in the traversal's order (no sorting); else the GR_WINDOWS_MAX open after a that
+// start first, by (start, Gaussian). Returns where the batch ends (every window it leaves out
+// starts there or later), +HUGE where it holds them all. Either way a window's place among the
+// others it meets does not depend on a.
+fn gauss_batch(ray: EventRay, a: f64, kept: u32) -> f64 {
     gv_mode = GV_BATCH;
+    gv_append = kept <= GR_WINDOWS_MAX;
     events_collect(ray, a, 0u, GR_WINDOWS_MAX + 1u, params.gaussian_count);
     var end = REF_HUGE_G;
     var n = events_count;
@@ -353,11 +369,13 @@ struct GState {
     status: u32,
     unconverged: u32,
     // The gather's sums (`gauss_sum`): the depth left out of the windows, the profiles'
-    // uncertainty as depth, the windows' span; the candidates' count; the ray's phase.
+    // uncertainty as depth, the windows' span; the candidates' and the kept windows' counts;
+    // the ray's phase.
     left_out: f64,
     pert: f64,
     span: f64,
     count: u32,
+    kept: u32,
     phase: u32,
 }
 
@@ -389,6 +407,7 @@ fn load_gstate(r: u32) -> GState {
         state[b + GST_PERT],
         state[b + GST_SPAN],
         u32(state[b + GST_COUNT]),
+        u32(state[b + GST_KEPT]),
         u32(state[b + GST_PHASE]),
     );
 }
@@ -410,6 +429,7 @@ fn store_gstate(r: u32, s: GState) {
     state[b + GST_PERT] = s.pert;
     state[b + GST_SPAN] = s.span;
     state[b + GST_COUNT] = f64(s.count);
+    state[b + GST_KEPT] = f64(s.kept);
     state[b + GST_PHASE] = f64(s.phase);
 }
 
@@ -703,7 +723,7 @@ fn gaussian_main(@builtin(global_invocation_id) gid: vec3<u32>) {
         } else {
             if (end < 0.0lf) {
                 set_thresholds(s.count, depth_per_tol);
-                end = gauss_batch(ray, s.a);
+                end = gauss_batch(ray, s.a, s.kept);
                 traversed = true;
                 if (end <= s.a) {
                     // More windows open at the cursor than a ray holds.
