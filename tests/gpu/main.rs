@@ -14,6 +14,7 @@ mod ellipsoids;
 mod gaussians;
 mod intrinsics;
 mod layout;
+mod limits;
 mod methods;
 mod raster;
 mod reference;
