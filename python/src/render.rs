@@ -110,11 +110,19 @@ fn run_polled<T: Send>(
         guard.is_some()
     };
     std::thread::scope(|s| {
-        s.spawn(|| {
+        let worker = s.spawn(|| {
             let result = std::panic::catch_unwind(std::panic::AssertUnwindSafe(work));
             *slot.lock().unwrap_or_else(|e| e.into_inner()) = Some(result);
             ready.notify_all();
         });
+        // The scope itself waits only for the closure to return; the thread then still runs
+        // its thread-locals' destructors (rayon's among them) and exits. Joining it waits for
+        // that too, so no thread of this call outlives it (python/tests/test_threads.py counts
+        // the process's threads).
+        let join = || {
+            // The closure catches every panic, so the thread cannot end in one.
+            let _ = worker.join();
+        };
         let mut shown = (u64::MAX, u64::MAX);
         loop {
             if py.detach(|| wait_for(Some(POLL))) {
@@ -132,10 +140,11 @@ fn run_polled<T: Send>(
             }
             if let Some(e) = stop {
                 control.stop();
-                py.detach(|| wait_for(None));
+                py.detach(join);
                 return Err(e);
             }
         }
+        py.detach(join);
         if let Some(callback) = progress {
             let now = control.progress();
             if now != shown && now.1 > 0 {

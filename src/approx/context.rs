@@ -30,10 +30,15 @@ impl std::fmt::Display for AdapterDescription {
 }
 
 /// An open device on a chosen adapter.
+///
+/// The device has the adapter's own limits (docs/design.md §4 "Buffer limits"), not wgpu's
+/// defaults: the largest storage buffer bounds the scene size, and every buffer pgt creates
+/// is checked against it first ([`GpuContext::check_buffers`]).
 pub struct GpuContext {
     /// The adapter that runs everything (named in every summary).
     pub adapter: AdapterDescription,
-    /// The device, opened with every limit the adapter offers.
+    /// The device, opened with every limit the adapter offers (or with a smaller storage
+    /// buffer: [`GpuContext::with_storage_limit`]).
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     /// Whether compute passes can carry timestamp queries (`TIMESTAMP_QUERY`).
@@ -117,16 +122,32 @@ impl GpuContext {
     /// (`--adapter`); without one, the first hardware adapter, else the first of any kind
     /// (lavapipe is a `Cpu` adapter).
     pub fn new(adapter_filter: Option<&str>) -> Result<GpuContext> {
-        GpuContext::open(adapter_filter, false)
+        GpuContext::open(adapter_filter, false, None)
     }
 
     /// [`GpuContext::new`] with f64 in shaders (`SHADER_F64`, Vulkan's `shaderFloat64`), as the
     /// GPU reference needs (docs/design.md §12); an adapter without it is refused by name.
     pub fn with_f64(adapter_filter: Option<&str>) -> Result<GpuContext> {
-        GpuContext::open(adapter_filter, true)
+        GpuContext::open(adapter_filter, true, None)
     }
 
-    fn open(adapter_filter: Option<&str>, f64: bool) -> Result<GpuContext> {
+    /// [`GpuContext::new`] (`f64` false) or [`GpuContext::with_f64`] (`f64` true) on a device
+    /// whose storage buffers bind at most `bytes` (wgpu's `max_storage_buffer_binding_size`,
+    /// where the adapter allows more): an adapter of a smaller limit, which wgpu then
+    /// enforces, so that the tests of the limits run on small scenes.
+    pub fn with_storage_limit(
+        adapter_filter: Option<&str>,
+        f64: bool,
+        bytes: u64,
+    ) -> Result<GpuContext> {
+        GpuContext::open(adapter_filter, f64, Some(bytes))
+    }
+
+    fn open(
+        adapter_filter: Option<&str>,
+        f64: bool,
+        storage_cap: Option<u64>,
+    ) -> Result<GpuContext> {
         let instance = instance();
         let adapters = pollster::block_on(instance.enumerate_adapters(wgpu::Backends::all()));
         if adapters.is_empty() {
@@ -181,11 +202,17 @@ impl GpuContext {
             require_f64(adapter.features(), &describe(&info).to_string())?;
             required_features |= wgpu::Features::SHADER_F64;
         }
-        // Ask for everything the adapter offers: the storage-buffer limits bound the scene size.
+        // Ask for everything the adapter offers, not wgpu's defaults (128 MiB a storage
+        // buffer): the storage-buffer limits bound the scene size.
+        let mut required_limits = adapter.limits();
+        if let Some(bytes) = storage_cap {
+            required_limits.max_storage_buffer_binding_size =
+                bytes.min(required_limits.max_storage_buffer_binding_size);
+        }
         let desc = wgpu::DeviceDescriptor {
             label: Some("pgt"),
             required_features,
-            required_limits: adapter.limits(),
+            required_limits,
             ..Default::default()
         };
         let (device, queue) = pollster::block_on(adapter.request_device(&desc))
@@ -205,6 +232,35 @@ impl GpuContext {
             f64,
             uncaptured,
         })
+    }
+
+    /// The largest storage buffer the device binds and allocates (bytes): the smaller of
+    /// wgpu's `max_storage_buffer_binding_size` and `max_buffer_size` as the device has them.
+    pub fn storage_limit(&self) -> u64 {
+        storage_limit(&self.device.limits())
+    }
+
+    /// Refuses the first of `buffers` (a name for messages and a size in bytes) that exceeds
+    /// [`GpuContext::storage_limit`], naming the buffer, its size, the limit and the adapter;
+    /// `advice` says what the user can do instead. Called before the buffers are made, so a
+    /// scene too large for the adapter is an error (exit code 2), never wgpu's validation
+    /// error or an image rendered from part of the scene (docs/design.md §4 "Buffer limits").
+    pub fn check_buffers(&self, buffers: &[(&str, u64)], advice: &str) -> Result<()> {
+        self.check_buffers_under(u64::MAX, buffers, advice)
+    }
+
+    /// [`GpuContext::check_buffers`] as if the adapter bound at most `limit` bytes per storage
+    /// buffer (never more than it does): the approximations' forced bands
+    /// (`dispatch::run_with_limit`).
+    pub(crate) fn check_buffers_under(
+        &self,
+        limit: u64,
+        buffers: &[(&str, u64)],
+        advice: &str,
+    ) -> Result<()> {
+        let mut limits = self.device.limits();
+        limits.max_storage_buffer_binding_size = limits.max_storage_buffer_binding_size.min(limit);
+        check_sizes(&limits, &self.adapter.to_string(), buffers, advice)
     }
 
     /// Runs `f` inside validation and out-of-memory error scopes; an error caught by either, or
@@ -236,6 +292,57 @@ impl GpuContext {
     }
 }
 
+/// See [`GpuContext::storage_limit`].
+fn storage_limit(limits: &wgpu::Limits) -> u64 {
+    limits
+        .max_storage_buffer_binding_size
+        .min(limits.max_buffer_size)
+}
+
+/// [`GpuContext::check_buffers`] for a device of `limits` on the adapter `described`.
+fn check_sizes(
+    limits: &wgpu::Limits,
+    described: &str,
+    buffers: &[(&str, u64)],
+    advice: &str,
+) -> Result<()> {
+    let limit = storage_limit(limits);
+    match buffers.iter().find(|&&(_, size)| size > limit) {
+        None => Ok(()),
+        Some(&(name, size)) => Err(PgtError::Gpu(format!(
+            "this scene is too large for {described}: its {name} buffer needs {}, \
+             the adapter allows {} per storage buffer (wgpu max_storage_buffer_binding_size {}, \
+             max_buffer_size {}); {advice}",
+            exact_bytes(size),
+            exact_bytes(limit),
+            limits.max_storage_buffer_binding_size,
+            limits.max_buffer_size,
+        ))),
+    }
+}
+
+/// `320 bytes`, `1.5 KiB`, `128.0 MiB`, `2.0 GiB`.
+pub fn human_bytes(bytes: u64) -> String {
+    const KIB: u64 = 1 << 10;
+    const MIB: u64 = 1 << 20;
+    const GIB: u64 = 1 << 30;
+    match bytes {
+        0..KIB => format!("{bytes} bytes"),
+        KIB..MIB => format!("{:.1} KiB", bytes as f64 / KIB as f64),
+        MIB..GIB => format!("{:.1} MiB", bytes as f64 / MIB as f64),
+        _ => format!("{:.1} GiB", bytes as f64 / GIB as f64),
+    }
+}
+
+/// [`human_bytes`] with the exact count from 1 KiB up: `320 bytes`, `4.0 KiB (4097 bytes)`.
+fn exact_bytes(bytes: u64) -> String {
+    if bytes < 1024 {
+        human_bytes(bytes)
+    } else {
+        format!("{} ({bytes} bytes)", human_bytes(bytes))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -257,5 +364,47 @@ mod tests {
             "{err}"
         );
         assert!(require_f64(wgpu::Features::SHADER_F64, "lavapipe").is_ok());
+    }
+
+    /// A buffer over the smaller of the two wgpu limits is refused with its name, its size,
+    /// the limit, both wgpu limits and the adapter; one at the limit passes (the limit is the
+    /// largest size allowed). Small fake limits: nothing is allocated.
+    #[test]
+    fn a_buffer_over_the_storage_limit_is_refused_by_name() {
+        let limits = wgpu::Limits {
+            max_storage_buffer_binding_size: 4096,
+            max_buffer_size: 8192,
+            ..wgpu::Limits::default()
+        };
+        let check = |buffers: &[(&str, u64)]| {
+            check_sizes(&limits, "SomeGPU (Vulkan, Cpu)", buffers, "render fewer")
+        };
+        assert!(check(&[("particle", 4096), ("BVH node", 0)]).is_ok());
+        let err = check(&[("particle", 4096), ("BVH node", 4097), ("x", 1 << 40)])
+            .unwrap_err()
+            .to_string();
+        for part in [
+            "too large for SomeGPU (Vulkan, Cpu)",
+            "its BVH node buffer needs 4.0 KiB (4097 bytes)",
+            "allows 4.0 KiB (4096 bytes) per storage buffer",
+            "max_storage_buffer_binding_size 4096",
+            "max_buffer_size 8192",
+            "; render fewer",
+        ] {
+            assert!(err.contains(part), "{part:?} missing from: {err}");
+        }
+        // max_buffer_size the smaller: it is the limit.
+        let limits = wgpu::Limits {
+            max_storage_buffer_binding_size: 8192,
+            max_buffer_size: 1000,
+            ..wgpu::Limits::default()
+        };
+        assert!(check_sizes(&limits, "A", &[("p", 1000)], "").is_ok());
+        let err = check_sizes(&limits, "A", &[("p", 1001)], "").unwrap_err();
+        assert!(
+            err.to_string().contains("allows 1000 bytes per storage"),
+            "{err}"
+        );
+        assert_eq!(human_bytes(3 << 30), "3.0 GiB");
     }
 }

@@ -4,7 +4,7 @@
 //! with unit tests that need no GPU) and the read-back of the image. Timing by timestamp
 //! queries where the adapter has them, wall time otherwise.
 
-use super::context::GpuContext;
+use super::context::{human_bytes, GpuContext};
 use super::contract::{
     BindingKind, BINDINGS, LOOP_BUDGET, OVERRIDE_HAS_ELLIPSOIDS, WORKGROUP_SIDE,
 };
@@ -14,6 +14,7 @@ use super::layout::{
 use super::shader::{ShaderProgram, ENTRY_POINT};
 use crate::error::{PgtError, Result};
 use crate::image_io::RgbImage;
+use crate::scene::Scene;
 use std::sync::OnceLock;
 use std::time::Instant;
 use wgpu::util::DeviceExt;
@@ -207,39 +208,33 @@ impl Pipeline {
     }
 }
 
-/// The largest storage buffer the adapter binds and allocates (bytes).
+/// The largest storage buffer the adapter binds and allocates (bytes):
+/// [`GpuContext::storage_limit`].
 pub fn storage_limit(ctx: &GpuContext) -> u64 {
-    let limits = ctx.device.limits();
-    limits
-        .max_storage_buffer_binding_size
-        .min(limits.max_buffer_size)
+    ctx.storage_limit()
 }
 
-/// Sizes of the scene's storage buffers, checked against `limit` before any allocation so that
-/// a scene that is too large is refused with a message (the limit and the size), not a wgpu
-/// validation error. The image never is: it is split into bands ([`bands`]).
-fn check_limits(ctx: &GpuContext, limit: u64, buffers: &[(&str, u64)]) -> Result<()> {
-    for &(name, size) in buffers {
-        if size > limit {
-            return Err(PgtError::Gpu(format!(
-                "too large for {}: the {name} buffer needs {}, the adapter allows {} per storage buffer \
-                 (max_storage_buffer_binding_size); render fewer particles, or use an adapter with larger limits",
-                ctx.adapter.name,
-                human_bytes(size),
-                human_bytes(limit)
-            )));
-        }
-    }
-    Ok(())
-}
+/// What a user can do with a scene too large for the approximations' buffers.
+pub const TOO_LARGE: &str =
+    "render fewer particles, or choose an adapter with larger limits (--adapter)";
 
-/// `320 bytes`, `1.5 KiB`, `128.0 MiB`.
-fn human_bytes(bytes: u64) -> String {
-    match bytes {
-        0..1024 => format!("{bytes} bytes"),
-        1024..1048576 => format!("{:.1} KiB", bytes as f64 / 1024.0),
-        _ => format!("{:.1} MiB", bytes as f64 / 1048576.0),
-    }
+/// Checks the buffers whose sizes the particle count fixes (particles and ellipsoids) against
+/// the adapter's limit before the BVH and the splatting methods' tile lists are built, which
+/// for 10⁷ particles take a minute and gigabytes; [`Upload::new`] checks every buffer again
+/// once their sizes are known.
+pub fn check_scene_size(ctx: &GpuContext, scene: &Scene) -> Result<()> {
+    let ellipsoids = scene
+        .particles
+        .iter()
+        .filter(|p| p.ellipsoid.is_some())
+        .count();
+    ctx.check_buffers(
+        &[
+            ("particle", bytes::<GpuParticle>(scene.particles.len())),
+            ("ellipsoid", bytes::<GpuEllipsoid>(ellipsoids)),
+        ],
+        TOO_LARGE,
+    )
 }
 
 /// Bytes of one output pixel (a `vec4<f32>`).
@@ -430,8 +425,7 @@ impl Upload {
         limit: u64,
     ) -> Result<Upload> {
         let limit = limit.min(storage_limit(ctx));
-        check_limits(
-            ctx,
+        ctx.check_buffers_under(
             limit,
             &[
                 ("particle", bytes::<GpuParticle>(scene.particles.len())),
@@ -442,6 +436,7 @@ impl Upload {
                 ("splat", bytes::<GpuSplat>(scene.splats.len())),
                 ("tile list", bytes::<u32>(scene.tile_entries.len())),
             ],
+            TOO_LARGE,
         )?;
         let rows = bands(frame.width, frame.height, limit)?;
         let max_groups = ctx.device.limits().max_compute_workgroups_per_dimension;

@@ -198,6 +198,7 @@ impl ApproxPipeline {
                 self.names
             )));
         }
+        dispatch::check_scene_size(ctx, scene)?;
         let prep = self.method.preparation();
         let bvh = match prep.traced_sigmas {
             Some(k) => layout::widened_gaussians(scene, k).build_bvh(),

@@ -120,7 +120,7 @@ fn scene_buffers_beyond_the_limit_are_refused_with_the_limit_and_the_size() {
         .to_string();
     assert!(
         e.contains(
-            "the particle buffer needs 320 bytes, the adapter allows 256 bytes per storage buffer"
+            "its particle buffer needs 320 bytes, the adapter allows 256 bytes per storage buffer"
         ),
         "{e}"
     );

@@ -279,7 +279,14 @@ fn a_particle_buffer_beyond_the_storage_buffer_limit_is_refused_with_exit_2() {
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{err}");
     assert!(
-        err.contains("the particle buffer needs 134.3 MiB, the adapter allows 128.0 MiB"),
+        err.contains(&format!(
+            "its particle buffer needs 134.3 MiB (140800000 bytes), the adapter allows {}",
+            if limit == 128 << 20 {
+                "128.0 MiB (134217728 bytes) per storage buffer"
+            } else {
+                ""
+            }
+        )) && err.contains(&ctx.adapter.name),
         "{err}"
     );
     assert!(!out.exists());

@@ -1,6 +1,6 @@
 //! The GPU approximations (docs/design.md §4) on whatever adapter wgpu finds (lavapipe in CI): the
-//! CPU–GPU contract and layouts, the methods against exact answers, bands, `pgt approx`, and the
-//! rasterising example.
+//! CPU–GPU contract and layouts, the methods against exact answers, bands, buffer limits,
+//! `pgt approx`, and the rasterising example.
 //!
 //! One module per topic; `support` (tests/support) is shared by every test binary.
 
@@ -14,6 +14,7 @@ mod ellipsoids;
 mod gaussians;
 mod intrinsics;
 mod layout;
+mod limits;
 mod methods;
 mod raster;
 mod reference;

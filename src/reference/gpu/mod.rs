@@ -121,6 +121,7 @@ pub fn render_rows_on(
     rows: &[u32],
 ) -> Result<RowsOutput> {
     check_supported(scene, options)?;
+    check_scene_size(ctx, scene)?;
     let start = Instant::now();
     let camera = &scene.camera;
     let (w, k) = (camera.width, options.spp.max(1));
@@ -195,6 +196,29 @@ pub fn render_rows_on(
             worst_unconverged,
         },
     })
+}
+
+/// Checks the buffers whose sizes the particle count fixes against the adapter's limit before
+/// the scene's data and BVH are built (docs/design.md §4 "Buffer limits", §12): the f64 particles
+/// and ellipsoids of spheres and ellipsoids, the f64 Gaussians (those of σ > 0, as
+/// `GaussianRenderer` keeps them) of a Gaussian scene. The traces check their buffers again
+/// once their sizes are known.
+pub fn check_scene_size(ctx: &GpuContext, scene: &Scene) -> Result<()> {
+    let f64s = |count: usize, stride: usize| (count.max(1) * stride * 8) as u64;
+    let particles = &scene.particles;
+    if scene.has_gaussians() {
+        let kept = particles.iter().filter(|p| p.sigma != 0.0).count();
+        let gaussians = f64s(kept, gaussian::GAUSS_STRIDE);
+        return ctx.check_buffers(&[("Gaussian", gaussians)], run::TOO_LARGE);
+    }
+    let ellipsoids = particles.iter().filter(|p| p.ellipsoid.is_some()).count();
+    ctx.check_buffers(
+        &[
+            ("particle", f64s(particles.len(), program::PARTICLE_STRIDE)),
+            ("ellipsoid", f64s(ellipsoids, program::ELLIPSOID_STRIDE)),
+        ],
+        run::TOO_LARGE,
+    )
 }
 
 /// A bound on how far a ray of `camera` (`Camera::ray_at`, any sample position in the image)

@@ -9,13 +9,14 @@ use super::program::{
 };
 use super::ray_error;
 use crate::approx::contract::{LOOP_BUDGET, STACK_DEPTH};
-use crate::approx::dispatch::{read_back, storage_limit};
+use crate::approx::dispatch::read_back;
 use crate::approx::layout::SceneBuffers;
 use crate::approx::GpuContext;
 use crate::error::{PgtError, Result};
 use crate::optics::source::SourceParams;
 use crate::scene::Scene;
 use glam::DVec3;
+use std::mem::size_of_val;
 use wgpu::util::DeviceExt;
 use wgpu::BufferUsages as Usage;
 
@@ -137,6 +138,7 @@ pub fn trace(
             ctx.adapter
         )));
     }
+    super::check_scene_size(ctx, scene)?;
     let data = scene_data(scene, origin, direction_error)?;
     let program = program();
     program.validate_with(naga::valid::Capabilities::FLOAT64)?;
@@ -157,31 +159,25 @@ pub fn trace(
                 cache: None,
             })
     })?;
-    let limit = storage_limit(ctx);
-    let sizes = [
-        ("the particles", std::mem::size_of_val(&data.particles[..])),
-        (
-            "the ellipsoids",
-            std::mem::size_of_val(&data.ellipsoids[..]),
-        ),
-        ("the BVH", std::mem::size_of_val(&data.buffers.nodes[..])),
-    ];
-    for (what, bytes) in sizes {
-        if bytes as u64 > limit {
-            return Err(PgtError::Gpu(format!(
-                "{what} of this scene take {bytes} bytes in f64, more than the {limit} bytes {} binds: render it on the CPU (without --gpu)",
-                ctx.adapter.name
-            )));
-        }
-    }
-    let per_ray = (STATE_STRIDE * 8) as u64;
-    let chunk = (limit / per_ray).min(65535 * WORKGROUP as u64) as usize;
+    ctx.check_buffers(
+        &[
+            ("particle", size_of_val(&data.particles[..]) as u64),
+            ("ellipsoid", size_of_val(&data.ellipsoids[..]) as u64),
+            ("BVH node", size_of_val(&data.buffers.nodes[..]) as u64),
+            (
+                "leaf index",
+                size_of_val(&data.buffers.leaf_indices[..]) as u64,
+            ),
+        ],
+        TOO_LARGE,
+    )?;
+    let chunk = ray_chunk(ctx, STATE_STRIDE);
     let scene_buffers = ctx.checked("uploading the scene to the GPU reference", || {
         SceneGpu::new(ctx, &data)
     })?;
     let mut out = Vec::with_capacity(directions.len());
     let mut passes = 0;
-    for part in directions.chunks(chunk.max(WORKGROUP as usize)) {
+    for part in directions.chunks(chunk) {
         let (state, chunk_passes) = run_chunk(ctx, &pipeline, &scene_buffers, part)?;
         passes = passes.max(chunk_passes);
         for ray in state.chunks_exact(STATE_STRIDE) {
@@ -198,6 +194,18 @@ pub fn trace(
         samples: out,
         passes,
     })
+}
+
+/// What a user can do with a scene too large for the GPU reference's buffers.
+pub(super) const TOO_LARGE: &str =
+    "render it on the CPU (without --gpu), or choose an adapter with larger limits (--adapter)";
+
+/// The rays of one chunk of a trace whose per-ray state is `state_stride` f64s: as many as
+/// fit the adapter's storage limit with their state and their directions, and one dispatch.
+pub(super) fn ray_chunk(ctx: &GpuContext, state_stride: usize) -> usize {
+    let per_ray = ((state_stride.max(3)) * 8) as u64;
+    let groups = ctx.device.limits().max_compute_workgroups_per_dimension as u64;
+    (ctx.storage_limit() / per_ray).clamp(1, groups * WORKGROUP as u64) as usize
 }
 
 /// An error naming why a ray did not finish, if it did not.
@@ -340,6 +348,13 @@ impl Passes<'_> {
         let device = &ctx.device;
         let rays: Vec<f64> = directions.iter().flat_map(|d| d.to_array()).collect();
         let state_bytes = (initial.len() * 8) as u64;
+        ctx.check_buffers(
+            &[
+                ("ray", size_of_val(&rays[..]) as u64),
+                ("per-ray state", state_bytes),
+            ],
+            TOO_LARGE,
+        )?;
         let (bind_group, state, counters, counters_read, state_read) =
             ctx.checked(&format!("uploading the {what}'s rays"), || {
                 let params = storage_init(ctx, "pgt reference params", &[params], Usage::UNIFORM);
