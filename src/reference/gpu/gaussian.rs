@@ -17,9 +17,8 @@
 
 use super::math::{ERFC_NORMAL, ERFC_ULPS, EXPM1_ULPS, EXP_ULPS, F64_MATH_WGSL, U};
 use super::program::SAFETY;
-use super::run::{pass_limits, storage_init, Passes, RaySample};
+use super::run::{pass_limits, ray_chunk, storage_init, Passes, RaySample, TOO_LARGE};
 use crate::approx::contract::{STACK_DEPTH, STACK_SIZE};
-use crate::approx::dispatch::storage_limit;
 use crate::approx::layout::{bvh_depth, widen, GpuBvhNode};
 use crate::approx::shader::{ShaderPart, ShaderProgram, NEAREST_EVENTS};
 use crate::approx::wgsl::struct_declaration;
@@ -383,21 +382,21 @@ pub fn trace(
                 cache: None,
             })
     })?;
-    let limit = storage_limit(ctx);
-    let sizes = [
-        ("the Gaussians", std::mem::size_of_val(&data.gaussians[..])),
-        ("the BVH", std::mem::size_of_val(&data.nodes[..])),
-    ];
-    for (what, bytes) in sizes {
-        if bytes as u64 > limit {
-            return Err(PgtError::Gpu(format!(
-                "{what} of this scene take {bytes} bytes in f64, more than the {limit} bytes {} binds: render it on the CPU (without --gpu)",
-                ctx.adapter.name
-            )));
-        }
-    }
-    let per_ray = (GST_STRIDE * 8) as u64;
-    let chunk = (limit / per_ray).min(65535 * WORKGROUP as u64) as usize;
+    ctx.check_buffers(
+        &[
+            (
+                "Gaussian",
+                std::mem::size_of_val(&data.gaussians[..]) as u64,
+            ),
+            ("BVH node", std::mem::size_of_val(&data.nodes[..]) as u64),
+            (
+                "leaf index",
+                std::mem::size_of_val(&data.indices[..]) as u64,
+            ),
+        ],
+        TOO_LARGE,
+    )?;
+    let chunk = ray_chunk(ctx, GST_STRIDE);
     let buffers = ctx.checked("uploading the scene to the Gaussian GPU reference", || {
         SceneGpu::new(ctx, &data)
     })?;
@@ -406,7 +405,7 @@ pub fn trace(
         unconverged: Vec::with_capacity(directions.len()),
         passes: 0,
     };
-    for part in directions.chunks(chunk.max(WORKGROUP as usize)) {
+    for part in directions.chunks(chunk) {
         let (state, passes) = run_chunk(ctx, &pipeline, &buffers, part)?;
         out.passes = out.passes.max(passes);
         for ray in state.chunks_exact(GST_STRIDE) {
