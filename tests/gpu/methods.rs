@@ -6,7 +6,7 @@ use glam::DVec3;
 use pgt::approx::{render_approx_with, ApproxParams, Method, N_EXACT_ALL};
 use pgt::optics::models;
 use pgt::reference::{self, RenderOptions};
-use pgt::scene::{Light, RenderMode};
+use pgt::scene::{Light, RenderMode, Scene};
 use std::path::PathBuf;
 
 /// A built-in method with no parameters chosen (its defaults).
@@ -235,17 +235,7 @@ fn a_crowded_ray_reports_hit_list_overflow() {
     let Some(ctx) = gpu() else { return };
     // 200 spheres in a row along the view axis (overlapping: this is about counting): the
     // rays near the centre cross all of them, more than MAX_HITS (128).
-    let ps: Vec<_> = (0..200)
-        .map(|i| {
-            particle(
-                [0.0, 0.0, -5.0 + 0.1 * i as f64],
-                0.5,
-                [1.0, 1.0, 1.0],
-                0.01,
-            )
-        })
-        .collect();
-    let s = scene(ps, vec![], RenderMode::Volume, models::EMISSION);
+    let s = row_of_spheres(200);
     let out = render_approx_with(ctx, &s, &plain("emission")).unwrap();
     assert!(out.hit_overflow_pixels > 0);
     assert!(out.image.all_finite());
@@ -280,17 +270,7 @@ fn a_full_hit_list_keeps_its_nearest_entries_sorted() {
 ",
     )
     .unwrap();
-    let ps: Vec<_> = (0..200)
-        .map(|i| {
-            particle(
-                [0.0, 0.0, -5.0 + 0.1 * i as f64],
-                0.5,
-                [1.0, 1.0, 1.0],
-                0.01,
-            )
-        })
-        .collect();
-    let s = scene(ps, vec![], RenderMode::Volume, models::EMISSION);
+    let s = row_of_spheres(200);
     let out = render_approx_with(ctx, &s, &user(shader, 1, 0)).unwrap();
     let centre = (SIDE / 2 * SIDE + SIDE / 2) as usize;
     assert_eq!(out.image.pixels[centre], [128.0, 127.0, 1.0]);
@@ -356,17 +336,7 @@ fn pixels_beyond_lavapipes_loop_limit_are_reported() {
         "fn shade(ray: Ray, pixel: vec2<u32>) -> vec3<f32> {\n    var sum = vec3<f32>(0.0);\n    for (var i = 0u; i < 50u; i = i + 1u) {\n        sum = sum + emission_along(ray, 0.0, T_FAR, frame.background);\n    }\n    return sum / 50.0;\n}\n",
     )
     .unwrap();
-    let ps: Vec<_> = (0..200)
-        .map(|i| {
-            particle(
-                [0.0, 0.0, -5.0 + 0.1 * i as f64],
-                0.5,
-                [1.0, 1.0, 1.0],
-                0.01,
-            )
-        })
-        .collect();
-    let s = scene(ps, vec![], RenderMode::Volume, models::EMISSION);
+    let s = row_of_spheres(200);
     let out = render_approx_with(ctx, &s, &user(shader, 1, 0)).unwrap();
     if ctx.adapter.is_cpu {
         assert!(out.loop_limited_pixels > 0);
@@ -492,4 +462,20 @@ fn progress_is_reported_once_per_pass() {
             "lavapipe should split 256 samples into passes"
         );
     }
+}
+
+/// `n` overlapping spheres of radius 0.5 in a row along the camera's axis, 0.1 apart from
+/// z = −5, emission model.
+fn row_of_spheres(n: usize) -> Scene {
+    let ps: Vec<_> = (0..n)
+        .map(|i| {
+            particle(
+                [0.0, 0.0, -5.0 + 0.1 * i as f64],
+                0.5,
+                [1.0, 1.0, 1.0],
+                0.01,
+            )
+        })
+        .collect();
+    scene(ps, vec![], RenderMode::Volume, models::EMISSION)
 }
