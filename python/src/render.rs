@@ -232,7 +232,7 @@ pub fn render(
         warn(py, &w, 2)?;
     }
     let above_tol = out.error.as_ref().and_then(|err| {
-        pgt::reference::err_above_tol_warning(&out.image, err, scene.render.tol, scene, gpu)
+        pgt::reference::err_above_tol_warning(&out.image, err, scene.render.tol, scene)
     });
     if let Some(w) = above_tol {
         warn(py, &w, 2)?;

@@ -188,7 +188,7 @@ pub fn run(args: RenderArgs) -> anyhow::Result<Outcome> {
         eprintln!("warning: {warning}");
     }
     let above_tol = out.error.as_ref().and_then(|err| {
-        reference::err_above_tol_warning(&out.image, err, scene.render.tol, &scene, args.gpu)
+        reference::err_above_tol_warning(&out.image, err, scene.render.tol, &scene)
     });
     if let Some(warning) = above_tol {
         eprintln!("warning: {warning}");

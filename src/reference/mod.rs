@@ -408,14 +408,12 @@ pub fn worse_unconverged(
 /// depth beyond the cut-off of k σ, so a small `gaussian_cutoff` makes err large everywhere).
 /// The float32 rounding of the stored value (part 5 of err, up to one spacing of float32 at the
 /// value with err's rounding up) is not counted: a tol below it is no news. The count and the
-/// pixel with the largest err, or `None` when every err is within `tol` so far. `gpu`: the
-/// image is the GPU reference's (§12), whose err also bounds its f64 rounding.
+/// pixel with the largest err, or `None` when every err is within `tol` so far.
 pub fn err_above_tol_warning(
     image: &RgbImage,
     err: &RgbImage,
     tol: f64,
     scene: &Scene,
-    gpu: bool,
 ) -> Option<String> {
     let mut count = 0u64;
     let mut worst: Option<(u32, u32, f64)> = None;
@@ -439,7 +437,7 @@ pub fn err_above_tol_warning(
         .particles
         .iter()
         .any(|p| p.profile == crate::optics::Profile::Gaussian);
-    let mut why = match (gaussians, scene.render.gaussian_cutoff) {
+    let why = match (gaussians, scene.render.gaussian_cutoff) {
         (true, Some(k)) => format!(
             ": it bounds the depth of the Gaussians the rays pass beyond the cut-off gaussian_cutoff = {k} σ; a larger cut-off (or none, to choose it from tol) makes it smaller"
         ),
@@ -448,9 +446,6 @@ pub fn err_above_tol_warning(
         }
         (false, _) => String::new(),
     };
-    if gaussians && gpu {
-        why += "; on the GPU also each Gaussian profile's f64 rounding, bounded to first order, which is large for very flat Gaussians (docs/design.md §12): the CPU reference's err is tighter there";
-    }
     Some(format!(
         "{count} pixel(s) have err above tol {tol:e}; the largest is {e:.3e} at ({x}, {y}){why}"
     ))
@@ -513,12 +508,9 @@ mod tests {
         image.pixels = vec![[0.5; 3], [0.5; 3]];
         // Float32's spacing at 0.5 is 5.96e-8: err 1.2e-7 at tol 1e-7 is the storage alone.
         err.pixels = vec![[1.2e-7; 3], [1.2e-7; 3]];
-        assert_eq!(
-            err_above_tol_warning(&image, &err, 1e-7, &spheres, false),
-            None
-        );
+        assert_eq!(err_above_tol_warning(&image, &err, 1e-7, &spheres), None);
         err.pixels[1] = [0.0, 2.0e-7, 0.0];
-        let w = err_above_tol_warning(&image, &err, 1e-7, &spheres, false).expect("a warning");
+        let w = err_above_tol_warning(&image, &err, 1e-7, &spheres).expect("a warning");
         assert!(
             w.starts_with("1 pixel(s) have err above tol 1e-7") && w.contains("at (1, 0)"),
             "{w}"
@@ -527,15 +519,7 @@ mod tests {
         let cut = scene(
             "[render]\nmodel = \"emission\"\ngaussian_cutoff = 1.0\n[defaults]\ndensity = \"gaussian\"\n[[particles]]\ncenter = [0.0, 0.0, 0.0]\nradius = 1.0\n",
         );
-        let w = err_above_tol_warning(&image, &err, 1e-7, &cut, false).expect("a warning");
+        let w = err_above_tol_warning(&image, &err, 1e-7, &cut).expect("a warning");
         assert!(w.contains("gaussian_cutoff = 1 σ"), "{w}");
-        assert!(!w.contains("GPU"), "{w}");
-        let w = err_above_tol_warning(&image, &err, 1e-7, &cut, true).expect("a warning");
-        assert!(
-            w.contains("on the GPU also each Gaussian profile's f64 rounding"),
-            "{w}"
-        );
-        let w = err_above_tol_warning(&image, &err, 1e-7, &spheres, true).expect("a warning");
-        assert!(!w.contains("GPU"), "{w}");
     }
 }
