@@ -28,10 +28,12 @@
 //
 // Error bound, carried per ray and turned into err by gaussian.rs (`ray_error`): the parts of
 // the CPU (ray stop, bounded deviations, quadrature, the depth left out) and the device's own:
-// * each profile's uncertainty as optical depth: t*, s and the peak computed from the rounded
-//   o − c, M·(o − c), M·d (d within GS_DIRECTION_ERROR of the exact unit direction), and each
-//   piece's depth through the erfc bound (GR_ERFC_ULPS, GR_ERFC_NORMAL); a change of the medium
-//   by optical depth δ changes L by at most M·δ;
+// * each profile's uncertainty as optical depth: s and the peak computed from the rounded
+//   o − c, M·(o − c), M·d (d within GS_DIRECTION_ERROR of the exact unit direction; m*²'s
+//   rounding by its part across the ray, `across_error_off_ray`), and each piece's depth
+//   through the erfc bound (GR_ERFC_ULPS, GR_ERFC_NORMAL); a change of the medium by optical
+//   depth δ changes L by at most M·δ; t*'s uncertainty through the position derivative of L
+//   (`shift_depth`), which only other gas makes matter;
 // * the composite's rounding: relative bounds carried through T and each term, and half an ulp
 //   of every addition to the radiance, in `rounding`.
 
@@ -56,6 +58,9 @@ const EVENT_IN_BOX: bool = false;
 var<private> w_tstar: array<f64, GR_WINDOWS_MAX>;
 var<private> w_s: array<f64, GR_WINDOWS_MAX>;
 var<private> w_peak: array<f64, GR_WINDOWS_MAX>;
+// The exact peak's upper bound and t*'s uncertainty.
+var<private> w_peak_hi: array<f64, GR_WINDOWS_MAX>;
+var<private> w_et: array<f64, GR_WINDOWS_MAX>;
 var<private> w_lo: array<f64, GR_WINDOWS_MAX>;
 var<private> w_hi: array<f64, GR_WINDOWS_MAX>;
 var<private> w_index: array<u32, GR_WINDOWS_MAX>;
@@ -98,7 +103,8 @@ fn g_ln(x: f64) -> f64 {
 
 // A Gaussian's density along the ray (src/optics/gaussian.rs `GaussianAlongRay::new`: the
 // same operations), and `pert`, a bound on the optical depth (over the whole line) by which the
-// computed profile may differ from the exact one along the exact ray.
+// computed profile's peak and width may make it differ from the exact one along the exact ray;
+// the shift of t* (within e_t) is bounded where the profile is used (`shift_depth`).
 struct Profile64 {
     t_star: f64,
     s: f64,
@@ -141,15 +147,48 @@ fn gauss_profile(o: vec3<f64>, d: vec3<f64>, i: u32) -> Profile64 {
     let e_along = e_u0 + n_u0 * e_vhat + 3.0lf * GR_U * n_u0;
     let e_across = e_u0 + e_along + abs(along) * e_vhat + 3.0lf * GR_U * (n_u0 + abs(along));
     let n_across = sqrt(m2);
-    p.e_m2 = GR_SAFETY * (2.0lf * n_across * e_across + e_across * e_across + 3.0lf * GR_U * m2);
+    let iso_m2 = 2.0lf * n_across * e_across + e_across * e_across + 3.0lf * GR_U * m2;
+    let p_err = across_error_off_ray(f, d, m0, m1, m2r, u0, v_hat, along, across, k, e_v, e_vhat, e_along);
+    // |ã|² − |a|² = 2a·δ + |δ|² with the exact a ⊥ v̂: a·δ = a·Pδ.
+    let projected_m2 = 2.0lf * (n_across + e_across) * p_err + e_across * e_across + 3.0lf * GR_U * m2;
+    p.e_m2 = GR_SAFETY * min(iso_m2, projected_m2);
     p.e_t = GR_SAFETY * ((e_along + abs(p.t_star) * e_k) / k + GR_U * abs(p.t_star));
     let rel_peak = 0.5lf * p.e_m2 + 2.0lf * GR_EXP_ULPS * GR_U + 2.0lf * GR_U;
     let rel_s = GR_SAFETY * (e_k / k + GR_U);
     let total = p.peak * p.s * 2.0lf * GR_SQRT_HALF_PI;
-    // Over the line: a relative change of the peak or of s changes the depth by that much, a
-    // shift δ of t* by at most 2·peak·δ (∫|g(t − δ) − g(t)| dt ≤ δ·∫|g′|).
-    p.pert = total * (rel_peak + rel_s + 8.0lf * GR_U) + 2.0lf * p.peak * (1.0lf + rel_peak) * p.e_t;
+    // Over the line: a relative change of the peak or of s changes the depth by that much.
+    p.pert = total * (rel_peak + rel_s + 8.0lf * GR_U);
     return p;
+}
+
+// A bound on |P·(ã − a)|, the part across the exact v̂ (P = I − v̂v̂ᵀ) of the rounding of
+// `across` (ã computed, a exact), which is all that m*² sees to first order. An error along axis
+// i reaches it through |P·eᵢ| = √(1 − v̂ᵢ²) only, and the roundings of M·(o − c) and M·d are
+// largest along the rows of M with the largest entries, which for a flat Gaussian lie nearly
+// along v̂: there this is orders below the isotropic bound. The terms: (1) u₀'s rounding, o − c's
+// included, componentwise; (2) v̂'s, |P·(v̂′ − v̂)| = |P·δv|/|v′| for v′ = v + δv (d's direction
+// error and M·d's rounding, componentwise), times |u₀| and |along|; (3) the rounding of along
+// times v̂′'s part across v̂; (4) the rounding of along·v̂ᵢ and of the subtraction. +∞ where the
+// direction's error is not small against k (the isotropic bound then stands).
+fn across_error_off_ray(f: vec3<f64>, d: vec3<f64>, m0: vec3<f64>, m1: vec3<f64>, m2r: vec3<f64>, u0: vec3<f64>, v_hat: vec3<f64>, along: f64, across: vec3<f64>, k: f64, e_v: f64, e_vhat: f64, e_along: f64) -> f64 {
+    if (!(e_v < 0.5lf * k)) {
+        return REF_HUGE_G;
+    }
+    let sq = v_hat * v_hat;
+    let pe = sqrt(vec3<f64>(sq.y + sq.z, sq.x + sq.z, sq.x + sq.y)) * (1.0lf + 4.0lf * GR_U) + vec3<f64>(e_vhat);
+    let af = abs(f);
+    let ad = abs(d);
+    let mf = vec3<f64>(g_dot(abs(m0), af), g_dot(abs(m1), af), g_dot(abs(m2r), af));
+    let md = vec3<f64>(g_dot(abs(m0), ad), g_dot(abs(m1), ad), g_dot(abs(m2r), ad));
+    let rows = vec3<f64>(g_norm(m0), g_norm(m1), g_norm(m2r));
+    let ed = scene_data[GS_DIRECTION_ERROR];
+    let p_u0 = 4.1lf * GR_U * g_dot(mf, pe);
+    let p_vhat = g_dot(3.1lf * GR_U * md + rows * (ed * (1.0lf + 4.0lf * GR_U)), pe) / (k - e_v) + 2.0lf * GR_U * g_dot(abs(v_hat), pe);
+    let n_u0 = g_norm(u0) * (1.0lf + 4.0lf * GR_U);
+    let p_direction = (n_u0 * e_vhat + abs(along) + e_along) * p_vhat;
+    let p_along = 3.0lf * GR_U * g_dot(abs(u0), abs(v_hat)) * p_vhat;
+    let p_subtract = GR_U * g_dot(abs(along) * abs(v_hat) + abs(across), pe);
+    return (p_u0 + p_direction + p_along + p_subtract) * (1.0lf + 16.0lf * GR_U);
 }
 
 // erf(z_b) − erf(z_a) for z_a ≤ z_b from the tails ta = erfc(|z_a|), tb = erfc(|z_b|)
@@ -200,6 +239,26 @@ var<private> gv_left_out: f64;
 var<private> gv_pert: f64;
 var<private> gv_first: f64;
 var<private> gv_last: f64;
+// GV_SUM's sums for the shift of t* (`shift_depth`): the density bound of the candidates outside
+// their windows (all of a faint one), the candidates' peaks, and Σ e_t times each kept window's
+// tails or peak.
+var<private> gv_edge: f64;
+var<private> gv_peaks: f64;
+var<private> gv_tail_shift: f64;
+var<private> gv_far_shift: f64;
+var<private> gv_total_shift: f64;
+
+// An upper bound of the exact peak: its m*² within e_m2, the exponential's rounding.
+fn peak_upper(p: Profile64) -> f64 {
+    return p.peak * f64_exp(0.5lf * p.e_m2) * (1.0lf + 1.0e-12lf);
+}
+
+// The most density the profile has at a distance of at least `reach`·s from its centre, with the
+// centre anywhere within e_t of t*.
+fn density_beyond(p: Profile64, reach: f64) -> f64 {
+    let z = max(reach - p.e_t / p.s, 0.0lf);
+    return peak_upper(p) * f64_exp(-0.5lf * z * z) * (1.0lf + 1.0e-12lf);
+}
 
 // peak·s·√(π/2): a profile's optical depth per unit of erf difference.
 fn depth_factor(peak: f64, s: f64) -> f64 {
@@ -232,11 +291,15 @@ fn event_visit(ray: EventRay, i: u32, t_after: f64, key_after: u32, capacity: u3
     let factor = depth_factor(p.peak, p.s);
     let front = factor * f64_erfc(-p.t_star / (GR_SQRT2 * p.s));
     if (gv_mode == GV_SUM) {
-        gv_pert = gv_pert + p.pert + front * (2.0lf * GR_ERFC_ULPS * GR_U + 4.0lf * GR_U) + factor * 12.0lf * GR_U;
+        // The shift moves depth across the eye: at most e_t times the density there.
+        let at_eye = p.e_t * density_beyond(p, abs(p.t_star) / p.s);
+        gv_pert = gv_pert + p.pert + at_eye + front * (2.0lf * GR_ERFC_ULPS * GR_U + 4.0lf * GR_U) + factor * 12.0lf * GR_U;
+        gv_peaks = gv_peaks + peak_upper(p);
     }
     if (front <= gv_faint) {
         if (gv_mode == GV_SUM) {
             gv_left_out = gv_left_out + front;
+            gv_edge = gv_edge + peak_upper(p);
         }
         return;
     }
@@ -245,7 +308,13 @@ fn event_visit(ray: EventRay, i: u32, t_after: f64, key_after: u32, capacity: u3
     let lo = max(p.t_star - w * p.s, 0.0lf);
     let hi = max(p.t_star + w * p.s, 0.0lf);
     if (gv_mode == GV_SUM) {
-        gv_left_out = gv_left_out + total * f64_exp(-0.5lf * w * w) * (1.0lf + 16.0lf * GR_U);
+        let tails = total * f64_exp(-0.5lf * w * w) * (1.0lf + 16.0lf * GR_U);
+        gv_left_out = gv_left_out + tails;
+        let edge = density_beyond(p, w);
+        gv_edge = gv_edge + edge;
+        gv_tail_shift = gv_tail_shift + p.e_t * (tails + 2.0lf * p.e_t * edge);
+        gv_far_shift = gv_far_shift + p.e_t * peak_upper(p);
+        gv_total_shift = gv_total_shift + p.e_t * (total + 2.0lf * p.e_t * peak_upper(p));
         if (hi > lo) {
             gv_count = gv_count + 1u;
             gv_first = min(gv_first, lo);
@@ -290,9 +359,19 @@ fn gauss_sum(ray: EventRay, s: ptr<function, GState>) {
     gv_pert = 0.0lf;
     gv_first = REF_HUGE_G;
     gv_last = 0.0lf;
+    gv_edge = 0.0lf;
+    gv_peaks = 0.0lf;
+    gv_tail_shift = 0.0lf;
+    gv_far_shift = 0.0lf;
+    gv_total_shift = 0.0lf;
     events_collect(ray, 0.0lf, 0u, 1u, params.gaussian_count);
     (*s).left_out = gv_left_out;
-    (*s).pert = gv_pert;
+    // The shift of each kept window's t* against the others' density (`shift_depth`): of its
+    // tails against every candidate's peak, of all of it against the far Gaussians' depth.
+    let far = scene_data[GS_FAR_DEPTH];
+    (*s).pert = gv_pert + (gv_tail_shift * gv_peaks + gv_far_shift * far) * (1.0lf + 1.0e-9lf);
+    (*s).edge = gv_edge * (1.0lf + 1.0e-9lf);
+    (*s).rest_shift = gv_total_shift * (gv_peaks + gv_edge) * (1.0lf + 1.0e-9lf);
     (*s).span = max(gv_last - gv_first, 0.0lf);
     (*s).kept = gv_count;
 }
@@ -319,6 +398,8 @@ fn gauss_batch(ray: EventRay, a: f64, kept: u32) -> f64 {
         w_tstar[j] = p.t_star;
         w_s[j] = p.s;
         w_peak[j] = p.peak;
+        w_peak_hi[j] = peak_upper(p);
+        w_et[j] = p.e_t;
         w_lo[j] = events_t[j];
         w_hi[j] = max(p.t_star + window_reach(2.0lf * depth_factor(p.peak, p.s)) * p.s, 0.0lf);
         w_index[j] = i;
@@ -377,6 +458,8 @@ struct GState {
     count: u32,
     kept: u32,
     phase: u32,
+    edge: f64,
+    rest_shift: f64,
 }
 
 fn st_vec(b: u32) -> vec3<f64> {
@@ -409,6 +492,8 @@ fn load_gstate(r: u32) -> GState {
         u32(state[b + GST_COUNT]),
         u32(state[b + GST_KEPT]),
         u32(state[b + GST_PHASE]),
+        state[b + GST_EDGE],
+        state[b + GST_REST_SHIFT],
     );
 }
 
@@ -431,6 +516,8 @@ fn store_gstate(r: u32, s: GState) {
     state[b + GST_COUNT] = f64(s.count);
     state[b + GST_KEPT] = f64(s.kept);
     state[b + GST_PHASE] = f64(s.phase);
+    state[b + GST_EDGE] = s.edge;
+    state[b + GST_REST_SHIFT] = s.rest_shift;
 }
 
 // Adds a term c (any sign) with relative error ≤ rel to the radiance, with its rounding.
@@ -586,16 +673,33 @@ fn integrate_piece(s: ptr<function, GState>, a: f64, b: f64, c_ref: vec3<f64>, t
     }
 }
 
+// The effect of window w's t* lying anywhere within e_t of the computed one, on a piece where
+// its depth is `depth` and the density of all windows' Gaussians is at most `others` + its own
+// peak, as optical depth (times M it bounds L's change). dL/dx for a Gaussian at position x is
+// g(−x)·(Cᵢ − R(0)) − ∫ g(t − x)·T(t)·Σ_{j≠i} σⱼ(t)(Cᵢ − Cⱼ) dt (the density's derivative
+// integrated by parts against T and the radiance R from behind), so a shift by δ changes L by at
+// most M·δ·(g at the eye + ∫ g·Σ_{j≠i} σⱼ): the first is in the gather's `pert`, the second
+// split over the pieces, within each the others' peaks (members) or their density beyond their
+// windows (`edge`), and over the tails and against the far Gaussians in `pert`. A Gaussian
+// alone moves no light: this is far below 2·peak·δ for flat ones.
+fn shift_depth(w: u32, depth: f64, others: f64) -> f64 {
+    let own = w_peak_hi[w];
+    let rest = max(others - own, 0.0lf) + 4.0lf * GR_U * others;
+    return w_et[w] * (abs(depth) + 2.0lf * own * w_et[w]) * rest * (1.0lf + 8.0lf * GR_U);
+}
+
 // The piece [a, b]: members, closed form, deviation; returns whether the ray has ended (a stop
 // behind nearly opaque gas). src/reference/gaussian.rs `sweep`, one piece.
 fn take_piece(s: ptr<function, GState>, a: f64, b: f64, bound: vec3<f64>) -> bool {
     m_count = 0u;
+    var peaks = 0.0lf;
     for (var w = 0u; w < w_count; w = w + 1u) {
         count_iteration();
         if (w_lo[w] < b && w_hi[w] > a) {
             m_window[m_count] = w;
             m_tail_a[m_count] = f64_erfc(abs(w_z(w, a)));
             m_count = m_count + 1u;
+            peaks = peaks + w_peak_hi[w];
         }
     }
     if (m_count == 0u) {
@@ -608,8 +712,11 @@ fn take_piece(s: ptr<function, GState>, a: f64, b: f64, bound: vec3<f64>) -> boo
         let rest = (0.5lf * t) * bound;
         g_add(s, rest, (*s).transmittance_rel + GR_U);
         (*s).ray_stop = (*s).ray_stop + rest;
+        // The shifts' effect behind the stop, where the transmittance is below about t.
+        (*s).depth = (*s).depth + 2.0lf * t * (*s).rest_shift;
         return true;
     }
+    let others = peaks * (1.0lf + 2.0lf * f64(m_count) * GR_U) + (*s).edge;
     // Each member's depth on the piece; the heaviest gives C_ref.
     var tau = 0.0lf;
     var e_tau = 0.0lf;
@@ -625,6 +732,7 @@ fn take_piece(s: ptr<function, GState>, a: f64, b: f64, bound: vec3<f64>) -> boo
         let depth = f * erf_between(w_z(w, a), m_tail_a[j], zb, tb);
         tau = tau + depth;
         e_tau = e_tau + erf_between_error(f, m_tail_a[j], tb, depth);
+        e_tau = e_tau + shift_depth(w, depth, others);
         // At a node inside the piece each erfc is at most 2.
         node_tau = node_tau + erf_between_error(f, 2.0lf, 2.0lf, depth);
         if (depth > heaviest_depth) {
