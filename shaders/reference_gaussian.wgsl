@@ -312,9 +312,11 @@ fn event_visit(ray: EventRay, i: u32, t_after: f64, key_after: u32, capacity: u3
         gv_left_out = gv_left_out + tails;
         let edge = density_beyond(p, w);
         gv_edge = gv_edge + edge;
-        gv_tail_shift = gv_tail_shift + p.e_t * (tails + 2.0lf * p.e_t * edge);
+        // The exact profile's depths: the peak's bound over the computed peak.
+        let exact = select(1.0lf, peak_upper(p) / p.peak, p.peak > 0.0lf);
+        gv_tail_shift = gv_tail_shift + p.e_t * (tails * exact + 2.0lf * p.e_t * edge);
         gv_far_shift = gv_far_shift + p.e_t * peak_upper(p);
-        gv_total_shift = gv_total_shift + p.e_t * (total + 2.0lf * p.e_t * peak_upper(p));
+        gv_total_shift = gv_total_shift + p.e_t * (total * exact + 2.0lf * p.e_t * peak_upper(p));
         if (hi > lo) {
             gv_count = gv_count + 1u;
             gv_first = min(gv_first, lo);
@@ -685,7 +687,9 @@ fn integrate_piece(s: ptr<function, GState>, a: f64, b: f64, c_ref: vec3<f64>, t
 fn shift_depth(w: u32, depth: f64, others: f64) -> f64 {
     let own = w_peak_hi[w];
     let rest = max(others - own, 0.0lf) + 4.0lf * GR_U * others;
-    return w_et[w] * (abs(depth) + 2.0lf * own * w_et[w]) * rest * (1.0lf + 8.0lf * GR_U);
+    // The exact profile's depth on the piece: the peak's bound over the computed peak.
+    let exact = abs(depth) * select(1.0lf, own / w_peak[w], w_peak[w] > 0.0lf);
+    return w_et[w] * (exact + 2.0lf * own * w_et[w]) * rest * (1.0lf + 8.0lf * GR_U);
 }
 
 // The piece [a, b]: members, closed form, deviation; returns whether the ray has ended (a stop
