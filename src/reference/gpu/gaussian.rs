@@ -416,8 +416,11 @@ pub fn trace(
         passes: 0,
     };
     for part in directions.chunks(chunk) {
-        let (state, passes) = run_chunk(ctx, &pipeline, &buffers, part)?;
+        let (mut state, passes) = run_chunk(ctx, &pipeline, &buffers, part)?;
         out.passes = out.passes.max(passes);
+        if ctx.adapter.is_cpu {
+            taint_loop_limited_workgroups(&mut state);
+        }
         for ray in state.chunks_exact(GST_STRIDE) {
             let radiance = DVec3::new(
                 ray[GST_RADIANCE],
@@ -431,6 +434,24 @@ pub fn trace(
         }
     }
     Ok(out)
+}
+
+/// On a Cpu adapter (lavapipe), every ray of a workgroup in which one ray ran past the loop
+/// budget is marked loop-limited: lavapipe counts the loop iterations of SIMD lanes together
+/// and, past its limit, ends the loops of all of them with wrong values, so a ray that finished
+/// beside one that did not may be wrong without knowing it (docs/design.md §12). Such rays get
+/// err = |L| + M and are counted not converged.
+fn taint_loop_limited_workgroups(state: &mut [f64]) {
+    for group in state.chunks_mut(GST_STRIDE * WORKGROUP as usize) {
+        let limited = group
+            .chunks_exact(GST_STRIDE)
+            .any(|ray| ray[GST_STATUS] as u32 == GSTATUS_LOOP_LIMITED);
+        if limited {
+            for ray in group.chunks_exact_mut(GST_STRIDE) {
+                ray[GST_STATUS] = f64::from(GSTATUS_LOOP_LIMITED);
+            }
+        }
+    }
 }
 
 /// The buffers every chunk of rays shares.
