@@ -7,13 +7,15 @@
 //! **err** has the CPU's meaning, a bound on |stored − true| per pixel channel, and the CPU's
 //! parts ([`ray_error`]): the ray stop, the deviations bounded in closed form, the quadrature's
 //! estimate, M·(1 − e^{−Δ}) for the depth Δ left out (far, faint, tails); and the device's own:
-//! the profiles' and the pieces' depth uncertainty as M per unit of depth, and the composite's
+//! the profiles' and the pieces' depth uncertainty as M per unit of depth (t*'s through the
+//! position derivative of L, which only other gas makes matter), and the composite's
 //! rounding, doubled for the second-order terms. A ray takes its windows in batches of
 //! [`WINDOWS_MAX`] over the shared traversal (`shaders/nearest_events.wgsl`). A ray the
 //! program cannot finish (more windows open at one depth than a batch holds; a piece beyond
-//! the loop budget of a pass) is not converged with err = |L| + M, the bound that holds for any
-//! value; a ray whose quadrature could not meet its share keeps
-//! its estimate in err and is counted not converged, as on the CPU.
+//! the loop budget of a pass, and on lavapipe every ray of that ray's workgroup) is not
+//! converged with err = |L| + M, the bound that holds for any value; a ray whose quadrature
+//! could not meet its share keeps its estimate in err and is counted not converged, as on the
+//! CPU.
 
 use super::math::{ERFC_NORMAL, ERFC_ULPS, EXPM1_ULPS, EXP_ULPS, F64_MATH_WGSL, U};
 use super::program::SAFETY;
