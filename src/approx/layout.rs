@@ -338,24 +338,7 @@ impl SceneBuffers {
                 },
             })
             .collect();
-        let nodes = bvh
-            .nodes
-            .iter()
-            .map(|n| {
-                let (min, max) = if n.min.x <= n.max.x {
-                    widen(n.min, n.max, origin)
-                } else {
-                    // The empty tree's root: an inverted box no ray enters.
-                    ([f32::MAX; 3], [f32::MIN; 3])
-                };
-                GpuBvhNode {
-                    min,
-                    first: n.first,
-                    max,
-                    count: n.count,
-                }
-            })
-            .collect();
+        let nodes = gpu_nodes(bvh, origin);
         let lights = scene
             .lights
             .iter()
@@ -444,6 +427,27 @@ pub fn widened_gaussians(scene: &Scene, k: f64) -> Scene {
         }
     }
     out
+}
+
+/// The nodes of `bvh` as the shaders read them: boxes relative to `origin`, widened outwards to
+/// f32 ([`widen`]); the empty tree's root an inverted box no ray enters.
+pub fn gpu_nodes(bvh: &Bvh, origin: DVec3) -> Vec<GpuBvhNode> {
+    bvh.nodes
+        .iter()
+        .map(|n| {
+            let (min, max) = if n.min.x <= n.max.x {
+                widen(n.min, n.max, origin)
+            } else {
+                ([f32::MAX; 3], [f32::MIN; 3])
+            };
+            GpuBvhNode {
+                min,
+                first: n.first,
+                max,
+                count: n.count,
+            }
+        })
+        .collect()
 }
 
 /// Depth of the tree (a lone root is 1), by an explicit stack: no recursion on deep trees.

@@ -272,6 +272,18 @@ pub(super) fn within_both_errs(what: &str, gpu: &RenderOutput, cpu: &RenderOutpu
     worst
 }
 
+/// Renders `scene` twice on the GPU reference and asserts the same bits in image and err.
+pub(super) fn same_bits_twice(ctx: &GpuContext, scene: &Scene) {
+    let options = RenderOptions::default();
+    let a = gpu::render_on(ctx, scene, &options).unwrap();
+    let b = gpu::render_on(ctx, scene, &options).unwrap();
+    assert!(same_bits(&a.image, &b.image));
+    assert!(same_bits(
+        a.error.as_ref().unwrap(),
+        b.error.as_ref().unwrap()
+    ));
+}
+
 pub(super) fn same_bits(a: &RgbImage, b: &RgbImage) -> bool {
     a.pixels
         .iter()
@@ -500,14 +512,7 @@ fn rays_with_many_events_go_on_over_passes_and_agree() {
 fn the_gpu_reference_gives_the_same_bits_on_every_run() {
     let Some(ctx) = gpu64() else { return };
     let scene = random_scene(9, 60);
-    let options = RenderOptions::default();
-    let a = gpu::render_on(ctx, &scene, &options).unwrap();
-    let b = gpu::render_on(ctx, &scene, &options).unwrap();
-    assert!(same_bits(&a.image, &b.image));
-    assert!(same_bits(
-        a.error.as_ref().unwrap(),
-        b.error.as_ref().unwrap()
-    ));
+    same_bits_twice(ctx, &scene);
 }
 
 #[test]

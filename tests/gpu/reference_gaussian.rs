@@ -5,7 +5,9 @@
 //! a batch holds; the same bits on every run; err_gpu within a small factor of the
 //! CPU's; the refusals by name.
 
-use super::reference::{emission_at, gpu64, pgt, repo, same_bits, within_both_errs};
+use super::reference::{
+    emission_at, gpu64, pgt, repo, same_bits, same_bits_twice, within_both_errs,
+};
 use super::support::volume::{self, Rng};
 use glam::{DQuat, DVec3};
 use pgt::approx::GpuContext;
@@ -110,6 +112,20 @@ fn random_flat_and_round_gaussians_agree_with_the_cpu_reference_within_both_errs
     }
 }
 
+/// Per pixel channel of the GPU render `g` against the tighter CPU render `t`: (pixel, channel,
+/// |g − t|, err_gpu, err of `t`).
+fn channels_against(g: &RenderOutput, t: &RenderOutput) -> Vec<(usize, usize, f64, f64, f64)> {
+    let (ge, te) = (g.error.as_ref().unwrap(), t.error.as_ref().unwrap());
+    let mut out = Vec::with_capacity(3 * g.image.pixels.len());
+    for i in 0..g.image.pixels.len() {
+        for c in 0..3 {
+            let d = (g.image.pixels[i][c] as f64 - t.image.pixels[i][c] as f64).abs();
+            out.push((i, c, d, ge.pixels[i][c] as f64, te.pixels[i][c] as f64));
+        }
+    }
+    out
+}
+
 /// err_gpu alone against the truth: a CPU render at tol/100 stands for it (its err, about
 /// 100 times smaller, added), and the GPU's err at tol 1e-5 covers the distance at ≥ 99.9 % of
 /// pixel channels, as the CPU's err does in tests/reference/gaussians.rs.
@@ -122,20 +138,12 @@ fn err_gpu_covers_a_hundred_times_tighter_cpu_render() {
     let options = RenderOptions::default();
     let g = gpu::render_on(ctx, &scene, &options).unwrap();
     let t = reference::render(&tight, &options).unwrap();
-    let (ge, te) = (g.error.as_ref().unwrap(), t.error.as_ref().unwrap());
     let (mut covered, mut total, mut off) = (0, 0, 0.0f64);
-    for i in 0..g.image.pixels.len() {
-        for c in 0..3 {
-            let d = (g.image.pixels[i][c] as f64 - t.image.pixels[i][c] as f64).abs();
-            let e = ge.pixels[i][c] as f64;
-            assert!(
-                d <= e + te.pixels[i][c] as f64,
-                "pixel {i} channel {c}: {d:e} > {e:e}"
-            );
-            covered += usize::from(d <= e);
-            total += 1;
-            off = off.max(d);
-        }
+    for (i, c, d, e, te) in channels_against(&g, &t) {
+        assert!(d <= e + te, "pixel {i} channel {c}: {d:e} > {e:e}");
+        covered += usize::from(d <= e);
+        total += 1;
+        off = off.max(d);
     }
     eprintln!("err_gpu covers {covered} of {total} channels; largest distance {off:.3e}");
     assert!(
@@ -252,19 +260,13 @@ fn a_crop_of_a_trained_tile_of_very_flat_gaussians_agrees_with_the_cpu() {
     let mut tight = scene.clone();
     tight.render.tol = scene.render.tol / 100.0;
     let t = reference::render(&tight, &options).unwrap();
-    let (ge, te) = (g.error.as_ref().unwrap(), t.error.as_ref().unwrap());
     let mut off = 0.0f64;
-    for i in 0..g.image.pixels.len() {
-        for c in 0..3 {
-            let d = (g.image.pixels[i][c] as f64 - t.image.pixels[i][c] as f64).abs();
-            assert!(
-                d <= ge.pixels[i][c] as f64,
-                "pixel {i} channel {c}: {d:e} > err_gpu {:e} (cpu tol/100 err {:e})",
-                ge.pixels[i][c],
-                te.pixels[i][c]
-            );
-            off = off.max(d);
-        }
+    for (i, c, d, e, te) in channels_against(&g, &t) {
+        assert!(
+            d <= e,
+            "pixel {i} channel {c}: {d:e} > err_gpu {e:e} (cpu tol/100 err {te:e})"
+        );
+        off = off.max(d);
     }
     let (gx, cx) = (g.stats.max_error.unwrap(), cpu.stats.max_error.unwrap());
     eprintln!(
@@ -396,14 +398,7 @@ fn a_ray_with_more_gaussians_open_at_once_than_it_holds_is_not_converged() {
 fn the_gaussian_gpu_reference_gives_the_same_bits_on_every_run() {
     let Some(ctx) = gpu64() else { return };
     let scene = flat_and_round(4803, 20, 12);
-    let options = RenderOptions::default();
-    let a = gpu::render_on(ctx, &scene, &options).unwrap();
-    let b = gpu::render_on(ctx, &scene, &options).unwrap();
-    assert!(same_bits(&a.image, &b.image));
-    assert!(same_bits(
-        a.error.as_ref().unwrap(),
-        b.error.as_ref().unwrap()
-    ));
+    same_bits_twice(ctx, &scene);
 }
 
 #[test]

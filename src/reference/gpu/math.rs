@@ -79,12 +79,7 @@ pub fn harness_program() -> ShaderProgram {
 /// (exp x, expm1 x, log1p x, erfc x) for every x, computed on the GPU by
 /// `shaders/f64_math.wgsl` (log1p: 0 where x ≤ −1). At most 65535·64 arguments a call.
 pub fn evaluate(ctx: &GpuContext, xs: &[f64]) -> Result<Vec<[f64; 4]>> {
-    if !ctx.f64 {
-        return Err(PgtError::Gpu(format!(
-            "{} was opened without f64 (GpuContext::with_f64)",
-            ctx.adapter
-        )));
-    }
+    super::pipeline::check_f64(ctx)?;
     if xs.is_empty() {
         return Ok(Vec::new());
     }
@@ -92,23 +87,11 @@ pub fn evaluate(ctx: &GpuContext, xs: &[f64]) -> Result<Vec<[f64; 4]>> {
     if groups > 65535 {
         return Err(PgtError::Gpu("at most 65535·64 arguments a call".into()));
     }
-    let program = harness_program();
-    program.validate_with(naga::valid::Capabilities::FLOAT64)?;
+    let pipeline =
+        super::pipeline::compile(ctx, &harness_program(), "f64 math harness", "math_main")?;
     let device = &ctx.device;
     let out_bytes = (xs.len() * 4 * 8) as u64;
-    let (pipeline, bind_group, output, read) = ctx.checked("the f64 math harness", || {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("pgt f64 math"),
-            source: wgpu::ShaderSource::Wgsl(program.source().into()),
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("pgt f64 math"),
-            layout: None,
-            module: &module,
-            entry_point: Some("math_main"),
-            compilation_options: Default::default(),
-            cache: None,
-        });
+    let (bind_group, output, read) = ctx.checked("the f64 math harness", || {
         let input = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
             label: Some("pgt f64 math in"),
             contents: bytemuck::cast_slice(xs),
@@ -140,7 +123,7 @@ pub fn evaluate(ctx: &GpuContext, xs: &[f64]) -> Result<Vec<[f64; 4]>> {
                 },
             ],
         });
-        (pipeline, bind_group, output, read)
+        (bind_group, output, read)
     })?;
     ctx.checked("running the f64 math harness", || {
         let mut encoder = device.create_command_encoder(&Default::default());

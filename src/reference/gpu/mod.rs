@@ -29,6 +29,7 @@
 
 pub mod gaussian;
 pub mod math;
+mod pipeline;
 pub mod program;
 mod run;
 

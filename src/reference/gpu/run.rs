@@ -1,5 +1,6 @@
 //! The GPU reference's buffers, passes and read-back (docs/design.md §12).
 
+use super::pipeline::{check_f64, compile};
 use super::program::{
     program, RefParams, ELLIPSOID_STRIDE, ENTRY_POINT, PARTICLE_STRIDE, P_COLOR, P_RADIUS, P_SHAPE,
     P_SIGMA, SCENE_BACKGROUND, SCENE_CMAX, SCENE_DIRECTION_ERROR, SCENE_LEN, SCENE_ORIGIN,
@@ -132,33 +133,10 @@ pub fn trace(
     directions: &[DVec3],
     direction_error: f64,
 ) -> Result<Traced> {
-    if !ctx.f64 {
-        return Err(PgtError::Gpu(format!(
-            "{} was opened without f64 (GpuContext::with_f64)",
-            ctx.adapter
-        )));
-    }
+    check_f64(ctx)?;
     super::check_scene_size(ctx, scene)?;
     let data = scene_data(scene, origin, direction_error)?;
-    let program = program();
-    program.validate_with(naga::valid::Capabilities::FLOAT64)?;
-    let pipeline = ctx.checked("compiling the GPU reference", || {
-        let module = ctx
-            .device
-            .create_shader_module(wgpu::ShaderModuleDescriptor {
-                label: Some("pgt reference"),
-                source: wgpu::ShaderSource::Wgsl(program.source().into()),
-            });
-        ctx.device
-            .create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some("pgt reference"),
-                layout: None,
-                module: &module,
-                entry_point: Some(ENTRY_POINT),
-                compilation_options: Default::default(),
-                cache: None,
-            })
-    })?;
+    let pipeline = compile(ctx, &program(), "GPU reference", ENTRY_POINT)?;
     ctx.check_buffers(
         &[
             ("particle", size_of_val(&data.particles[..]) as u64),
