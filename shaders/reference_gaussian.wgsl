@@ -253,11 +253,11 @@ fn peak_upper(p: Profile64) -> f64 {
     return p.peak * f64_exp(0.5lf * p.e_m2) * (1.0lf + 1.0e-12lf);
 }
 
-// The most density the profile has at a distance of at least `reach`·s from its centre, with the
-// centre anywhere within e_t of t*.
-fn density_beyond(p: Profile64, reach: f64) -> f64 {
+// The most density the profile (its peak at most `peak_hi`) has at a distance of at least
+// `reach`·s from its centre, with the centre anywhere within e_t of t*.
+fn density_beyond(p: Profile64, peak_hi: f64, reach: f64) -> f64 {
     let z = max(reach - p.e_t / p.s, 0.0lf);
-    return peak_upper(p) * f64_exp(-0.5lf * z * z) * (1.0lf + 1.0e-12lf);
+    return peak_hi * f64_exp(-0.5lf * z * z) * (1.0lf + 1.0e-12lf);
 }
 
 // peak·s·√(π/2): a profile's optical depth per unit of erf difference.
@@ -290,16 +290,18 @@ fn event_visit(ray: EventRay, i: u32, t_after: f64, key_after: u32, capacity: u3
     // The depth over [0, ∞): factor·(1 + erf(t*/(√2 s))) = factor·erfc(−t*/(√2 s)).
     let factor = depth_factor(p.peak, p.s);
     let front = factor * f64_erfc(-p.t_star / (GR_SQRT2 * p.s));
+    var peak_hi = 0.0lf;
     if (gv_mode == GV_SUM) {
+        peak_hi = peak_upper(p);
         // The shift moves depth across the eye: at most e_t times the density there.
-        let at_eye = p.e_t * density_beyond(p, abs(p.t_star) / p.s);
+        let at_eye = p.e_t * density_beyond(p, peak_hi, abs(p.t_star) / p.s);
         gv_pert = gv_pert + p.pert + at_eye + front * (2.0lf * GR_ERFC_ULPS * GR_U + 4.0lf * GR_U) + factor * 12.0lf * GR_U;
-        gv_peaks = gv_peaks + peak_upper(p);
+        gv_peaks = gv_peaks + peak_hi;
     }
     if (front <= gv_faint) {
         if (gv_mode == GV_SUM) {
             gv_left_out = gv_left_out + front;
-            gv_edge = gv_edge + peak_upper(p);
+            gv_edge = gv_edge + peak_hi;
         }
         return;
     }
@@ -310,13 +312,13 @@ fn event_visit(ray: EventRay, i: u32, t_after: f64, key_after: u32, capacity: u3
     if (gv_mode == GV_SUM) {
         let tails = total * f64_exp(-0.5lf * w * w) * (1.0lf + 16.0lf * GR_U);
         gv_left_out = gv_left_out + tails;
-        let edge = density_beyond(p, w);
+        let edge = density_beyond(p, peak_hi, w);
         gv_edge = gv_edge + edge;
         // The exact profile's depths: the peak's bound over the computed peak.
-        let exact = select(1.0lf, peak_upper(p) / p.peak, p.peak > 0.0lf);
+        let exact = select(1.0lf, peak_hi / p.peak, p.peak > 0.0lf);
         gv_tail_shift = gv_tail_shift + p.e_t * (tails * exact + 2.0lf * p.e_t * edge);
-        gv_far_shift = gv_far_shift + p.e_t * peak_upper(p);
-        gv_total_shift = gv_total_shift + p.e_t * (total * exact + 2.0lf * p.e_t * peak_upper(p));
+        gv_far_shift = gv_far_shift + p.e_t * peak_hi;
+        gv_total_shift = gv_total_shift + p.e_t * (total * exact + 2.0lf * p.e_t * peak_hi);
         if (hi > lo) {
             gv_count = gv_count + 1u;
             gv_first = min(gv_first, lo);
